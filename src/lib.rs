@@ -1,0 +1,15 @@
+//! # yarnsim
+//!
+//! Simulation of thin elastic objects: 2D yarn bundles by the Material Point
+//! Method (Jiang, Gast, Teran 2017), and mass-spring wires and cloth.
+//!
+//! * [`math`]: 2x2 QR, B-spline weights.
+//! * [`scene`]: scene descriptions ("layouts") and their TOML files.
+//! * [`mpm`]: the yarn-bundle MPM solver.
+
+pub mod math;
+pub mod mpm;
+pub mod scene;
+
+pub use mpm::{SimError, YarnSim};
+pub use scene::{Scene, SceneError, YarnScene};

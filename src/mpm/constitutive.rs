@@ -1,0 +1,154 @@
+//! The anisotropic yarn energy of Jiang, Gast, Teran 2017 and its
+//! Mohr-Coulomb return mapping, in the fiber frame.
+//!
+//! Each quadrature particle has a material frame `d = [d1 | d2]` (fiber edge
+//! and normal) with rest frame `D = [D1 | R90 D1]`, `|D1| = l0`. The energy is
+//! evaluated on `G = d / l0`, the deformation gradient seen in the fiber frame,
+//! so that a yarn's response does not depend on its orientation in the world:
+//! with `G = Q R` (Givens QR, `det Q = +1`, `r11 >= 0`)
+//!
+//! ```text
+//! psi(R) = 1/2 k (r11 - 1)^2 + 1/2 gamma r12^2 + 1/2 (2 mu + lambda) (log r22)^2 [r22 < 1]
+//! ```
+//!
+//! and `P = dpsi/dG = Q A R^-T` with `A = (dpsi/dR) R^T` whose upper triangle
+//! is mirrored: `A00 = f' r11 + g' r12`, `A01 = A10 = g' r22`, `A11 = h' r22`.
+//! In world terms, with `F = d D^-1` and `D = Q_D l0`, `dpsi/dF D^-T = P / l0`.
+
+use crate::math::qr::{qr, Qr2};
+use crate::math::{Mat2, Vec2};
+use crate::scene::Material;
+
+/// `r22` is clamped to at least this before `log r22` and `1 / r22`, so a
+/// crushed or inverted cross-section gives a large finite restoring stress
+/// instead of NaN.
+pub const R22_MIN: f64 = 1e-3;
+/// `r11` is clamped to at least this before `1 / r11`.
+pub const R11_MIN: f64 = 1e-6;
+
+/// Material constants of the energy.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct YarnEnergy {
+    /// Fiber stretch stiffness.
+    pub k: f64,
+    /// Fiber shear stiffness.
+    pub gamma: f64,
+    /// Normal (cross-section) stiffness `2 mu + lambda = 1.4 E`.
+    pub normal: f64,
+    /// Mohr-Coulomb friction coefficient `c_f`.
+    pub friction: f64,
+}
+
+impl YarnEnergy {
+    pub fn from_material(m: &Material) -> Self {
+        YarnEnergy {
+            k: m.k,
+            gamma: m.gamma,
+            normal: 2.0 * m.mu() + m.lambda(),
+            friction: m.friction,
+        }
+    }
+
+    /// `psi` at the factor `R` (entries `r11, r12, r22`).
+    pub fn psi_r(&self, r11: f64, r12: f64, r22: f64) -> f64 {
+        let f = 0.5 * self.k * (r11 - 1.0) * (r11 - 1.0);
+        let g = 0.5 * self.gamma * r12 * r12;
+        let h = if r22 < 1.0 {
+            let l = r22.max(R22_MIN).ln();
+            0.5 * self.normal * l * l
+        } else {
+            0.0
+        };
+        f + g + h
+    }
+
+    /// `psi(G)` for a fiber-frame deformation gradient `G`.
+    pub fn psi(&self, g: &Mat2) -> f64 {
+        let d = qr(g);
+        self.psi_r(d.r11, d.r12, d.r22)
+    }
+
+    /// First Piola-Kirchhoff stress `P = dpsi/dG = Q A R^-T` from a QR factorisation.
+    #[inline]
+    pub fn stress_qr(&self, d: &Qr2) -> Mat2 {
+        let r11 = d.r11.max(R11_MIN);
+        let r12 = d.r12;
+        let r22 = d.r22.max(R22_MIN);
+        let fp = self.k * (r11 - 1.0);
+        let gp = self.gamma * r12;
+        // h'(r22) r22 = normal * log r22 for r22 < 1, else 0.
+        let hr = if r22 < 1.0 {
+            self.normal * r22.ln()
+        } else {
+            0.0
+        };
+        let a00 = fp * r11 + gp * r12;
+        let a01 = gp * r22;
+        let a11 = hr;
+        // A R^-T with R^-T = [[1/r11, 0], [-r12/(r11 r22), 1/r22]]
+        let i11 = 1.0 / r11;
+        let i22 = 1.0 / r22;
+        let i21 = -r12 * i11 * i22;
+        let b00 = a00 * i11 + a01 * i21;
+        let b01 = a01 * i22;
+        let b10 = a01 * i11 + a11 * i21;
+        let b11 = a11 * i22;
+        // Q B
+        let (c, s) = (d.c, d.s);
+        Mat2::new(
+            c * b00 - s * b10,
+            c * b01 - s * b11,
+            s * b00 + c * b10,
+            s * b01 + c * b11,
+        )
+    }
+
+    /// `P = dpsi/dG`.
+    pub fn stress(&self, g: &Mat2) -> Mat2 {
+        self.stress_qr(&qr(g))
+    }
+
+    /// Mohr-Coulomb return mapping on `(r12, r22)`, in stress units.
+    ///
+    /// * `r22 > 1` (cross-section in tension, yarns separated): `r12 = 0`, `r22 = 1`.
+    /// * otherwise the shear stress `|A01| = gamma |r12| r22` may not exceed
+    ///   `c_f` times the normal pressure `-A11 = -(2 mu + lambda) log r22`;
+    ///   `r12` is scaled back onto that yield surface. `r22` is raised to at
+    ///   least [`R22_MIN`] so an inverted cross-section is reset.
+    #[inline]
+    pub fn return_map(&self, r12: f64, r22: f64) -> (f64, f64) {
+        if r22 > 1.0 {
+            return (0.0, 1.0);
+        }
+        let r22 = r22.max(R22_MIN);
+        let pressure = -self.normal * r22.ln(); // >= 0
+        let limit = self.friction * pressure;
+        let shear = self.gamma * r12.abs() * r22;
+        if shear > limit {
+            let r12_max = if self.gamma > 0.0 {
+                limit / (self.gamma * r22)
+            } else {
+                0.0
+            };
+            (r12.signum() * r12_max, r22)
+        } else {
+            (r12, r22)
+        }
+    }
+
+    /// Yield function `gamma |r12| r22 - c_f (-(2 mu + lambda) log r22)`:
+    /// `<= 0` inside the elastic region, `0` on the yield surface.
+    pub fn yield_function(&self, r12: f64, r22: f64) -> f64 {
+        self.gamma * r12.abs() * r22 - self.friction * (-self.normal * r22.ln())
+    }
+}
+
+/// The fiber-frame force vectors of one quadrature particle: `dE/dd1` and
+/// `dE/dd2` for energy `E = V psi(d / l0)`.
+#[inline]
+pub fn frame_gradient(energy: &YarnEnergy, d: &Mat2, l0: f64, volume: f64) -> (Vec2, Vec2) {
+    let g = d * (1.0 / l0);
+    let p = energy.stress_qr(&qr(&g));
+    let s = volume / l0;
+    (p.column(0) * s, p.column(1) * s)
+}

@@ -1,0 +1,158 @@
+//! Particle storage of the yarn bundle: type-2 vertices (the yarns' mesh
+//! vertices) and type-3 quadrature particles (one per segment, carrying the
+//! material frame), as structures of arrays.
+//!
+//! Mass lives on both kinds: a segment of rest length `l0` and line density
+//! `rho` has mass `rho l0`; half of it sits on its quadrature particle and a
+//! quarter on each end vertex. Every particle takes its velocity from the grid
+//! (APIC), so linear momentum is conserved exactly; quadrature particle
+//! positions are re-interpolated from the vertices each step.
+
+use crate::math::bspline::Stencil;
+use crate::math::{perp, Mat2, Vec2};
+use crate::scene::YarnScene;
+
+/// Marks "no neighbour" in the index arrays.
+pub const NONE: u32 = u32::MAX;
+
+/// Type-2 particles: the yarn vertices.
+#[derive(Clone, Debug, Default)]
+pub struct Vertices {
+    pub x: Vec<Vec2>,
+    pub v: Vec<Vec2>,
+    /// APIC affine velocity matrix.
+    pub c: Vec<Mat2>,
+    pub m: Vec<f64>,
+    /// Quadrature particle of the segment to the left (this vertex is its right end), or [`NONE`].
+    pub q_left: Vec<u32>,
+    /// Quadrature particle of the segment to the right, or [`NONE`].
+    pub q_right: Vec<u32>,
+    /// Bending partner two vertices back, or [`NONE`], and its rest distance.
+    pub bend_prev: Vec<(u32, f64)>,
+    /// Bending partner two vertices ahead, or [`NONE`], and its rest distance.
+    pub bend_next: Vec<(u32, f64)>,
+    /// Stencils at the start-of-step positions (scratch).
+    pub stencil: Vec<Stencil>,
+    /// Total internal force on the vertex (scratch).
+    pub force: Vec<Vec2>,
+}
+
+/// Type-3 particles: one quadrature point per segment.
+#[derive(Clone, Debug, Default)]
+pub struct Quads {
+    pub x: Vec<Vec2>,
+    pub v: Vec<Vec2>,
+    pub c: Vec<Mat2>,
+    pub m: Vec<f64>,
+    /// Current material frame `d = [d1 | d2]`.
+    pub d: Vec<Mat2>,
+    /// Rest frame `D = [D1 | R90 D1]`.
+    pub d_rest: Vec<Mat2>,
+    /// `D^-1`.
+    pub d_rest_inv: Vec<Mat2>,
+    /// Deformation gradient `F = d D^-1` (world frame).
+    pub f: Vec<Mat2>,
+    /// Rest length `|D1|`.
+    pub l0: Vec<f64>,
+    /// Volume (per unit depth): `l0` times unit thickness.
+    pub vol: Vec<f64>,
+    /// Index of the left vertex; the right one is `left + 1`.
+    pub left: Vec<u32>,
+    pub stencil: Vec<Stencil>,
+    /// `dE/dd1` (scratch).
+    pub t1: Vec<Vec2>,
+    /// `dE/dd2` (scratch).
+    pub t2: Vec<Vec2>,
+}
+
+/// All particles and the yarn topology.
+#[derive(Clone, Debug, Default)]
+pub struct Particles {
+    pub vert: Vertices,
+    pub quad: Quads,
+    /// `yarn_vertices[y]..yarn_vertices[y + 1]` are yarn `y`'s vertices.
+    pub yarn_vertices: Vec<usize>,
+}
+
+impl Particles {
+    /// Builds the particles of a validated scene at rest.
+    pub fn from_scene(scene: &YarnScene) -> Self {
+        let curves = scene.curves();
+        let vels = scene.curve_velocities();
+        let rho = scene.material.density;
+        let mut p = Particles::default();
+        p.yarn_vertices.push(0);
+        for (curve, vel) in curves.iter().zip(vels) {
+            let base = p.vert.x.len();
+            let n = curve.len();
+            for (i, &x) in curve.iter().enumerate() {
+                p.vert.x.push(x);
+                p.vert.v.push(vel);
+                p.vert.c.push(Mat2::zeros());
+                p.vert.m.push(0.0);
+                p.vert.q_left.push(NONE);
+                p.vert.q_right.push(NONE);
+                let prev = if i >= 2 {
+                    ((base + i - 2) as u32, (x - curve[i - 2]).norm())
+                } else {
+                    (NONE, 0.0)
+                };
+                let next = if i + 2 < n {
+                    ((base + i + 2) as u32, (curve[i + 2] - x).norm())
+                } else {
+                    (NONE, 0.0)
+                };
+                p.vert.bend_prev.push(prev);
+                p.vert.bend_next.push(next);
+            }
+            for i in 0..n - 1 {
+                let (l, r) = (base + i, base + i + 1);
+                let d1 = curve[i + 1] - curve[i];
+                let l0 = d1.norm();
+                let dm = Mat2::from_columns(&[d1, perp(d1)]);
+                let q = p.quad.x.len() as u32;
+                let seg_mass = rho * l0;
+                p.vert.m[l] += 0.25 * seg_mass;
+                p.vert.m[r] += 0.25 * seg_mass;
+                p.vert.q_right[l] = q;
+                p.vert.q_left[r] = q;
+                p.quad.x.push((curve[i] + curve[i + 1]) * 0.5);
+                p.quad.v.push(vel);
+                p.quad.c.push(Mat2::zeros());
+                p.quad.m.push(0.5 * seg_mass);
+                p.quad.d.push(dm);
+                p.quad.d_rest.push(dm);
+                p.quad
+                    .d_rest_inv
+                    .push(dm.try_inverse().expect("segments have positive length"));
+                p.quad.f.push(Mat2::identity());
+                p.quad.l0.push(l0);
+                p.quad.vol.push(l0);
+                p.quad.left.push(l as u32);
+            }
+            p.yarn_vertices.push(p.vert.x.len());
+        }
+        let (nv, nq) = (p.vert.x.len(), p.quad.x.len());
+        p.vert.stencil = vec![Stencil::default(); nv];
+        p.vert.force = vec![Vec2::zeros(); nv];
+        p.quad.stencil = vec![Stencil::default(); nq];
+        p.quad.t1 = vec![Vec2::zeros(); nq];
+        p.quad.t2 = vec![Vec2::zeros(); nq];
+        p
+    }
+
+    /// Number of yarns.
+    pub fn num_yarns(&self) -> usize {
+        self.yarn_vertices.len() - 1
+    }
+
+    /// Total number of particles (vertices plus quadrature points).
+    pub fn len(&self) -> usize {
+        self.vert.x.len() + self.quad.x.len()
+    }
+
+    /// Whether there are no particles.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+}

@@ -1,0 +1,464 @@
+//! The passes of one MPM substep, each a free function over the state it
+//! needs. [`crate::mpm::YarnSim::step`] runs them in order and skips those a
+//! scene does not need.
+//!
+//! 1. [`particle_forces`]: stencils, fiber-frame stress of every quadrature
+//!    particle, total internal force on every vertex (tangent + bending).
+//! 2. [`scatter`]: APIC particle-to-grid of mass and momentum, with the
+//!    internal forces added as `dt f` to the momentum.
+//! 3. [`grid_update`]: momentum / mass, gravity, attractor, obstacles, walls.
+//! 4. [`gather_vertices`] and [`gather_quads`]: grid-to-particle, vertex
+//!    advection, quadrature re-interpolation, `d2` update, return mapping.
+
+use rayon::prelude::*;
+
+use super::constitutive::{frame_gradient, YarnEnergy};
+use super::grid::{Grid, GridGeom, ScatterBuffer, CHUNKS};
+use super::particles::{Particles, Quads, Vertices, NONE};
+use crate::math::bspline::Stencil;
+use crate::math::qr::qr;
+use crate::math::{Mat2, Vec2};
+use crate::scene::{Obstacle, WallMode};
+
+/// Minimum particles per parallel task.
+const PAR_MIN: usize = 256;
+
+/// The external-force and boundary settings used by [`grid_update`].
+#[derive(Clone, Debug)]
+pub struct GridForces<'a> {
+    pub gravity: Vec2,
+    /// `(position, strength)` when the attractor acts.
+    pub attractor: Option<(Vec2, f64)>,
+    pub obstacles: &'a [Obstacle],
+    pub walls: WallMode,
+    pub wall_cells: usize,
+}
+
+/// Pass 1: stencils, quadrature stress and vertex forces.
+pub fn particle_forces(p: &mut Particles, geom: &GridGeom, energy: &YarnEnergy, bending: f64) {
+    let inv_dx = geom.inv_dx;
+    let q = &mut p.quad;
+    (
+        &mut q.stencil,
+        &mut q.t1,
+        &mut q.t2,
+        &q.x,
+        &q.d,
+        &q.l0,
+        &q.vol,
+    )
+        .into_par_iter()
+        .with_min_len(PAR_MIN)
+        .for_each(|(st, t1, t2, x, d, l0, vol)| {
+            *st = Stencil::new(*x, inv_dx);
+            let (a, b) = frame_gradient(energy, d, *l0, *vol);
+            *t1 = a;
+            *t2 = b;
+        });
+    let t1 = &p.quad.t1;
+    let v = &mut p.vert;
+    let xs = &v.x;
+    (
+        &mut v.stencil,
+        &mut v.force,
+        xs,
+        &v.q_left,
+        &v.q_right,
+        &v.bend_prev,
+        &v.bend_next,
+    )
+        .into_par_iter()
+        .with_min_len(PAR_MIN)
+        .for_each(|(st, f, x, ql, qr_, bp, bn)| {
+            *st = Stencil::new(*x, inv_dx);
+            // E depends on d1 = x_right - x_left: the left end gets +dE/dd1, the right end -dE/dd1.
+            let mut force = Vec2::zeros();
+            if *qr_ != NONE {
+                force += t1[*qr_ as usize];
+            }
+            if *ql != NONE {
+                force -= t1[*ql as usize];
+            }
+            if bending > 0.0 {
+                for &(j, rest) in [bp, bn] {
+                    if j != NONE {
+                        force += spring_force(*x, xs[j as usize], bending / rest, rest);
+                    }
+                }
+            }
+            *f = force;
+        });
+}
+
+/// Force on a particle at `xi` from a spring to `xj` of stiffness `k` and rest length `rest`.
+#[inline(always)]
+fn spring_force(xi: Vec2, xj: Vec2, k: f64, rest: f64) -> Vec2 {
+    let d = xj - xi;
+    let len = d.norm();
+    if len > 0.0 {
+        d * (k * (len - rest) / len)
+    } else {
+        Vec2::zeros()
+    }
+}
+
+/// Index ranges of chunk `k` of `n` items.
+#[inline]
+fn chunk_range(n: usize, k: usize) -> std::ops::Range<usize> {
+    (n * k / CHUNKS)..(n * (k + 1) / CHUNKS)
+}
+
+/// Adds one particle's APIC mass and momentum plus `dt f` to a buffer.
+#[inline(always)]
+fn splat(
+    buf: &mut ScatterBuffer,
+    geom: &GridGeom,
+    st: &Stencil,
+    m: f64,
+    v: Vec2,
+    c: &Mat2,
+    impulse: Vec2,
+) {
+    buf.touch_stencil(geom, st.base);
+    let dx = geom.dx;
+    // APIC momentum at node: m (v + C (x_i - x_p)) = m v + m C off dx.
+    let mc = c * (m * dx);
+    let (bi, bj) = (st.base[0] as usize, st.base[1] as usize);
+    for i in 0..3 {
+        let wi = st.w[0][i];
+        let ox = i as f64 - st.fx[0];
+        for j in 0..3 {
+            let w = wi * st.w[1][j];
+            let oy = j as f64 - st.fx[1];
+            let px = m * v.x + mc[(0, 0)] * ox + mc[(0, 1)] * oy + impulse.x;
+            let py = m * v.y + mc[(1, 0)] * ox + mc[(1, 1)] * oy + impulse.y;
+            let n = &mut buf.node[geom.index(bi + i, bj + j)];
+            n[0] += w * m;
+            n[1] += w * px;
+            n[2] += w * py;
+        }
+    }
+}
+
+/// Pass 2: particle-to-grid of mass, momentum and `dt` times internal force.
+pub fn scatter(p: &Particles, grid: &mut Grid, dt: f64) {
+    let geom = grid.geom;
+    let (nv, nq) = (p.vert.x.len(), p.quad.x.len());
+    let vert = &p.vert;
+    let quad = &p.quad;
+    grid.buffers
+        .par_iter_mut()
+        .enumerate()
+        .for_each(|(k, buf)| {
+            buf.clear(&geom);
+            for i in chunk_range(nv, k) {
+                splat(
+                    buf,
+                    &geom,
+                    &vert.stencil[i],
+                    vert.m[i],
+                    vert.v[i],
+                    &vert.c[i],
+                    vert.force[i] * dt,
+                );
+            }
+            for q in chunk_range(nq, k) {
+                scatter_quad(buf, &geom, quad, q, dt);
+            }
+        });
+    grid.collect_active();
+}
+
+/// Quadrature particle: APIC mass/momentum and the normal-direction force
+/// `f_i = -dE/dd2 (grad w_i . d2)` with the MLS gradient `grad w_i = w_i 4 (x_i - x_p) / dx^2`.
+#[inline(always)]
+fn scatter_quad(buf: &mut ScatterBuffer, geom: &GridGeom, quad: &Quads, q: usize, dt: f64) {
+    let st = &quad.stencil[q];
+    buf.touch_stencil(geom, st.base);
+    let m = quad.m[q];
+    let v = quad.v[q];
+    let mc = quad.c[q] * (m * geom.dx);
+    let d2 = quad.d[q].column(1).into_owned();
+    // impulse per unit (w * offset . d2): -dt * t2 * 4 / dx
+    let g = quad.t2[q] * (-dt * 4.0 * geom.inv_dx);
+    let (bi, bj) = (st.base[0] as usize, st.base[1] as usize);
+    for i in 0..3 {
+        let wi = st.w[0][i];
+        let ox = i as f64 - st.fx[0];
+        for j in 0..3 {
+            let w = wi * st.w[1][j];
+            let oy = j as f64 - st.fx[1];
+            let s = ox * d2.x + oy * d2.y;
+            let px = m * v.x + mc[(0, 0)] * ox + mc[(0, 1)] * oy + g.x * s;
+            let py = m * v.y + mc[(1, 0)] * ox + mc[(1, 1)] * oy + g.y * s;
+            let n = &mut buf.node[geom.index(bi + i, bj + j)];
+            n[0] += w * m;
+            n[1] += w * px;
+            n[2] += w * py;
+        }
+    }
+}
+
+/// Pass 3: sums the chunk buffers on the active blocks, turns momentum into
+/// velocity and applies gravity, attractor, obstacles and walls.
+pub fn grid_update(grid: &mut Grid, dt: f64, ext: &GridForces) {
+    let geom = grid.geom;
+    let mut is_active = vec![false; geom.blocks()];
+    for &b in &grid.active {
+        is_active[b as usize] = true;
+    }
+    let buffers = &grid.buffers;
+    grid.node
+        .par_chunks_mut(super::grid::BLOCK * super::grid::BLOCK)
+        .enumerate()
+        .filter(|(b, _)| is_active[*b])
+        .for_each(|(b, nodes)| {
+            let start = b * nodes.len();
+            for (o, out) in nodes.iter_mut().enumerate() {
+                let idx = start + o;
+                let mut acc = [0.0; 3];
+                for buf in buffers {
+                    if buf.touched[b] {
+                        let n = buf.node[idx];
+                        acc[0] += n[0];
+                        acc[1] += n[1];
+                        acc[2] += n[2];
+                    }
+                }
+                if acc[0] <= 0.0 {
+                    *out = [0.0; 3];
+                    continue;
+                }
+                let (i, j) = geom.node(idx);
+                let xi = Vec2::new(i as f64 * geom.dx, j as f64 * geom.dx);
+                let mut v = Vec2::new(acc[1], acc[2]) / acc[0] + ext.gravity * dt;
+                if let Some((pos, strength)) = ext.attractor {
+                    let r = pos - xi;
+                    v += r * (dt * strength / (r.norm() + 0.01));
+                }
+                for o in ext.obstacles {
+                    v = obstacle_velocity(o, xi, v);
+                }
+                v = wall_velocity(ext.walls, ext.wall_cells, geom.n, i, j, v);
+                *out = [acc[0], v.x, v.y];
+            }
+        });
+}
+
+/// Velocity of a grid node after contact with a circular obstacle: no
+/// inward normal velocity, Coulomb friction on the tangential part.
+#[inline]
+pub fn obstacle_velocity(o: &Obstacle, xi: Vec2, v: Vec2) -> Vec2 {
+    let c = Vec2::from(o.center);
+    let r = xi - c;
+    let dist = r.norm();
+    if dist >= o.radius {
+        return v;
+    }
+    let n = if dist > 0.0 {
+        r / dist
+    } else {
+        Vec2::new(0.0, 1.0)
+    };
+    let vn = v.dot(&n);
+    if vn >= 0.0 {
+        return v;
+    }
+    let vt = v - n * vn;
+    let vt_norm = vt.norm();
+    if vt_norm <= -o.friction * vn {
+        Vec2::zeros()
+    } else {
+        vt * (1.0 + o.friction * vn / vt_norm)
+    }
+}
+
+#[inline(always)]
+fn wall_velocity(mode: WallMode, cells: usize, n: usize, i: usize, j: usize, mut v: Vec2) -> Vec2 {
+    let (lo_x, hi_x) = (i < cells, i + cells >= n);
+    let (lo_y, hi_y) = (j < cells, j + cells >= n);
+    match mode {
+        WallMode::None => v,
+        WallMode::Sticky => {
+            if lo_x || hi_x || lo_y || hi_y {
+                Vec2::zeros()
+            } else {
+                v
+            }
+        }
+        WallMode::Slip => {
+            if lo_x {
+                v.x = v.x.max(0.0);
+            }
+            if hi_x {
+                v.x = v.x.min(0.0);
+            }
+            if lo_y {
+                v.y = v.y.max(0.0);
+            }
+            if hi_y {
+                v.y = v.y.min(0.0);
+            }
+            v
+        }
+    }
+}
+
+/// Grid velocity and APIC matrix at a stencil: `v = sum w v_i`,
+/// `C = 4 / dx sum w v_i (i - fx)^T`.
+#[inline(always)]
+fn interpolate(grid: &Grid, st: &Stencil) -> (Vec2, Mat2) {
+    let geom = &grid.geom;
+    let (bi, bj) = (st.base[0] as usize, st.base[1] as usize);
+    let mut v = Vec2::zeros();
+    let (mut c00, mut c01, mut c10, mut c11) = (0.0, 0.0, 0.0, 0.0);
+    for i in 0..3 {
+        let wi = st.w[0][i];
+        let ox = i as f64 - st.fx[0];
+        for j in 0..3 {
+            let w = wi * st.w[1][j];
+            let oy = j as f64 - st.fx[1];
+            let n = grid.node[geom.index(bi + i, bj + j)];
+            let (wx, wy) = (w * n[1], w * n[2]);
+            v.x += wx;
+            v.y += wy;
+            c00 += wx * ox;
+            c01 += wx * oy;
+            c10 += wy * ox;
+            c11 += wy * oy;
+        }
+    }
+    let s = 4.0 * geom.inv_dx;
+    (v, Mat2::new(c00 * s, c01 * s, c10 * s, c11 * s))
+}
+
+/// Keeps a particle where its stencil stays on the grid; removes outward velocity there.
+#[inline(always)]
+fn clamp_to_grid(x: &mut Vec2, v: &mut Vec2, lo: f64, hi: f64) {
+    for a in 0..2 {
+        if x[a] < lo {
+            x[a] = lo;
+            v[a] = v[a].max(0.0);
+        } else if x[a] > hi {
+            x[a] = hi;
+            v[a] = v[a].min(0.0);
+        }
+    }
+}
+
+/// Pushes a vertex that ended inside an obstacle back to its surface and
+/// removes its inward velocity.
+#[inline]
+fn project_out(o: &Obstacle, x: &mut Vec2, v: &mut Vec2) {
+    let c = Vec2::from(o.center);
+    let r = *x - c;
+    let dist = r.norm();
+    if dist < o.radius {
+        let n = if dist > 0.0 {
+            r / dist
+        } else {
+            Vec2::new(0.0, 1.0)
+        };
+        *x = c + n * o.radius;
+        let vn = v.dot(&n);
+        if vn < 0.0 {
+            *v -= n * vn;
+        }
+    }
+}
+
+/// Pass 4a: grid-to-particle for vertices and advection `x += dt v`.
+/// Returns the index of the first vertex with a non-finite state, if any.
+pub fn gather_vertices(
+    vert: &mut Vertices,
+    grid: &Grid,
+    dt: f64,
+    obstacles: &[Obstacle],
+) -> Option<usize> {
+    let geom = grid.geom;
+    let (lo, hi) = (geom.dx, (geom.n as f64 - 2.0) * geom.dx);
+    (&mut vert.x, &mut vert.v, &mut vert.c, &vert.stencil)
+        .into_par_iter()
+        .with_min_len(PAR_MIN)
+        .enumerate()
+        .filter_map(|(k, (x, v, c, st))| {
+            let (nv, nc) = interpolate(grid, st);
+            *v = nv;
+            *c = nc;
+            *x += nv * dt;
+            for o in obstacles {
+                project_out(o, x, v);
+            }
+            clamp_to_grid(x, v, lo, hi);
+            let ok = x.x.is_finite()
+                && x.y.is_finite()
+                && v.x.is_finite()
+                && v.y.is_finite()
+                && c.iter().all(|e| e.is_finite());
+            if ok {
+                None
+            } else {
+                Some(k)
+            }
+        })
+        .min()
+}
+
+/// Pass 4b: grid-to-particle for quadrature particles: velocity and `C` from
+/// the grid, position and `d1` from the (already moved) vertices,
+/// `d2 += dt C d2`, then the return mapping and `F = d D^-1`.
+/// Returns the first quadrature particle with a non-finite frame, if any.
+pub fn gather_quads(
+    quad: &mut Quads,
+    vx: &[Vec2],
+    grid: &Grid,
+    dt: f64,
+    plastic: Option<&YarnEnergy>,
+) -> Option<usize> {
+    (
+        &mut quad.x,
+        &mut quad.v,
+        &mut quad.c,
+        &mut quad.d,
+        &mut quad.f,
+        &quad.stencil,
+        &quad.left,
+        &quad.d_rest_inv,
+        &quad.l0,
+    )
+        .into_par_iter()
+        .with_min_len(PAR_MIN)
+        .enumerate()
+        .filter_map(|(k, (x, v, c, d, f, st, left, dinv, l0))| {
+            let (nv, nc) = interpolate(grid, st);
+            *v = nv;
+            *c = nc;
+            let (xl, xr) = (vx[*left as usize], vx[*left as usize + 1]);
+            *x = (xl + xr) * 0.5;
+            let d1 = xr - xl;
+            let d2o = d.column(1).into_owned();
+            let mut d2 = d2o + nc * d2o * dt;
+            if let Some(energy) = plastic {
+                let g = Mat2::from_columns(&[d1, d2]) / *l0;
+                let r = qr(&g);
+                let (r12, r22) = energy.return_map(r.r12, r.r22);
+                if r12 != r.r12 || r22 != r.r22 {
+                    d2 = r.rotate(Vec2::new(r12, r22)) * *l0;
+                }
+            }
+            *d = Mat2::from_columns(&[d1, d2]);
+            *f = *d * dinv;
+            if d.iter().all(|e| e.is_finite()) && v.x.is_finite() && v.y.is_finite() {
+                None
+            } else {
+                Some(k)
+            }
+        })
+        .min()
+}
+
+/// Whether `n` splits into the same chunks as the scatter uses (for tests).
+#[doc(hidden)]
+pub fn chunk_bounds(n: usize) -> Vec<std::ops::Range<usize>> {
+    (0..CHUNKS).map(|k| chunk_range(n, k)).collect()
+}

@@ -1,0 +1,418 @@
+//! [`YarnSim`]: a yarn-bundle scene turned into a running MPM simulation.
+
+use std::time::Instant;
+
+use super::constitutive::YarnEnergy;
+use super::grid::{Grid, GridGeom};
+use super::particles::Particles;
+use super::passes::{self, GridForces};
+use crate::math::Vec2;
+use crate::scene::{Obstacle, SceneError, WallMode, YarnScene};
+
+/// Why a step failed.
+#[derive(Clone, Debug, PartialEq)]
+pub enum SimError {
+    /// A particle's state became NaN or infinite during this step; the
+    /// simulation refuses further steps until its state is restored.
+    NonFinite { step: u64, time: f64, what: String },
+    /// An input given to the simulation is unusable.
+    BadInput(String),
+}
+
+impl std::fmt::Display for SimError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            SimError::NonFinite { step, time, what } => {
+                write!(
+                    f,
+                    "simulation diverged at step {step} (t = {time:.6} s): {what} is not finite"
+                )
+            }
+            SimError::BadInput(m) => write!(f, "bad input: {m}"),
+        }
+    }
+}
+
+impl std::error::Error for SimError {}
+
+/// The attractor as the simulation sees it (settable at run time).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Attractor {
+    pub position: Vec2,
+    pub strength: f64,
+    pub active: bool,
+}
+
+/// Which optional passes a scene needs; the stepper skips the others.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Passes {
+    pub bending: bool,
+    pub plasticity: bool,
+    pub obstacles: bool,
+    pub attractor: bool,
+    pub walls: bool,
+}
+
+/// Wall-clock seconds spent in each pass since the last reset.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct PassTimes {
+    pub forces: f64,
+    pub scatter: f64,
+    pub grid: f64,
+    pub gather_vertices: f64,
+    pub gather_quads: f64,
+    pub substeps: u64,
+}
+
+impl PassTimes {
+    pub fn total(&self) -> f64 {
+        self.forces + self.scatter + self.grid + self.gather_vertices + self.gather_quads
+    }
+
+    /// `(name, seconds)` of every pass, in execution order.
+    pub fn entries(&self) -> [(&'static str, f64); 5] {
+        [
+            ("particle forces (QR, stress, bending)", self.forces),
+            ("P2G scatter", self.scatter),
+            ("grid update (forces, obstacles, walls)", self.grid),
+            ("G2P vertices", self.gather_vertices),
+            ("G2P quadrature + return mapping", self.gather_quads),
+        ]
+    }
+}
+
+/// Summary quantities of the current state.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Diagnostics {
+    pub time: f64,
+    pub steps: u64,
+    pub kinetic_energy: f64,
+    pub elastic_energy: f64,
+    /// Gravitational potential energy `-sum m g.x`.
+    pub potential_energy: f64,
+    pub momentum: Vec2,
+    /// Angular momentum about the origin, including the APIC affine part.
+    pub angular_momentum: f64,
+    pub min_stretch: f64,
+    pub max_stretch: f64,
+    pub mean_stretch: f64,
+    pub center_of_mass: Vec2,
+    pub total_mass: f64,
+}
+
+/// A running yarn-bundle simulation.
+#[derive(Clone, Debug)]
+pub struct YarnSim {
+    scene: YarnScene,
+    pub(crate) particles: Particles,
+    grid: Grid,
+    energy: YarnEnergy,
+    pub(crate) dt: f64,
+    pub(crate) gravity: Vec2,
+    pub(crate) attractor: Attractor,
+    pub(crate) time: f64,
+    pub(crate) steps: u64,
+    pub(crate) failed: Option<SimError>,
+    timings: PassTimes,
+}
+
+impl YarnSim {
+    /// Builds the simulation of a scene, at rest at t = 0.
+    pub fn new(scene: &YarnScene) -> Result<Self, SceneError> {
+        scene.validate()?;
+        let geom = GridGeom::new(scene.grid.resolution as usize, scene.grid.size);
+        Ok(YarnSim {
+            particles: Particles::from_scene(scene),
+            grid: Grid::new(geom),
+            energy: YarnEnergy::from_material(&scene.material),
+            dt: scene.time.dt,
+            gravity: Vec2::from(scene.gravity),
+            attractor: Attractor {
+                position: Vec2::from(scene.attractor.position),
+                strength: scene.attractor.strength,
+                active: scene.attractor.active,
+            },
+            time: 0.0,
+            steps: 0,
+            failed: None,
+            timings: PassTimes::default(),
+            scene: scene.clone(),
+        })
+    }
+
+    pub fn scene(&self) -> &YarnScene {
+        &self.scene
+    }
+    pub fn particles(&self) -> &Particles {
+        &self.particles
+    }
+    /// Mutable particles, to set up initial conditions in tests and tools.
+    pub fn particles_mut(&mut self) -> &mut Particles {
+        &mut self.particles
+    }
+    pub fn time(&self) -> f64 {
+        self.time
+    }
+    pub fn steps(&self) -> u64 {
+        self.steps
+    }
+    /// Substep size.
+    pub fn dt(&self) -> f64 {
+        self.dt
+    }
+    pub fn grid_geom(&self) -> GridGeom {
+        self.grid.geom
+    }
+    pub fn energy_model(&self) -> &YarnEnergy {
+        &self.energy
+    }
+    pub fn gravity(&self) -> Vec2 {
+        self.gravity
+    }
+    pub fn attractor(&self) -> Attractor {
+        self.attractor
+    }
+    /// Number of blocks (8x8 nodes) the last substep touched.
+    pub fn active_blocks(&self) -> usize {
+        self.grid.active.len()
+    }
+    /// The error that stopped the simulation, if any.
+    pub fn failure(&self) -> Option<&SimError> {
+        self.failed.as_ref()
+    }
+    pub fn num_yarns(&self) -> usize {
+        self.particles.num_yarns()
+    }
+
+    /// Sets gravity; rejects non-finite or absurd values (|g| > 1e6 m/s^2).
+    pub fn set_gravity(&mut self, g: Vec2) -> Result<(), SimError> {
+        if !(g.x.is_finite() && g.y.is_finite()) || g.norm() > 1e6 {
+            return Err(SimError::BadInput(format!(
+                "gravity ({}, {}) must be finite and at most 1e6 m/s^2",
+                g.x, g.y
+            )));
+        }
+        self.gravity = g;
+        Ok(())
+    }
+
+    /// Sets the attractor; rejects non-finite positions and strengths outside [0, 1e6].
+    pub fn set_attractor(&mut self, a: Attractor) -> Result<(), SimError> {
+        if !(a.position.x.is_finite() && a.position.y.is_finite()) {
+            return Err(SimError::BadInput(format!(
+                "attractor position ({}, {}) must be finite",
+                a.position.x, a.position.y
+            )));
+        }
+        if !(a.strength.is_finite() && (0.0..=1e6).contains(&a.strength)) {
+            return Err(SimError::BadInput(format!(
+                "attractor strength {} must be in [0, 1e6]",
+                a.strength
+            )));
+        }
+        self.attractor = a;
+        Ok(())
+    }
+
+    /// Which optional passes run.
+    pub fn passes(&self) -> Passes {
+        let s = &self.scene;
+        Passes {
+            bending: s.material.bending > 0.0,
+            plasticity: s.material.plasticity,
+            obstacles: !s.obstacles.is_empty(),
+            attractor: self.attractor.active && self.attractor.strength != 0.0,
+            walls: s.walls.mode != WallMode::None,
+        }
+    }
+
+    /// Accumulated pass timings.
+    pub fn timings(&self) -> PassTimes {
+        self.timings
+    }
+    pub fn reset_timings(&mut self) {
+        self.timings = PassTimes::default();
+    }
+
+    /// One substep of the scene's `dt`.
+    pub fn step(&mut self) -> Result<(), SimError> {
+        self.step_dt(self.dt)
+    }
+
+    /// `n` substeps.
+    pub fn steps_n(&mut self, n: u64) -> Result<(), SimError> {
+        for _ in 0..n {
+            self.step()?;
+        }
+        Ok(())
+    }
+
+    /// Advances by `duration` seconds in `round(duration / dt)` substeps.
+    pub fn advance(&mut self, duration: f64) -> Result<(), SimError> {
+        let n = (duration / self.dt).round().max(0.0) as u64;
+        self.steps_n(n)
+    }
+
+    /// One substep of size `dt`.
+    pub fn step_dt(&mut self, dt: f64) -> Result<(), SimError> {
+        if let Some(e) = &self.failed {
+            return Err(e.clone());
+        }
+        if !(dt.is_finite() && dt > 0.0) {
+            return Err(SimError::BadInput(format!(
+                "substep dt {dt} must be finite and > 0"
+            )));
+        }
+        let passes = self.passes();
+        let bending = if passes.bending {
+            self.scene.material.bending
+        } else {
+            0.0
+        };
+        let empty: [Obstacle; 0] = [];
+        let obstacles: &[Obstacle] = if passes.obstacles {
+            &self.scene.obstacles
+        } else {
+            &empty
+        };
+
+        let t0 = Instant::now();
+        passes::particle_forces(&mut self.particles, &self.grid.geom, &self.energy, bending);
+        let t1 = Instant::now();
+        passes::scatter(&self.particles, &mut self.grid, dt);
+        let t2 = Instant::now();
+        let ext = GridForces {
+            gravity: self.gravity,
+            attractor: passes
+                .attractor
+                .then_some((self.attractor.position, self.attractor.strength)),
+            obstacles,
+            walls: self.scene.walls.mode,
+            wall_cells: self.scene.walls.cells as usize,
+        };
+        passes::grid_update(&mut self.grid, dt, &ext);
+        let t3 = Instant::now();
+        let bad_v = passes::gather_vertices(&mut self.particles.vert, &self.grid, dt, obstacles);
+        let t4 = Instant::now();
+        let plastic = passes.plasticity.then_some(&self.energy);
+        let bad_q = passes::gather_quads(
+            &mut self.particles.quad,
+            &self.particles.vert.x,
+            &self.grid,
+            dt,
+            plastic,
+        );
+        let t5 = Instant::now();
+
+        let tm = &mut self.timings;
+        tm.forces += (t1 - t0).as_secs_f64();
+        tm.scatter += (t2 - t1).as_secs_f64();
+        tm.grid += (t3 - t2).as_secs_f64();
+        tm.gather_vertices += (t4 - t3).as_secs_f64();
+        tm.gather_quads += (t5 - t4).as_secs_f64();
+        tm.substeps += 1;
+
+        self.steps += 1;
+        self.time += dt;
+        let what = match (bad_v, bad_q) {
+            (Some(i), _) => Some(format!("vertex {i}")),
+            (None, Some(q)) => Some(format!("quadrature particle {q}")),
+            _ => None,
+        };
+        if let Some(what) = what {
+            let e = SimError::NonFinite {
+                step: self.steps,
+                time: self.time,
+                what,
+            };
+            self.failed = Some(e.clone());
+            return Err(e);
+        }
+        Ok(())
+    }
+
+    /// Left and right end of yarn `y`.
+    pub fn yarn_endpoints(&self, y: usize) -> (Vec2, Vec2) {
+        let r = &self.particles.yarn_vertices;
+        (
+            self.particles.vert.x[r[y]],
+            self.particles.vert.x[r[y + 1] - 1],
+        )
+    }
+
+    /// Stretch `|x_r - x_l| / l0` of every segment.
+    pub fn stretches(&self) -> Vec<f64> {
+        let p = &self.particles;
+        p.quad
+            .left
+            .iter()
+            .zip(&p.quad.l0)
+            .map(|(&l, &l0)| (p.vert.x[l as usize + 1] - p.vert.x[l as usize]).norm() / l0)
+            .collect()
+    }
+
+    /// Total elastic energy (yarn energy of every quadrature particle plus bending springs).
+    pub fn elastic_energy(&self) -> f64 {
+        let p = &self.particles;
+        let mut e = 0.0;
+        for q in 0..p.quad.x.len() {
+            e += p.quad.vol[q] * self.energy.psi(&(p.quad.d[q] / p.quad.l0[q]));
+        }
+        let kb = self.scene.material.bending;
+        if kb > 0.0 {
+            for (i, &(j, rest)) in p.vert.bend_next.iter().enumerate() {
+                if j != super::particles::NONE {
+                    let len = (p.vert.x[j as usize] - p.vert.x[i]).norm();
+                    e += 0.5 * kb / rest * (len - rest) * (len - rest);
+                }
+            }
+        }
+        e
+    }
+
+    /// Energies, momenta, stretch and centre of mass.
+    pub fn diagnostics(&self) -> Diagnostics {
+        let p = &self.particles;
+        let dx = self.grid.geom.dx;
+        let mut ke = 0.0;
+        let mut pe = 0.0;
+        let mut mom = Vec2::zeros();
+        let mut ang = 0.0;
+        let mut mass = 0.0;
+        let mut com = Vec2::zeros();
+        let mut add = |x: &[Vec2], v: &[Vec2], c: &[nalgebra::Matrix2<f64>], m: &[f64]| {
+            for k in 0..x.len() {
+                ke += 0.5 * m[k] * v[k].norm_squared();
+                pe -= m[k] * self.gravity.dot(&x[k]);
+                mom += v[k] * m[k];
+                ang += m[k] * crate::math::cross(x[k], v[k])
+                    + m[k] * dx * dx * 0.25 * (c[k][(1, 0)] - c[k][(0, 1)]);
+                mass += m[k];
+                com += x[k] * m[k];
+            }
+        };
+        add(&p.vert.x, &p.vert.v, &p.vert.c, &p.vert.m);
+        add(&p.quad.x, &p.quad.v, &p.quad.c, &p.quad.m);
+        let s = self.stretches();
+        let (mut lo, mut hi, mut sum) = (f64::INFINITY, f64::NEG_INFINITY, 0.0);
+        for &x in &s {
+            lo = lo.min(x);
+            hi = hi.max(x);
+            sum += x;
+        }
+        Diagnostics {
+            time: self.time,
+            steps: self.steps,
+            kinetic_energy: ke,
+            elastic_energy: self.elastic_energy(),
+            potential_energy: pe,
+            momentum: mom,
+            angular_momentum: ang,
+            min_stretch: lo,
+            max_stretch: hi,
+            mean_stretch: sum / s.len().max(1) as f64,
+            center_of_mass: com / mass,
+            total_mass: mass,
+        }
+    }
+}

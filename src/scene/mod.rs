@@ -1,0 +1,95 @@
+//! Scene descriptions ("layouts"): what exists in a simulation, as data.
+//!
+//! A scene file is TOML; its `kind` field picks the model (`"yarn"` for the
+//! MPM yarn bundle). Built-in scenes are listed by [`builtin_names`].
+
+pub mod builtin;
+pub mod error;
+pub mod yarn;
+
+pub use builtin::{builtin, builtin_names, DEFAULT_SCENE};
+pub use error::SceneError;
+pub use yarn::{
+    AttractorSpec, GridSpec, Material, Obstacle, TimeSpec, WallMode, Walls, YarnScene, YarnSpec,
+};
+
+/// Any scene this crate can simulate.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Scene {
+    /// A 2D MPM yarn bundle.
+    Yarn(YarnScene),
+}
+
+impl Scene {
+    /// Parses a scene file's text, dispatching on its `kind` field.
+    pub fn from_toml_str(text: &str) -> Result<Scene, SceneError> {
+        let kind = toml_kind(text)?;
+        match kind.as_deref() {
+            None | Some("yarn") => YarnScene::from_toml_str(text).map(Scene::Yarn),
+            Some(other) => Err(SceneError::Invalid {
+                field: "kind".into(),
+                line: text
+                    .lines()
+                    .position(|l| l.trim_start().starts_with("kind"))
+                    .map(|i| i + 1),
+                message: format!("unknown scene kind {other:?}; known kinds: \"yarn\""),
+            }),
+        }
+    }
+
+    /// Reads a scene file.
+    pub fn from_file(path: impl AsRef<std::path::Path>) -> Result<Scene, SceneError> {
+        let path = path.as_ref();
+        let text = std::fs::read_to_string(path).map_err(|e| SceneError::Io {
+            path: path.display().to_string(),
+            message: e.to_string(),
+        })?;
+        Scene::from_toml_str(&text)
+    }
+
+    /// A built-in scene name, or else a path to a scene file.
+    pub fn resolve(name_or_path: &str) -> Result<Scene, SceneError> {
+        if let Some(s) = builtin(name_or_path) {
+            return Ok(s);
+        }
+        let p = std::path::Path::new(name_or_path);
+        if p.exists() || name_or_path.ends_with(".toml") {
+            return Scene::from_file(p);
+        }
+        Err(SceneError::UnknownScene {
+            name: name_or_path.to_string(),
+            known: builtin_names().iter().map(|(n, _)| n.to_string()).collect(),
+        })
+    }
+
+    /// The scene as TOML text.
+    pub fn to_toml_string(&self) -> String {
+        match self {
+            Scene::Yarn(s) => s.to_toml_string(),
+        }
+    }
+
+    /// The scene's name.
+    pub fn name(&self) -> &str {
+        match self {
+            Scene::Yarn(s) => &s.name,
+        }
+    }
+}
+
+/// The top-level `kind` string of a scene file, if any.
+fn toml_kind(text: &str) -> Result<Option<String>, SceneError> {
+    let value: toml::Table = toml::from_str(text).map_err(|e| error::from_toml_error(text, e))?;
+    match value.get("kind") {
+        None => Ok(None),
+        Some(toml::Value::String(s)) => Ok(Some(s.clone())),
+        Some(_) => Err(SceneError::Invalid {
+            field: "kind".into(),
+            line: text
+                .lines()
+                .position(|l| l.trim_start().starts_with("kind"))
+                .map(|i| i + 1),
+            message: "kind must be a string".into(),
+        }),
+    }
+}

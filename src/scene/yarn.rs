@@ -1,0 +1,553 @@
+//! The yarn-bundle scene: what exists (grid, material, yarns, obstacles,
+//! walls, attractor, gravity), as plain data read from TOML. How it moves is
+//! the business of [`crate::mpm`].
+
+use serde::{Deserialize, Deserializer, Serialize};
+
+use super::error::{from_toml_error, line_of, SceneError};
+use crate::math::Vec2;
+
+/// A complete yarn-bundle scene. See the README section "Scene files" for
+/// every field with its unit and default.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct YarnScene {
+    /// Scene kind tag, always `"yarn"` for this type.
+    #[serde(default = "kind_yarn", deserialize_with = "kind_is_yarn")]
+    pub kind: String,
+    /// Short name shown by the CLI.
+    #[serde(default)]
+    pub name: String,
+    /// One line of description.
+    #[serde(default)]
+    pub description: String,
+    pub grid: GridSpec,
+    pub time: TimeSpec,
+    pub material: Material,
+    /// Gravity acceleration `[gx, gy]` in m/s^2 (default `[0, -9.8]`).
+    #[serde(default = "default_gravity", deserialize_with = "finite2")]
+    pub gravity: [f64; 2],
+    #[serde(default)]
+    pub attractor: AttractorSpec,
+    #[serde(default)]
+    pub walls: Walls,
+    #[serde(default)]
+    pub obstacles: Vec<Obstacle>,
+    pub yarns: Vec<YarnSpec>,
+}
+
+/// The background grid: a square domain `[0, size]^2` of `resolution^2` cells.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct GridSpec {
+    /// Cells per side (8 to 8192).
+    #[serde(deserialize_with = "resolution")]
+    pub resolution: u32,
+    /// Side length of the domain in m (default 1).
+    #[serde(default = "one", deserialize_with = "positive")]
+    pub size: f64,
+}
+
+/// Time stepping.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TimeSpec {
+    /// Substep size in s.
+    #[serde(deserialize_with = "positive")]
+    pub dt: f64,
+    /// Output frame interval in s (CLI frames and recordings; default 1/60).
+    #[serde(default = "default_frame_dt", deserialize_with = "positive")]
+    pub frame_dt: f64,
+}
+
+/// Material of the yarns (per unit thickness: the 2D model has unit depth).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Material {
+    /// Fiber stretch stiffness `k` (Pa).
+    #[serde(deserialize_with = "nonnegative")]
+    pub k: f64,
+    /// Fiber shear stiffness `gamma` (Pa).
+    #[serde(deserialize_with = "nonnegative")]
+    pub gamma: f64,
+    /// Young's modulus `E` of the cross-section (Pa); `mu = 0.4 E`, `lambda = 0.6 E`.
+    #[serde(deserialize_with = "nonnegative")]
+    pub youngs_modulus: f64,
+    /// Mohr-Coulomb friction coefficient `c_f` (dimensionless).
+    #[serde(deserialize_with = "nonnegative")]
+    pub friction: f64,
+    /// Bending modulus of the springs between every second vertex (Pa); a
+    /// spring of rest length `L` gets stiffness `bending / L`. 0 disables bending.
+    #[serde(default, deserialize_with = "nonnegative")]
+    pub bending: f64,
+    /// Line density in kg/m (per unit depth).
+    #[serde(default = "one", deserialize_with = "positive")]
+    pub density: f64,
+    /// Mohr-Coulomb return mapping on (default) or off.
+    #[serde(default = "yes")]
+    pub plasticity: bool,
+}
+
+impl Material {
+    /// Lame `mu = 0.4 E`.
+    pub fn mu(&self) -> f64 {
+        0.4 * self.youngs_modulus
+    }
+    /// Lame `lambda = 0.6 E`.
+    pub fn lambda(&self) -> f64 {
+        0.6 * self.youngs_modulus
+    }
+}
+
+/// A point attractor ("mouse") pulling grid velocity toward `position`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct AttractorSpec {
+    /// Attractor position `[x, y]` in m.
+    #[serde(default = "centre", deserialize_with = "finite2")]
+    pub position: [f64; 2],
+    /// Acceleration magnitude in m/s^2 (at distances well above 0.01 m).
+    #[serde(
+        default = "default_attractor_strength",
+        deserialize_with = "nonnegative"
+    )]
+    pub strength: f64,
+    /// Whether the attractor acts.
+    #[serde(default)]
+    pub active: bool,
+}
+
+impl Default for AttractorSpec {
+    fn default() -> Self {
+        AttractorSpec {
+            position: centre(),
+            strength: default_attractor_strength(),
+            active: false,
+        }
+    }
+}
+
+/// Boundary condition at the domain edges.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "lowercase")]
+pub enum WallMode {
+    /// Grid velocity set to zero near the edges.
+    #[default]
+    Sticky,
+    /// Only the outward normal velocity is removed.
+    Slip,
+    /// No walls: particles are only clamped to stay on the grid.
+    None,
+}
+
+/// Domain walls.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Walls {
+    /// `"sticky"` (default), `"slip"` or `"none"`.
+    #[serde(default)]
+    pub mode: WallMode,
+    /// Wall thickness in cells (1 to 16, default 3).
+    #[serde(default = "default_wall_cells", deserialize_with = "wall_cells")]
+    pub cells: u32,
+}
+
+impl Default for Walls {
+    fn default() -> Self {
+        Walls {
+            mode: WallMode::Sticky,
+            cells: default_wall_cells(),
+        }
+    }
+}
+
+/// A fixed circular obstacle with Coulomb friction.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Obstacle {
+    /// Centre `[x, y]` in m.
+    #[serde(deserialize_with = "finite2")]
+    pub center: [f64; 2],
+    /// Radius in m.
+    #[serde(deserialize_with = "positive")]
+    pub radius: f64,
+    /// Coulomb friction coefficient of the surface (default 0.3).
+    #[serde(
+        default = "default_obstacle_friction",
+        deserialize_with = "nonnegative"
+    )]
+    pub friction: f64,
+}
+
+/// One yarn, or `count` parallel copies of it.
+///
+/// Geometry is either a straight line (`start` plus `end`, or `start` plus
+/// `direction` and `length`) or a polyline (`points`); it is resampled to
+/// `vertices` equally spaced vertices along its arc length.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+pub struct YarnSpec {
+    #[serde(
+        default,
+        skip_serializing_if = "Option::is_none",
+        deserialize_with = "opt_finite2"
+    )]
+    pub start: Option<[f64; 2]>,
+    #[serde(
+        default,
+        skip_serializing_if = "Option::is_none",
+        deserialize_with = "opt_finite2"
+    )]
+    pub end: Option<[f64; 2]>,
+    #[serde(
+        default,
+        skip_serializing_if = "Option::is_none",
+        deserialize_with = "opt_finite2"
+    )]
+    pub direction: Option<[f64; 2]>,
+    #[serde(
+        default,
+        skip_serializing_if = "Option::is_none",
+        deserialize_with = "opt_positive"
+    )]
+    pub length: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub points: Option<Vec<[f64; 2]>>,
+    /// Number of type-2 vertices (2 or more).
+    #[serde(deserialize_with = "vertex_count")]
+    pub vertices: u32,
+    /// Number of copies (default 1), each shifted by `spacing` from the previous.
+    #[serde(default = "one_u32", deserialize_with = "copy_count")]
+    pub count: u32,
+    /// Offset between copies `[dx, dy]` in m.
+    #[serde(default, deserialize_with = "finite2")]
+    pub spacing: [f64; 2],
+    /// Initial velocity `[vx, vy]` in m/s.
+    #[serde(default, deserialize_with = "finite2")]
+    pub velocity: [f64; 2],
+}
+
+impl YarnScene {
+    /// Parses and validates a scene from TOML text.
+    pub fn from_toml_str(text: &str) -> Result<Self, SceneError> {
+        let scene: YarnScene = toml::from_str(text).map_err(|e| from_toml_error(text, e))?;
+        scene.validate_with_source(Some(text))?;
+        Ok(scene)
+    }
+
+    /// The scene as TOML text that [`YarnScene::from_toml_str`] reads back.
+    pub fn to_toml_string(&self) -> String {
+        toml::to_string_pretty(self).expect("a yarn scene always serializes")
+    }
+
+    /// Grid spacing `dx` in m.
+    pub fn dx(&self) -> f64 {
+        self.grid.size / self.grid.resolution as f64
+    }
+
+    /// Checks cross-field constraints (geometry, time step against grid).
+    pub fn validate(&self) -> Result<(), SceneError> {
+        self.validate_with_source(None)
+    }
+
+    fn validate_with_source(&self, text: Option<&str>) -> Result<(), SceneError> {
+        let yarn_line = |i: usize| {
+            text.and_then(|t| {
+                t.match_indices("[[yarns]]")
+                    .nth(i)
+                    .map(|(p, _)| line_of(t, p))
+            })
+        };
+        let obstacle_line = |i: usize| {
+            text.and_then(|t| {
+                t.match_indices("[[obstacles]]")
+                    .nth(i)
+                    .map(|(p, _)| line_of(t, p))
+            })
+        };
+        if self.yarns.is_empty() {
+            return Err(SceneError::Invalid {
+                field: "yarns".into(),
+                line: None,
+                message: "a yarn scene needs at least one [[yarns]] entry".into(),
+            });
+        }
+        let size = self.grid.size;
+        let margin = self.dx() * 1.5;
+        for (i, y) in self.yarns.iter().enumerate() {
+            let curves = y.curves().map_err(|message| SceneError::Invalid {
+                field: format!("yarns[{i}]"),
+                line: yarn_line(i),
+                message,
+            })?;
+            for c in &curves {
+                for p in c {
+                    if p.x < margin || p.y < margin || p.x > size - margin || p.y > size - margin {
+                        return Err(SceneError::Invalid {
+                            field: format!("yarns[{i}]"),
+                            line: yarn_line(i),
+                            message: format!(
+                                "vertex ({:.4}, {:.4}) lies outside the grid interior [{margin:.4}, {:.4}]^2",
+                                p.x,
+                                p.y,
+                                size - margin
+                            ),
+                        });
+                    }
+                }
+            }
+        }
+        for (i, o) in self.obstacles.iter().enumerate() {
+            if o.radius > 10.0 * size {
+                return Err(SceneError::Invalid {
+                    field: format!("obstacles[{i}].radius"),
+                    line: obstacle_line(i),
+                    message: "radius is absurdly large for the domain".into(),
+                });
+            }
+        }
+        let total: u64 = self
+            .yarns
+            .iter()
+            .map(|y| y.vertices as u64 * y.count as u64)
+            .sum();
+        if total > 20_000_000 {
+            return Err(SceneError::Invalid {
+                field: "yarns".into(),
+                line: None,
+                message: format!("{total} vertices in all is more than the 20 million supported"),
+            });
+        }
+        if self.time.frame_dt < self.time.dt {
+            return Err(SceneError::Invalid {
+                field: "time.frame_dt".into(),
+                line: None,
+                message: format!(
+                    "frame_dt {} is shorter than the substep dt {}",
+                    self.time.frame_dt, self.time.dt
+                ),
+            });
+        }
+        Ok(())
+    }
+
+    /// All yarn curves (one per copy), each resampled to its vertex count.
+    pub fn curves(&self) -> Vec<Vec<Vec2>> {
+        self.yarns
+            .iter()
+            .flat_map(|y| y.curves().expect("validated scene"))
+            .collect()
+    }
+
+    /// Initial velocity of each yarn curve, in the order of [`YarnScene::curves`].
+    pub fn curve_velocities(&self) -> Vec<Vec2> {
+        self.yarns
+            .iter()
+            .flat_map(|y| std::iter::repeat_n(Vec2::from(y.velocity), y.count as usize))
+            .collect()
+    }
+}
+
+impl YarnSpec {
+    /// A straight yarn from `start` to `end` with `vertices` vertices.
+    pub fn straight(start: [f64; 2], end: [f64; 2], vertices: u32) -> Self {
+        YarnSpec {
+            start: Some(start),
+            end: Some(end),
+            vertices,
+            count: 1,
+            ..Default::default()
+        }
+    }
+
+    /// The control polyline of the first copy.
+    fn polyline(&self) -> Result<Vec<Vec2>, String> {
+        match (
+            &self.points,
+            self.start,
+            self.end,
+            self.direction,
+            self.length,
+        ) {
+            (Some(pts), None, None, None, None) => {
+                if pts.len() < 2 {
+                    return Err("`points` needs at least two points".into());
+                }
+                if pts.iter().flatten().any(|v| !v.is_finite()) {
+                    return Err("`points` must be finite".into());
+                }
+                Ok(pts.iter().map(|&p| Vec2::from(p)).collect())
+            }
+            (None, Some(s), Some(e), None, None) => Ok(vec![s.into(), e.into()]),
+            (None, Some(s), None, Some(d), Some(l)) => {
+                let d = Vec2::from(d);
+                let n = d.norm();
+                if n == 0.0 {
+                    return Err("`direction` must not be zero".into());
+                }
+                let s = Vec2::from(s);
+                Ok(vec![s, s + d * (l / n)])
+            }
+            _ => Err(
+                "give either `points`, or `start` and `end`, or `start`, `direction` and `length`"
+                    .into(),
+            ),
+        }
+    }
+
+    /// The vertex positions of every copy.
+    pub fn curves(&self) -> Result<Vec<Vec<Vec2>>, String> {
+        let poly = self.polyline()?;
+        let curve = resample(&poly, self.vertices as usize)?;
+        let step = Vec2::from(self.spacing);
+        Ok((0..self.count)
+            .map(|c| curve.iter().map(|p| p + step * c as f64).collect())
+            .collect())
+    }
+}
+
+/// `n` points equally spaced by arc length along the polyline `poly`.
+fn resample(poly: &[Vec2], n: usize) -> Result<Vec<Vec2>, String> {
+    let seg: Vec<f64> = poly.windows(2).map(|w| (w[1] - w[0]).norm()).collect();
+    let total: f64 = seg.iter().sum();
+    if total.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
+        return Err("the yarn has zero length".into());
+    }
+    let mut out = Vec::with_capacity(n);
+    let mut k = 0;
+    let mut acc = 0.0;
+    for i in 0..n {
+        let s = total * i as f64 / (n - 1) as f64;
+        while k + 1 < seg.len() && acc + seg[k] < s {
+            acc += seg[k];
+            k += 1;
+        }
+        let t = if seg[k] > 0.0 {
+            ((s - acc) / seg[k]).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        out.push(poly[k] + (poly[k + 1] - poly[k]) * t);
+    }
+    Ok(out)
+}
+
+// ---- defaults -------------------------------------------------------------
+
+fn kind_yarn() -> String {
+    "yarn".into()
+}
+fn one() -> f64 {
+    1.0
+}
+fn one_u32() -> u32 {
+    1
+}
+fn yes() -> bool {
+    true
+}
+fn centre() -> [f64; 2] {
+    [0.5, 0.5]
+}
+fn default_gravity() -> [f64; 2] {
+    [0.0, -9.8]
+}
+fn default_frame_dt() -> f64 {
+    1.0 / 60.0
+}
+fn default_attractor_strength() -> f64 {
+    20.0
+}
+fn default_wall_cells() -> u32 {
+    3
+}
+fn default_obstacle_friction() -> f64 {
+    0.3
+}
+
+// ---- validating field readers (the error carries the value's span) --------
+
+use serde::de::Error as _;
+
+fn kind_is_yarn<'de, D: Deserializer<'de>>(d: D) -> Result<String, D::Error> {
+    let s = String::deserialize(d)?;
+    if s == "yarn" {
+        Ok(s)
+    } else {
+        Err(D::Error::custom(format!(
+            "kind must be \"yarn\" for a yarn scene, got {s:?}"
+        )))
+    }
+}
+
+fn finite<'de, D: Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
+    let v = f64::deserialize(d)?;
+    if v.is_finite() {
+        Ok(v)
+    } else {
+        Err(D::Error::custom(format!(
+            "must be a finite number, got {v}"
+        )))
+    }
+}
+
+fn positive<'de, D: Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
+    let v = finite(d)?;
+    if v > 0.0 {
+        Ok(v)
+    } else {
+        Err(D::Error::custom(format!("must be > 0, got {v}")))
+    }
+}
+
+fn nonnegative<'de, D: Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
+    let v = finite(d)?;
+    if v >= 0.0 {
+        Ok(v)
+    } else {
+        Err(D::Error::custom(format!("must be >= 0, got {v}")))
+    }
+}
+
+fn opt_positive<'de, D: Deserializer<'de>>(d: D) -> Result<Option<f64>, D::Error> {
+    positive(d).map(Some)
+}
+
+fn finite2<'de, D: Deserializer<'de>>(d: D) -> Result<[f64; 2], D::Error> {
+    let v = <[f64; 2]>::deserialize(d)?;
+    if v.iter().all(|x| x.is_finite()) {
+        Ok(v)
+    } else {
+        Err(D::Error::custom(format!(
+            "must be two finite numbers, got {v:?}"
+        )))
+    }
+}
+
+fn opt_finite2<'de, D: Deserializer<'de>>(d: D) -> Result<Option<[f64; 2]>, D::Error> {
+    finite2(d).map(Some)
+}
+
+fn bounded_u32<'de, D: Deserializer<'de>>(d: D, lo: u32, hi: u32) -> Result<u32, D::Error> {
+    let v = i64::deserialize(d)?;
+    if (lo as i64..=hi as i64).contains(&v) {
+        Ok(v as u32)
+    } else {
+        Err(D::Error::custom(format!(
+            "must be an integer from {lo} to {hi}, got {v}"
+        )))
+    }
+}
+
+fn resolution<'de, D: Deserializer<'de>>(d: D) -> Result<u32, D::Error> {
+    bounded_u32(d, 8, 8192)
+}
+fn wall_cells<'de, D: Deserializer<'de>>(d: D) -> Result<u32, D::Error> {
+    bounded_u32(d, 1, 16)
+}
+fn vertex_count<'de, D: Deserializer<'de>>(d: D) -> Result<u32, D::Error> {
+    bounded_u32(d, 2, 10_000_000)
+}
+fn copy_count<'de, D: Deserializer<'de>>(d: D) -> Result<u32, D::Error> {
+    bounded_u32(d, 1, 100_000)
+}
