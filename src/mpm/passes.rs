@@ -368,7 +368,8 @@ fn project_out(o: &Obstacle, x: &mut Vec2, v: &mut Vec2) {
 }
 
 /// Pass 4a: grid-to-particle for vertices and advection `x += dt v`.
-/// Returns the index of the first vertex with a non-finite state, if any.
+/// Returns the index of the first vertex whose state is non-finite or whose
+/// speed exceeds one cell per substep (the CFL limit), if any.
 pub fn gather_vertices(
     vert: &mut Vertices,
     grid: &Grid,
@@ -390,11 +391,12 @@ pub fn gather_vertices(
                 project_out(o, x, v);
             }
             clamp_to_grid(x, v, lo, hi);
+            // Finite, and no faster than one cell per substep (CFL): beyond
+            // that the transfer is meaningless and the run is diverging.
             let ok = x.x.is_finite()
                 && x.y.is_finite()
-                && v.x.is_finite()
-                && v.y.is_finite()
-                && c.iter().all(|e| e.is_finite());
+                && c.iter().all(|e| e.is_finite())
+                && nv.norm() * dt <= geom.dx;
             if ok {
                 None
             } else {

@@ -12,8 +12,9 @@ use crate::scene::{Obstacle, SceneError, WallMode, YarnScene};
 /// Why a step failed.
 #[derive(Clone, Debug, PartialEq)]
 pub enum SimError {
-    /// A particle's state became NaN or infinite during this step; the
-    /// simulation refuses further steps until its state is restored.
+    /// A particle's state became NaN or infinite, or a particle moved more
+    /// than one grid cell in one substep, during this step; the simulation
+    /// refuses further steps until its state is restored.
     NonFinite { step: u64, time: f64, what: String },
     /// An input given to the simulation is unusable.
     BadInput(String),
@@ -25,7 +26,7 @@ impl std::fmt::Display for SimError {
             SimError::NonFinite { step, time, what } => {
                 write!(
                     f,
-                    "simulation diverged at step {step} (t = {time:.6} s): {what} is not finite"
+                    "simulation diverged at step {step} (t = {time:.6} s): {what}"
                 )
             }
             SimError::BadInput(m) => write!(f, "bad input: {m}"),
@@ -315,8 +316,19 @@ impl YarnSim {
         self.steps += 1;
         self.time += dt;
         let what = match (bad_v, bad_q) {
-            (Some(i), _) => Some(format!("vertex {i}")),
-            (None, Some(q)) => Some(format!("quadrature particle {q}")),
+            (Some(i), _) => {
+                let v = self.particles.vert.v[i];
+                Some(if v.x.is_finite() && v.y.is_finite() {
+                    format!(
+                        "vertex {i} moves {:.3} m/s, more than one cell per substep (CFL limit {:.3} m/s)",
+                        v.norm(),
+                        self.grid.geom.dx / dt
+                    )
+                } else {
+                    format!("the state of vertex {i} is not finite")
+                })
+            }
+            (None, Some(q)) => Some(format!("the frame of quadrature particle {q} is not finite")),
             _ => None,
         };
         if let Some(what) = what {
