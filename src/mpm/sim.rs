@@ -328,7 +328,9 @@ impl YarnSim {
                     format!("the state of vertex {i} is not finite")
                 })
             }
-            (None, Some(q)) => Some(format!("the frame of quadrature particle {q} is not finite")),
+            (None, Some(q)) => Some(format!(
+                "the frame of quadrature particle {q} is not finite"
+            )),
             _ => None,
         };
         if let Some(what) = what {

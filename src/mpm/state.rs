@@ -232,7 +232,7 @@ impl YarnSim {
                 .chain(&quad.3)
                 .chain(&quad.4)
                 .all(|m| m.iter().all(|e| e.is_finite()));
-        if !finite || !(dt > 0.0) {
+        if !finite || dt <= 0.0 {
             return Err(StateError::NonFinite);
         }
         self.time = time;

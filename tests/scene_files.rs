@@ -1,0 +1,107 @@
+//! Scene files: round trip, and malformed files name the field and the line.
+
+use yarnsim::scene::{builtin, builtin_names, Scene, SceneError, YarnScene};
+
+const GOOD: &str = r#"
+name = "t"
+[grid]
+resolution = 64
+[time]
+dt = 1e-4
+[material]
+k = 1000
+gamma = 500.0
+youngs_modulus = 1000.0
+friction = 0.05
+[[yarns]]
+start = [0.2, 0.5]
+direction = [1.0, 0.0]
+length = 0.5
+vertices = 20
+"#;
+
+fn err(text: &str) -> SceneError {
+    YarnScene::from_toml_str(text).expect_err("must be rejected")
+}
+
+#[test]
+fn good_file_loads_with_defaults() {
+    let s = YarnScene::from_toml_str(GOOD).unwrap();
+    assert_eq!(s.gravity, [0.0, -9.8]);
+    assert_eq!(s.grid.size, 1.0);
+    assert!(s.material.plasticity);
+    let c = s.curves();
+    assert_eq!(c.len(), 1);
+    assert_eq!(c[0].len(), 20);
+    assert!((c[0][19].x - 0.7).abs() < 1e-12);
+}
+
+#[test]
+fn every_builtin_round_trips_through_toml() {
+    for (name, _) in builtin_names() {
+        let s = builtin(name).unwrap();
+        let text = s.to_toml_string();
+        let back = Scene::from_toml_str(&text).unwrap_or_else(|e| panic!("{name}: {e}\n{text}"));
+        assert_eq!(back, s, "{name}");
+    }
+}
+
+#[test]
+fn negative_value_names_field_and_line() {
+    let e = err(&GOOD.replace("dt = 1e-4", "dt = -1e-4"));
+    let m = e.to_string();
+    assert!(
+        m.contains("line 6") && m.contains("time.dt") && m.contains("> 0"),
+        "{m}"
+    );
+}
+
+#[test]
+fn unknown_field_names_field_and_line() {
+    let e = err(&GOOD.replace("gamma = 500.0", "gamma = 500.0\nstifness = 3"));
+    let m = e.to_string();
+    assert!(m.contains("line 10") && m.contains("stifness"), "{m}");
+}
+
+#[test]
+fn wrong_type_and_syntax_errors_name_the_line() {
+    let m = err(&GOOD.replace("resolution = 64", "resolution = \"big\"")).to_string();
+    assert!(m.contains("line 4") && m.contains("grid.resolution"), "{m}");
+    let m = err(&GOOD.replace("[material]", "[material")).to_string();
+    assert!(m.contains("line 7"), "{m}");
+    let m = err(&GOOD.replace("resolution = 64", "resolution = 3")).to_string();
+    assert!(m.contains("line 4") && m.contains("from 8"), "{m}");
+}
+
+#[test]
+fn missing_field_is_named() {
+    let m = err(&GOOD.replace("friction = 0.05\n", "")).to_string();
+    assert!(m.contains("friction"), "{m}");
+}
+
+#[test]
+fn inconsistent_geometry_names_the_yarn_and_its_line() {
+    let m = err(&GOOD.replace("length = 0.5", "length = 5.0")).to_string();
+    assert!(
+        m.contains("yarns[0]") && m.contains("line 12") && m.contains("outside"),
+        "{m}"
+    );
+    let m = err(&GOOD.replace("direction = [1.0, 0.0]\n", "")).to_string();
+    assert!(m.contains("yarns[0]") && m.contains("give either"), "{m}");
+    let m = err(&GOOD.replace("direction = [1.0, 0.0]", "direction = [0.0, 0.0]")).to_string();
+    assert!(m.contains("direction") && m.contains("zero"), "{m}");
+}
+
+#[test]
+fn unknown_builtin_lists_the_known_ones() {
+    match Scene::resolve("no-such-scene") {
+        Err(SceneError::UnknownScene { known, .. }) => {
+            assert!(known.contains(&"yarn-reference".to_string()))
+        }
+        other => panic!("{other:?}"),
+    }
+    assert!(matches!(
+        Scene::resolve("/nonexistent/x.toml"),
+        Err(SceneError::Io { .. })
+    ));
+}
