@@ -6,7 +6,9 @@
 //! * [`math`]: 2x2 QR, B-spline weights.
 //! * [`scene`]: scene descriptions ("layouts") and their TOML files.
 //! * [`mpm`]: the yarn-bundle MPM solver.
+//! * [`massspring`]: mass-spring wires and cloth (seeds 002, 004, 001).
 
+pub mod massspring;
 pub mod math;
 pub mod mpm;
 pub mod scene;

@@ -24,6 +24,9 @@ pub fn builtin_names() -> Vec<(&'static str, &'static str)> {
             "one diagonal yarn of 400 vertices drapes over a single circle",
         ),
     ]
+    .into_iter()
+    .chain(crate::massspring::scenes::names())
+    .collect()
 }
 
 /// A built-in scene by name.
@@ -32,6 +35,9 @@ pub fn builtin(name: &str) -> Option<Scene> {
         "yarn-reference" | "reference" | "default" => Some(Scene::Yarn(yarn_reference())),
         "yarn-vertical" => Some(Scene::Yarn(yarn_vertical())),
         "yarn-drape" => Some(Scene::Yarn(yarn_drape())),
+        "wire" | "three-particle" | "cloth" => {
+            crate::massspring::scenes::by_name(name).map(Scene::MassSpring)
+        }
         _ => None,
     }
 }

@@ -18,6 +18,8 @@ pub use yarn::{
 pub enum Scene {
     /// A 2D MPM yarn bundle.
     Yarn(YarnScene),
+    /// A 3D mass-spring wire or cloth (kinds "mass-spring", "wire", "cloth", "three-particle").
+    MassSpring(crate::massspring::Layout),
 }
 
 impl Scene {
@@ -26,13 +28,21 @@ impl Scene {
         let kind = toml_kind(text)?;
         match kind.as_deref() {
             None | Some("yarn") => YarnScene::from_toml_str(text).map(Scene::Yarn),
+            Some(k) if crate::massspring::layout::KINDS.contains(&k) => {
+                crate::massspring::Layout::from_toml_str(text).map(Scene::MassSpring)
+            }
             Some(other) => Err(SceneError::Invalid {
                 field: "kind".into(),
                 line: text
                     .lines()
                     .position(|l| l.trim_start().starts_with("kind"))
                     .map(|i| i + 1),
-                message: format!("unknown scene kind {other:?}; known kinds: \"yarn\""),
+                message: format!(
+                    "unknown scene kind {other:?}; known kinds: \"yarn\", {}",
+                    crate::massspring::layout::KINDS
+                        .map(|k| format!("{k:?}"))
+                        .join(", ")
+                ),
             }),
         }
     }
@@ -66,6 +76,7 @@ impl Scene {
     pub fn to_toml_string(&self) -> String {
         match self {
             Scene::Yarn(s) => s.to_toml_string(),
+            Scene::MassSpring(s) => s.to_toml_string(),
         }
     }
 
@@ -73,6 +84,7 @@ impl Scene {
     pub fn name(&self) -> &str {
         match self {
             Scene::Yarn(s) => &s.name,
+            Scene::MassSpring(s) => &s.name,
         }
     }
 }

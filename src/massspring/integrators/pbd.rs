@@ -1,0 +1,110 @@
+//! Seed 001's position-based pieces: the PBD model (inertia and gravity, then
+//! strain limiting), the strain-limiting projection itself (usable after any
+//! integrator), and sphere collision by projection with a velocity fix-up.
+
+use super::{set_kinematics, State, StepStats};
+use crate::massspring::forces::max_strain;
+use crate::massspring::layout::{System, V3};
+
+/// Weight of a vertex's own position in the Jacobi averaging (seed 001: 0.2).
+pub const SELF_WEIGHT: f64 = 0.2;
+
+/// Seed 001's PBD step: `v += h g; x += h v`, kinematics at `t + h`, then
+/// strain limiting with `limit` (0 = pull every spring to its rest length).
+pub fn step(sys: &System, s: &mut State, h: f64, limit: f64, passes: usize) -> StepStats {
+    for i in 0..sys.len() {
+        if sys.is_free(i) {
+            s.v[i] += sys.gravity * h;
+            s.x[i] += s.v[i] * h;
+        }
+    }
+    set_kinematics(sys, s.t + h, &mut s.x, &mut s.v);
+    let mut stats = StepStats::new(h);
+    let (n, after) = strain_limit(sys, &mut s.x, &mut s.v, h, limit, passes);
+    stats.strain_passes = n;
+    stats.strain_after_limiting = after;
+    stats
+}
+
+/// Jacobi strain-limiting projection (seed 001's `Strain_Limiting`, with each
+/// spring's target length clamped into `[(1-limit) l0, (1+limit) l0]`), run
+/// for up to `passes` passes, stopping early once every spring is within
+/// the limit. Each moved free vertex gets the velocity fix-up `dx / h`.
+/// Returns the passes run and the largest strain afterwards.
+pub fn strain_limit(
+    sys: &System,
+    x: &mut [V3],
+    v: &mut [V3],
+    h: f64,
+    limit: f64,
+    passes: usize,
+) -> (usize, f64) {
+    let n = sys.len();
+    let mut sum_x = vec![V3::zeros(); n];
+    let mut sum_n = vec![0u32; n];
+    let mut done = 0;
+    for _ in 0..passes {
+        if max_strain(&sys.springs, x) <= limit {
+            break;
+        }
+        done += 1;
+        sum_x.iter_mut().for_each(|s| *s = V3::zeros());
+        sum_n.iter_mut().for_each(|c| *c = 0);
+        for sp in &sys.springs {
+            let (a, b) = (sp.a, sp.b);
+            let dx = x[a] - x[b];
+            let l = dx.norm();
+            let mid = (x[a] + x[b]) * 0.5;
+            let half = if l > 0.0 {
+                let target = l.clamp(
+                    (1.0 - limit) * sp.rest_length,
+                    (1.0 + limit) * sp.rest_length,
+                );
+                dx * (0.5 * target / l)
+            } else {
+                V3::zeros()
+            };
+            sum_x[a] += mid + half;
+            sum_x[b] += mid - half;
+            sum_n[a] += 1;
+            sum_n[b] += 1;
+        }
+        for i in 0..n {
+            if !sys.is_free(i) || sum_n[i] == 0 {
+                continue;
+            }
+            let xt = (x[i] * SELF_WEIGHT + sum_x[i]) / (SELF_WEIGHT + sum_n[i] as f64);
+            v[i] += (xt - x[i]) / h;
+            x[i] = xt;
+        }
+    }
+    (done, max_strain(&sys.springs, x))
+}
+
+/// Projects free particles inside a sphere onto its surface, adding the
+/// displacement over `h` to their velocity (seed 001's `Collision_Handling`).
+/// Returns the number of projections.
+pub fn collide_spheres(sys: &System, x: &mut [V3], v: &mut [V3], h: f64) -> usize {
+    let mut count = 0;
+    for sph in &sys.spheres {
+        for i in 0..sys.len() {
+            if !sys.is_free(i) {
+                continue;
+            }
+            let d = x[i] - sph.center;
+            let dist = d.norm();
+            if dist < sph.radius {
+                let dir = if dist > 0.0 {
+                    d / dist
+                } else {
+                    V3::new(0.0, 1.0, 0.0)
+                };
+                let target = sph.center + dir * sph.radius;
+                v[i] += (target - x[i]) / h;
+                x[i] = target;
+                count += 1;
+            }
+        }
+    }
+    count
+}

@@ -1,0 +1,802 @@
+//! The mass-spring "layout" (seed 002's `SIMULATION_LAYOUT`): what exists in a
+//! wire or cloth scene, as plain data read from TOML. Particles and springs are
+//! given one by one (`[[particles]]`, `[[springs]]`) or generated
+//! (`[[chains]]`, `[[sheets]]`); kinematic constraints (`pinned`,
+//! `[[driven]]`), colliders (`[[spheres]]`), gravity and time parameters
+//! complete it. [`Layout::build`] expands it into a [`System`] that the
+//! integrators in [`super::integrators`] advance; they never look at the file
+//! form. See `docs/massspring.md` for every field with its unit and default.
+
+use nalgebra::Vector3;
+use serde::{Deserialize, Deserializer, Serialize};
+
+use crate::scene::error::{from_toml_error, line_of, SceneError};
+
+/// 3-vector of f64 used throughout the mass-spring model.
+pub type V3 = Vector3<f64>;
+
+/// The scene kinds a mass-spring layout answers to (the top-level `kind`).
+pub const KINDS: [&str; 4] = ["mass-spring", "wire", "cloth", "three-particle"];
+
+/// A complete mass-spring scene.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Layout {
+    /// One of [`KINDS`] (default `"mass-spring"`); all mean the same model.
+    #[serde(default = "kind_default", deserialize_with = "kind_ok")]
+    pub kind: String,
+    /// Short name shown by the CLI.
+    #[serde(default)]
+    pub name: String,
+    /// One line of description.
+    #[serde(default)]
+    pub description: String,
+    /// Gravity acceleration `[gx, gy, gz]` in m/s^2 (default `[0, -9.81, 0]`).
+    #[serde(default = "default_gravity", deserialize_with = "finite3")]
+    pub gravity: [f64; 3],
+    /// Indices of particles held fixed at their initial position.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub pinned: Vec<usize>,
+    /// Time and integration parameters.
+    pub time: TimeParams,
+    /// Individually given particles (global indices 0, 1, ... in file order).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub particles: Vec<ParticleSpec>,
+    /// Generated straight chains (their particles follow the explicit ones).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub chains: Vec<ChainSpec>,
+    /// Generated rectangular sheets (their particles follow the chains').
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub sheets: Vec<SheetSpec>,
+    /// Individually given springs between global particle indices.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub springs: Vec<SpringSpec>,
+    /// Particles driven on a prescribed circle.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub driven: Vec<DrivenSpec>,
+    /// Fixed spheres the particles collide with (projection + velocity fix-up).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub spheres: Vec<SphereSpec>,
+}
+
+/// Frame loop and step parameters (seed 002's "user-specified parameters").
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TimeParams {
+    /// Frame (snapshot) interval in s.
+    #[serde(deserialize_with = "positive")]
+    pub frame_time: f64,
+    /// Number of frames of a full run (1 or more).
+    #[serde(deserialize_with = "frame_count")]
+    pub frames: u32,
+    /// Step size in s of the implicit and position-based integrators
+    /// (default: `frame_time`). Explicit integrators use the CFL bound.
+    #[serde(
+        default,
+        skip_serializing_if = "Option::is_none",
+        deserialize_with = "opt_positive"
+    )]
+    pub time_step: Option<f64>,
+    /// Fraction of the stability bound the explicit integrators step at
+    /// (0 < c <= 1, default 0.5 as in seed 002).
+    #[serde(default = "half", deserialize_with = "unit_interval")]
+    pub cfl_number: f64,
+    /// Fraction of the free particles' velocity kept per `frame_time`
+    /// (0 < d <= 1, default 1 = none); a step of size `h` multiplies the
+    /// velocity by `d^(h / frame_time)` before it starts (seed 001: 0.99).
+    #[serde(default = "one", deserialize_with = "unit_interval")]
+    pub velocity_damping: f64,
+    /// Strain limit `s` of the position-based pass: after each step every
+    /// spring length is pulled into `[(1-s) l0, (1+s) l0]`. Absent: no pass
+    /// (the `pbd` integrator then uses `s = 0`).
+    #[serde(
+        default,
+        skip_serializing_if = "Option::is_none",
+        deserialize_with = "opt_strain"
+    )]
+    pub strain_limit: Option<f64>,
+}
+
+/// One particle.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ParticleSpec {
+    /// Initial position in m.
+    #[serde(deserialize_with = "finite3")]
+    pub position: [f64; 3],
+    /// Initial velocity in m/s (default 0).
+    #[serde(default, deserialize_with = "finite3")]
+    pub velocity: [f64; 3],
+    /// Mass in kg.
+    #[serde(deserialize_with = "positive")]
+    pub mass: f64,
+}
+
+/// One spring between two particles.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SpringSpec {
+    /// Global indices of the two particles.
+    pub particles: [usize; 2],
+    /// Stiffness `k` in N/m: force `k (l - l0)` along the spring.
+    #[serde(deserialize_with = "nonnegative")]
+    pub stiffness: f64,
+    /// Damping `b` in N s/m: force `b (d . (v_b - v_a))` along the spring (default 0).
+    #[serde(default, deserialize_with = "nonnegative")]
+    pub damping: f64,
+    /// Rest length in m (default: the initial distance).
+    #[serde(
+        default,
+        skip_serializing_if = "Option::is_none",
+        deserialize_with = "opt_positive"
+    )]
+    pub rest_length: Option<f64>,
+}
+
+/// A straight chain of `particles` equal masses joined by springs (seed 002's wire).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ChainSpec {
+    /// First particle's position in m.
+    #[serde(deserialize_with = "finite3")]
+    pub start: [f64; 3],
+    /// Last particle's position in m; springs rest at the initial spacing.
+    #[serde(deserialize_with = "finite3")]
+    pub end: [f64; 3],
+    /// Number of particles (2 or more).
+    #[serde(deserialize_with = "chain_count")]
+    pub particles: u32,
+    /// Total mass in kg, shared equally.
+    #[serde(deserialize_with = "positive")]
+    pub mass: f64,
+    /// Seed 002's `youngs_modulus` E in N: a spring of rest length `l0` has
+    /// stiffness `k = E / l0` (force `E (l / l0 - 1)`).
+    #[serde(deserialize_with = "nonnegative")]
+    pub youngs_modulus: f64,
+    /// Seed 002's `damping_coefficient` b in N s/m, per spring (default 0).
+    #[serde(default, deserialize_with = "nonnegative")]
+    pub damping: f64,
+}
+
+/// A rectangular sheet of `nu x nv` vertices, triangulated as in seed 001
+/// (structural edges plus the diagonal `(i, j)-(i+1, j+1)` of every quad).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SheetSpec {
+    /// Position of vertex `(0, 0)` in m.
+    #[serde(deserialize_with = "finite3")]
+    pub origin: [f64; 3],
+    /// Vector from vertex `(0, j)` to `(nu-1, j)` in m.
+    #[serde(deserialize_with = "finite3")]
+    pub edge_u: [f64; 3],
+    /// Vector from vertex `(i, 0)` to `(i, nv-1)` in m.
+    #[serde(deserialize_with = "finite3")]
+    pub edge_v: [f64; 3],
+    /// Vertices along `edge_u` (2 or more); vertex `(i, j)` has local index `j nu + i`.
+    #[serde(deserialize_with = "chain_count")]
+    pub nu: u32,
+    /// Vertices along `edge_v` (2 or more).
+    #[serde(deserialize_with = "chain_count")]
+    pub nv: u32,
+    /// Mass of each vertex in kg.
+    #[serde(deserialize_with = "positive")]
+    pub mass: f64,
+    /// Stiffness of every edge spring in N/m.
+    #[serde(deserialize_with = "nonnegative")]
+    pub stiffness: f64,
+    /// Damping of every edge spring in N s/m (default 0).
+    #[serde(default, deserialize_with = "nonnegative")]
+    pub damping: f64,
+    /// Whether the quad diagonals are springs too (default true).
+    #[serde(default = "yes")]
+    pub diagonals: bool,
+}
+
+/// A particle moved on the circle `center + u sin(w t + phase) + v cos(w t + phase)`,
+/// `w = 2 pi / period` (seed 002's upper endpoint).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DrivenSpec {
+    /// Global index of the driven particle.
+    pub particle: usize,
+    /// Circle centre in m.
+    #[serde(deserialize_with = "finite3")]
+    pub center: [f64; 3],
+    /// Radius vector multiplying `sin` in m.
+    #[serde(deserialize_with = "finite3")]
+    pub u: [f64; 3],
+    /// Radius vector multiplying `cos` in m.
+    #[serde(deserialize_with = "finite3")]
+    pub v: [f64; 3],
+    /// Period in s.
+    #[serde(deserialize_with = "positive")]
+    pub period: f64,
+    /// Phase in rad (default 0).
+    #[serde(default, deserialize_with = "finite")]
+    pub phase: f64,
+}
+
+/// A fixed sphere collider.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SphereSpec {
+    /// Centre in m.
+    #[serde(deserialize_with = "finite3")]
+    pub center: [f64; 3],
+    /// Radius in m.
+    #[serde(deserialize_with = "positive")]
+    pub radius: f64,
+}
+
+/// One spring of the expanded system.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Spring {
+    pub a: usize,
+    pub b: usize,
+    /// Stiffness in N/m.
+    pub k: f64,
+    /// Damping in N s/m.
+    pub damping: f64,
+    /// Rest length in m.
+    pub rest_length: f64,
+}
+
+/// How a particle moves.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Kinematic {
+    /// Moved by the integrator.
+    Free,
+    /// Held at this position (bitwise).
+    Pinned(V3),
+    /// Driven on a circle.
+    Circle {
+        center: V3,
+        u: V3,
+        v: V3,
+        omega: f64,
+        phase: f64,
+    },
+}
+
+impl Kinematic {
+    /// Prescribed position and velocity at time `t`, or `None` for a free particle.
+    pub fn at(&self, t: f64) -> Option<(V3, V3)> {
+        match *self {
+            Kinematic::Free => None,
+            Kinematic::Pinned(x) => Some((x, V3::zeros())),
+            Kinematic::Circle {
+                center,
+                u,
+                v,
+                omega,
+                phase,
+            } => {
+                let a = omega * t + phase;
+                let (s, c) = a.sin_cos();
+                Some((center + u * s + v * c, (u * c - v * s) * omega))
+            }
+        }
+    }
+
+    /// Whether the integrator moves this particle.
+    pub fn is_free(&self) -> bool {
+        matches!(self, Kinematic::Free)
+    }
+}
+
+/// A sphere collider of the expanded system.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Sphere {
+    pub center: V3,
+    pub radius: f64,
+}
+
+/// The expanded scene: flat arrays the integrators work on.
+#[derive(Clone, Debug, PartialEq)]
+pub struct System {
+    /// Initial positions in m.
+    pub positions: Vec<V3>,
+    /// Initial velocities in m/s.
+    pub velocities: Vec<V3>,
+    /// Masses in kg.
+    pub masses: Vec<f64>,
+    pub springs: Vec<Spring>,
+    /// One entry per particle.
+    pub kinematics: Vec<Kinematic>,
+    pub spheres: Vec<Sphere>,
+    /// Gravity in m/s^2.
+    pub gravity: V3,
+    pub frame_time: f64,
+    pub frames: u32,
+    /// Step of the implicit integrators in s.
+    pub time_step: f64,
+    pub cfl_number: f64,
+    pub velocity_damping: f64,
+    pub strain_limit: Option<f64>,
+}
+
+impl System {
+    /// Number of particles.
+    pub fn len(&self) -> usize {
+        self.positions.len()
+    }
+    /// Whether there are no particles.
+    pub fn is_empty(&self) -> bool {
+        self.positions.is_empty()
+    }
+    /// Whether particle `i` is moved by the integrator.
+    pub fn is_free(&self, i: usize) -> bool {
+        self.kinematics[i].is_free()
+    }
+    /// Number of free particles.
+    pub fn free_count(&self) -> usize {
+        self.kinematics.iter().filter(|k| k.is_free()).count()
+    }
+}
+
+impl Layout {
+    /// Parses and validates a layout from TOML text; errors name the field and line.
+    pub fn from_toml_str(text: &str) -> Result<Layout, SceneError> {
+        let layout: Layout = toml::from_str(text).map_err(|e| from_toml_error(text, e))?;
+        layout.build_with_source(Some(text))?;
+        Ok(layout)
+    }
+
+    /// The layout as TOML text that [`Layout::from_toml_str`] reads back.
+    pub fn to_toml_string(&self) -> String {
+        toml::to_string_pretty(self).expect("a mass-spring layout always serializes")
+    }
+
+    /// Checks cross-field constraints (indices, degenerate springs).
+    pub fn validate(&self) -> Result<(), SceneError> {
+        self.build().map(|_| ())
+    }
+
+    /// Number of particles after expansion of chains and sheets.
+    pub fn particle_count(&self) -> usize {
+        self.particles.len()
+            + self
+                .chains
+                .iter()
+                .map(|c| c.particles as usize)
+                .sum::<usize>()
+            + self
+                .sheets
+                .iter()
+                .map(|s| s.nu as usize * s.nv as usize)
+                .sum::<usize>()
+    }
+
+    /// Expands the layout into the flat [`System`].
+    pub fn build(&self) -> Result<System, SceneError> {
+        self.build_with_source(None)
+    }
+
+    fn build_with_source(&self, text: Option<&str>) -> Result<System, SceneError> {
+        let table_line = |header: &str, i: usize| {
+            text.and_then(|t| t.match_indices(header).nth(i).map(|(p, _)| line_of(t, p)))
+        };
+        let key_line = |key: &str| {
+            text.and_then(|t| {
+                t.lines()
+                    .position(|l| l.trim_start().starts_with(key))
+                    .map(|i| i + 1)
+            })
+        };
+        let invalid = |field: String, line: Option<usize>, message: String| SceneError::Invalid {
+            field,
+            line,
+            message,
+        };
+        let n_total = self.particle_count();
+        if n_total == 0 {
+            return Err(invalid(
+                "particles".into(),
+                None,
+                "a mass-spring scene needs at least one particle ([[particles]], [[chains]] or [[sheets]])".into(),
+            ));
+        }
+        if n_total > 5_000_000 {
+            return Err(invalid(
+                "particles".into(),
+                None,
+                format!("{n_total} particles is more than the 5 million supported"),
+            ));
+        }
+        let mut positions = Vec::with_capacity(n_total);
+        let mut velocities = Vec::with_capacity(n_total);
+        let mut masses = Vec::with_capacity(n_total);
+        let mut springs = Vec::new();
+        for p in &self.particles {
+            positions.push(V3::from(p.position));
+            velocities.push(V3::from(p.velocity));
+            masses.push(p.mass);
+        }
+        for (ci, c) in self.chains.iter().enumerate() {
+            let (s, e) = (V3::from(c.start), V3::from(c.end));
+            if (e - s).norm() == 0.0 {
+                return Err(invalid(
+                    format!("chains[{ci}]"),
+                    table_line("[[chains]]", ci),
+                    "start and end coincide: the chain has zero length".into(),
+                ));
+            }
+            let n = c.particles as usize;
+            let base = positions.len();
+            for i in 0..n {
+                positions.push(s + (e - s) * (i as f64 / (n - 1) as f64));
+                velocities.push(V3::zeros());
+                masses.push(c.mass / n as f64);
+            }
+            for i in 0..n - 1 {
+                let l0 = (positions[base + i + 1] - positions[base + i]).norm();
+                springs.push(Spring {
+                    a: base + i,
+                    b: base + i + 1,
+                    k: c.youngs_modulus / l0,
+                    damping: c.damping,
+                    rest_length: l0,
+                });
+            }
+        }
+        for (si, sh) in self.sheets.iter().enumerate() {
+            let (o, eu, ev) = (
+                V3::from(sh.origin),
+                V3::from(sh.edge_u),
+                V3::from(sh.edge_v),
+            );
+            if eu.cross(&ev).norm() == 0.0 {
+                return Err(invalid(
+                    format!("sheets[{si}]"),
+                    table_line("[[sheets]]", si),
+                    "edge_u and edge_v are parallel or zero: the sheet has no area".into(),
+                ));
+            }
+            let (nu, nv) = (sh.nu as usize, sh.nv as usize);
+            let base = positions.len();
+            for j in 0..nv {
+                for i in 0..nu {
+                    positions.push(
+                        o + eu * (i as f64 / (nu - 1) as f64) + ev * (j as f64 / (nv - 1) as f64),
+                    );
+                    velocities.push(V3::zeros());
+                    masses.push(sh.mass);
+                }
+            }
+            let edge = |a: usize, b: usize, springs: &mut Vec<Spring>| {
+                let (a, b) = (base + a, base + b);
+                springs.push(Spring {
+                    a,
+                    b,
+                    k: sh.stiffness,
+                    damping: sh.damping,
+                    rest_length: (positions[b] - positions[a]).norm(),
+                });
+            };
+            // Edges in the order of seed 001's sorted unique edge list:
+            // by smaller index, then larger.
+            for j in 0..nv {
+                for i in 0..nu {
+                    let v = j * nu + i;
+                    if i + 1 < nu {
+                        edge(v, v + 1, &mut springs);
+                    }
+                    if j + 1 < nv {
+                        edge(v, v + nu, &mut springs);
+                        if sh.diagonals && i + 1 < nu {
+                            edge(v, v + nu + 1, &mut springs);
+                        }
+                    }
+                }
+            }
+        }
+        for (si, s) in self.springs.iter().enumerate() {
+            let [a, b] = s.particles;
+            let line = table_line("[[springs]]", si);
+            if a >= n_total || b >= n_total {
+                return Err(invalid(
+                    format!("springs[{si}].particles"),
+                    line,
+                    format!("particle index out of range: the scene has {n_total} particles"),
+                ));
+            }
+            if a == b {
+                return Err(invalid(
+                    format!("springs[{si}].particles"),
+                    line,
+                    "a spring needs two different particles".into(),
+                ));
+            }
+            let rest_length = match s.rest_length {
+                Some(l) => l,
+                None => {
+                    let l = (positions[b] - positions[a]).norm();
+                    if l == 0.0 {
+                        return Err(invalid(
+                            format!("springs[{si}].rest_length"),
+                            line,
+                            "the particles coincide, so the rest length must be given".into(),
+                        ));
+                    }
+                    l
+                }
+            };
+            springs.push(Spring {
+                a,
+                b,
+                k: s.stiffness,
+                damping: s.damping,
+                rest_length,
+            });
+        }
+        let mut kinematics = vec![Kinematic::Free; n_total];
+        for &p in &self.pinned {
+            if p >= n_total {
+                return Err(invalid(
+                    "pinned".into(),
+                    key_line("pinned"),
+                    format!("particle index {p} out of range: the scene has {n_total} particles"),
+                ));
+            }
+            if !kinematics[p].is_free() {
+                return Err(invalid(
+                    "pinned".into(),
+                    key_line("pinned"),
+                    format!("particle {p} is listed twice"),
+                ));
+            }
+            kinematics[p] = Kinematic::Pinned(positions[p]);
+        }
+        for (di, d) in self.driven.iter().enumerate() {
+            let line = table_line("[[driven]]", di);
+            if d.particle >= n_total {
+                return Err(invalid(
+                    format!("driven[{di}].particle"),
+                    line,
+                    format!(
+                        "particle index {} out of range: the scene has {n_total} particles",
+                        d.particle
+                    ),
+                ));
+            }
+            if !kinematics[d.particle].is_free() {
+                return Err(invalid(
+                    format!("driven[{di}].particle"),
+                    line,
+                    format!("particle {} is already pinned or driven", d.particle),
+                ));
+            }
+            let k = Kinematic::Circle {
+                center: V3::from(d.center),
+                u: V3::from(d.u),
+                v: V3::from(d.v),
+                omega: 2.0 * std::f64::consts::PI / d.period,
+                phase: d.phase,
+            };
+            let (x, v) = k.at(0.0).expect("driven");
+            positions[d.particle] = x;
+            velocities[d.particle] = v;
+            kinematics[d.particle] = k;
+        }
+        let time_step = self.time.time_step.unwrap_or(self.time.frame_time);
+        if time_step > self.time.frame_time * (1.0 + 1e-12) {
+            return Err(invalid(
+                "time.time_step".into(),
+                key_line("time_step"),
+                format!(
+                    "time_step {time_step} is longer than frame_time {}",
+                    self.time.frame_time
+                ),
+            ));
+        }
+        Ok(System {
+            positions,
+            velocities,
+            masses,
+            springs,
+            kinematics,
+            spheres: self
+                .spheres
+                .iter()
+                .map(|s| Sphere {
+                    center: V3::from(s.center),
+                    radius: s.radius,
+                })
+                .collect(),
+            gravity: V3::from(self.gravity),
+            frame_time: self.time.frame_time,
+            frames: self.time.frames,
+            time_step,
+            cfl_number: self.time.cfl_number,
+            velocity_damping: self.time.velocity_damping,
+            strain_limit: self.time.strain_limit,
+        })
+    }
+}
+
+// ---- defaults -------------------------------------------------------------
+
+fn kind_default() -> String {
+    "mass-spring".into()
+}
+fn default_gravity() -> [f64; 3] {
+    [0.0, -9.81, 0.0]
+}
+fn half() -> f64 {
+    0.5
+}
+fn one() -> f64 {
+    1.0
+}
+fn yes() -> bool {
+    true
+}
+
+// ---- validating field readers (the error carries the value's span) --------
+// The f64 readers of `scene::yarn` are private to that module, and this model
+// needs 3-vectors and other ranges; the line/field plumbing is shared through
+// `scene::error::from_toml_error`.
+
+use serde::de::Error as _;
+
+fn kind_ok<'de, D: Deserializer<'de>>(d: D) -> Result<String, D::Error> {
+    let s = String::deserialize(d)?;
+    if KINDS.contains(&s.as_str()) {
+        Ok(s)
+    } else {
+        Err(D::Error::custom(format!(
+            "kind must be one of {KINDS:?} for a mass-spring scene, got {s:?}"
+        )))
+    }
+}
+
+fn finite<'de, D: Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
+    let v = f64::deserialize(d)?;
+    if v.is_finite() {
+        Ok(v)
+    } else {
+        Err(D::Error::custom(format!(
+            "must be a finite number, got {v}"
+        )))
+    }
+}
+
+fn positive<'de, D: Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
+    let v = finite(d)?;
+    if v > 0.0 {
+        Ok(v)
+    } else {
+        Err(D::Error::custom(format!("must be > 0, got {v}")))
+    }
+}
+
+fn nonnegative<'de, D: Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
+    let v = finite(d)?;
+    if v >= 0.0 {
+        Ok(v)
+    } else {
+        Err(D::Error::custom(format!("must be >= 0, got {v}")))
+    }
+}
+
+fn unit_interval<'de, D: Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
+    let v = finite(d)?;
+    if v > 0.0 && v <= 1.0 {
+        Ok(v)
+    } else {
+        Err(D::Error::custom(format!("must be in (0, 1], got {v}")))
+    }
+}
+
+fn opt_positive<'de, D: Deserializer<'de>>(d: D) -> Result<Option<f64>, D::Error> {
+    positive(d).map(Some)
+}
+
+fn opt_strain<'de, D: Deserializer<'de>>(d: D) -> Result<Option<f64>, D::Error> {
+    let v = finite(d)?;
+    if (0.0..1.0).contains(&v) {
+        Ok(Some(v))
+    } else {
+        Err(D::Error::custom(format!("must be in [0, 1), got {v}")))
+    }
+}
+
+fn finite3<'de, D: Deserializer<'de>>(d: D) -> Result<[f64; 3], D::Error> {
+    let v = <[f64; 3]>::deserialize(d)?;
+    if v.iter().all(|x| x.is_finite()) {
+        Ok(v)
+    } else {
+        Err(D::Error::custom(format!(
+            "must be three finite numbers, got {v:?}"
+        )))
+    }
+}
+
+fn bounded_u32<'de, D: Deserializer<'de>>(d: D, lo: u32, hi: u32) -> Result<u32, D::Error> {
+    let v = i64::deserialize(d)?;
+    if (lo as i64..=hi as i64).contains(&v) {
+        Ok(v as u32)
+    } else {
+        Err(D::Error::custom(format!(
+            "must be an integer from {lo} to {hi}, got {v}"
+        )))
+    }
+}
+
+fn frame_count<'de, D: Deserializer<'de>>(d: D) -> Result<u32, D::Error> {
+    bounded_u32(d, 1, 100_000_000)
+}
+
+fn chain_count<'de, D: Deserializer<'de>>(d: D) -> Result<u32, D::Error> {
+    bounded_u32(d, 2, 1_000_000)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const WIRE: &str = r#"
+kind = "wire"
+[time]
+frame_time = 0.05
+frames = 100
+[[chains]]
+start = [0.0, 0.0, 0.5]
+end = [0.0, -1.0, 0.5]
+particles = 11
+mass = 1.0
+youngs_modulus = 100.0
+damping = 100.0
+"#;
+
+    #[test]
+    fn chain_expands_to_seed_002_wire() {
+        let s = Layout::from_toml_str(WIRE).unwrap().build().unwrap();
+        assert_eq!(s.len(), 11);
+        assert_eq!(s.springs.len(), 10);
+        assert!((s.masses[3] - 1.0 / 11.0).abs() < 1e-15);
+        assert!((s.springs[0].rest_length - 0.1).abs() < 1e-12);
+        assert!((s.springs[0].k - 1000.0).abs() < 1e-9);
+        assert_eq!(s.gravity, V3::new(0.0, -9.81, 0.0));
+        assert_eq!(s.time_step, 0.05);
+    }
+
+    #[test]
+    fn bad_value_names_field_and_line() {
+        let e = Layout::from_toml_str(&WIRE.replace("mass = 1.0", "mass = -1.0")).unwrap_err();
+        let m = e.to_string();
+        assert!(
+            m.contains("line 10") && m.contains("chains.mass") && m.contains("> 0"),
+            "{m}"
+        );
+    }
+
+    #[test]
+    fn out_of_range_pin_names_field_and_line() {
+        let text = WIRE.replace("kind = \"wire\"", "kind = \"wire\"\npinned = [11]");
+        let m = Layout::from_toml_str(&text).unwrap_err().to_string();
+        assert!(m.contains("line 3") && m.contains("pinned"), "{m}");
+    }
+
+    #[test]
+    fn sheet_has_seed_001_edge_count() {
+        let text = r#"
+[time]
+frame_time = 0.0333
+frames = 10
+[[sheets]]
+origin = [5.0, 0.0, 5.0]
+edge_u = [-10.0, 0.0, 0.0]
+edge_v = [0.0, 0.0, -10.0]
+nu = 21
+nv = 21
+mass = 1.0
+stiffness = 8000.0
+"#;
+        let s = Layout::from_toml_str(text).unwrap().build().unwrap();
+        assert_eq!(s.len(), 441);
+        // 20*21 horizontal + 20*21 vertical + 20*20 diagonals.
+        assert_eq!(s.springs.len(), 1240);
+        assert_eq!(s.positions[20], V3::new(-5.0, 0.0, 5.0));
+    }
+}

@@ -1,0 +1,12 @@
+//! Linear algebra for the implicit integrators: a symmetric sparse matrix in
+//! CSR form assembled from 3x3 spring blocks, preconditioned conjugate
+//! gradients with Jacobi or incomplete-Cholesky IC(0) preconditioning, and a
+//! dense direct solve used to check CG on small systems (seed 004).
+
+pub mod cg;
+pub mod dense;
+pub mod sparse;
+
+pub use cg::{pcg, CgResult, Ic0, Preconditioner, PreconditionerKind};
+pub use dense::dense_solve;
+pub use sparse::{assemble_block_system, CsrMatrix, DofMap};
