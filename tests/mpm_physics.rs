@@ -91,7 +91,7 @@ vertices = 40
     let mut worst: f64 = 0.0;
     let mut forces = Vec::new();
     for &b in &grid.active {
-        for idx in geom.block_range(b as usize) {
+        for idx in geom.block_nodes(b as usize) {
             let f: Vec2 = grid
                 .buffers
                 .iter()

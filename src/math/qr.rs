@@ -24,7 +24,8 @@ pub struct Qr2 {
 #[inline]
 pub fn qr(f: &Mat2) -> Qr2 {
     let (a, b, cc, d) = (f[(0, 0)], f[(0, 1)], f[(1, 0)], f[(1, 1)]);
-    let r11 = a.hypot(cc);
+    // plain sqrt: entries are O(1) deformation gradients, hypot's overflow care is not needed
+    let r11 = (a * a + cc * cc).sqrt();
     let (c, s) = if r11 > 0.0 {
         (a / r11, cc / r11)
     } else {

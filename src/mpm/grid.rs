@@ -1,19 +1,20 @@
-//! The background grid, stored block by block (8 x 8 nodes) so that work and
-//! clearing touch only the blocks that particles reach.
+//! The background grid: dense row-major storage, worked on block by block
+//! (8 x 8 nodes) so that clearing, summing and the grid update touch only the
+//! blocks that particles reach.
 //!
 //! Scattering runs over a fixed number of particle chunks, each into its own
-//! buffer; the buffers are summed in chunk order. Results therefore do not
-//! depend on the number of threads.
+//! buffer; the buffers are summed in chunk order, so results do not depend on
+//! the number of threads.
 
 /// Side of a block in nodes.
 pub const BLOCK: usize = 8;
 const BLOCK_SHIFT: usize = 3;
-const BLOCK_NODES: usize = BLOCK * BLOCK;
 
 /// Number of scatter chunks (fixed for determinism).
 pub const CHUNKS: usize = 4;
 
-/// Grid geometry: `n x n` nodes at `(i dx, j dx)`.
+/// Grid geometry: `n x n` nodes at `(i dx, j dx)`, stored with row stride
+/// `stride` (`n` rounded up to whole blocks): node `(i, j)` is at `i * stride + j`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct GridGeom {
     pub n: usize,
@@ -21,52 +22,57 @@ pub struct GridGeom {
     pub inv_dx: f64,
     /// Blocks per side.
     pub nb: usize,
+    /// Row stride, `nb * BLOCK`.
+    pub stride: usize,
 }
 
 impl GridGeom {
     pub fn new(n: usize, size: f64) -> Self {
         let dx = size / n as f64;
+        let nb = n.div_ceil(BLOCK);
         GridGeom {
             n,
             dx,
             inv_dx: 1.0 / dx,
-            nb: n.div_ceil(BLOCK),
+            nb,
+            stride: nb * BLOCK,
         }
     }
 
     /// Storage index of node `(i, j)`.
     #[inline(always)]
     pub fn index(&self, i: usize, j: usize) -> usize {
-        (((i >> BLOCK_SHIFT) * self.nb + (j >> BLOCK_SHIFT)) << (2 * BLOCK_SHIFT))
-            + ((i & (BLOCK - 1)) << BLOCK_SHIFT)
-            + (j & (BLOCK - 1))
+        i * self.stride + j
     }
 
     /// Node `(i, j)` of storage index `idx`.
     #[inline(always)]
     pub fn node(&self, idx: usize) -> (usize, usize) {
-        let b = idx >> (2 * BLOCK_SHIFT);
-        let (bi, bj) = (b / self.nb, b % self.nb);
-        let r = idx & (BLOCK_NODES - 1);
-        (
-            (bi << BLOCK_SHIFT) + (r >> BLOCK_SHIFT),
-            (bj << BLOCK_SHIFT) + (r & (BLOCK - 1)),
-        )
+        (idx / self.stride, idx % self.stride)
     }
 
-    /// Total stored nodes (whole blocks).
+    /// Total stored nodes.
     pub fn storage(&self) -> usize {
-        self.nb * self.nb * BLOCK_NODES
+        self.stride * self.stride
     }
 
     pub fn blocks(&self) -> usize {
         self.nb * self.nb
     }
 
-    /// Range of storage indices of block `b`.
+    /// Block of node `(i, j)`.
     #[inline(always)]
-    pub fn block_range(&self, b: usize) -> std::ops::Range<usize> {
-        b * BLOCK_NODES..(b + 1) * BLOCK_NODES
+    pub fn block_of(&self, i: usize, j: usize) -> usize {
+        (i >> BLOCK_SHIFT) * self.nb + (j >> BLOCK_SHIFT)
+    }
+
+    /// Storage indices of block `b`, row by row (eight runs of eight).
+    pub fn block_nodes(&self, b: usize) -> impl Iterator<Item = usize> + '_ {
+        let (bi, bj) = (b / self.nb, b % self.nb);
+        (0..BLOCK).flat_map(move |r| {
+            let start = ((bi << BLOCK_SHIFT) + r) * self.stride + (bj << BLOCK_SHIFT);
+            start..start + BLOCK
+        })
     }
 }
 
@@ -91,8 +97,11 @@ impl ScatterBuffer {
     /// Zeroes the blocks touched last time and forgets them.
     pub fn clear(&mut self, geom: &GridGeom) {
         for &b in &self.touched_list {
-            let r = geom.block_range(b as usize);
-            self.node[r].fill([0.0; 3]);
+            let (bi, bj) = (b as usize / geom.nb, b as usize % geom.nb);
+            for r in 0..BLOCK {
+                let start = ((bi << BLOCK_SHIFT) + r) * geom.stride + (bj << BLOCK_SHIFT);
+                self.node[start..start + BLOCK].fill([0.0; 3]);
+            }
             self.touched[b as usize] = false;
         }
         self.touched_list.clear();
@@ -109,25 +118,36 @@ impl ScatterBuffer {
             (base[0] as usize + 2) >> BLOCK_SHIFT,
             (base[1] as usize + 2) >> BLOCK_SHIFT,
         );
-        for bi in [i0, i1] {
-            for bj in [j0, j1] {
-                let b = bi * geom.nb + bj;
-                if !self.touched[b] {
-                    self.touched[b] = true;
-                    self.touched_list.push(b as u32);
-                }
+        self.touch(i0 * geom.nb + j0);
+        if j1 != j0 {
+            self.touch(i0 * geom.nb + j1);
+        }
+        if i1 != i0 {
+            self.touch(i1 * geom.nb + j0);
+            if j1 != j0 {
+                self.touch(i1 * geom.nb + j1);
             }
+        }
+    }
+
+    #[inline(always)]
+    fn touch(&mut self, b: usize) {
+        if !self.touched[b] {
+            self.touched[b] = true;
+            self.touched_list.push(b as u32);
         }
     }
 }
 
-/// The summed grid: velocity `[m, vx, vy]` per node on the active blocks.
+/// The summed grid: `[m, vx, vy]` per node on the active blocks.
 #[derive(Clone, Debug)]
 pub struct Grid {
     pub geom: GridGeom,
     pub node: Vec<[f64; 3]>,
     /// Blocks touched this substep, sorted.
     pub active: Vec<u32>,
+    /// `is_active[b]` for every block.
+    pub is_active: Vec<bool>,
     pub buffers: Vec<ScatterBuffer>,
 }
 
@@ -137,18 +157,21 @@ impl Grid {
             geom,
             node: vec![[0.0; 3]; geom.storage()],
             active: Vec::new(),
+            is_active: vec![false; geom.blocks()],
             buffers: (0..CHUNKS).map(|_| ScatterBuffer::new(&geom)).collect(),
         }
     }
 
     /// Collects the union of the chunks' touched blocks into `active`, sorted.
     pub fn collect_active(&mut self) {
-        let mut mark = vec![false; self.geom.blocks()];
+        for &b in &self.active {
+            self.is_active[b as usize] = false;
+        }
         self.active.clear();
-        for b in &self.buffers {
-            for &k in &b.touched_list {
-                if !mark[k as usize] {
-                    mark[k as usize] = true;
+        for buf in &self.buffers {
+            for &k in &buf.touched_list {
+                if !self.is_active[k as usize] {
+                    self.is_active[k as usize] = true;
                     self.active.push(k);
                 }
             }
@@ -162,16 +185,21 @@ mod tests {
     use super::*;
 
     #[test]
-    fn index_roundtrip() {
+    fn index_roundtrip_and_blocks_partition_the_nodes() {
         let g = GridGeom::new(37, 1.0);
-        let mut seen = vec![false; g.storage()];
         for i in 0..37 {
             for j in 0..37 {
-                let k = g.index(i, j);
-                assert!(!seen[k]);
-                seen[k] = true;
-                assert_eq!(g.node(k), (i, j));
+                assert_eq!(g.node(g.index(i, j)), (i, j));
             }
         }
+        let mut seen = vec![0u8; g.storage()];
+        for b in 0..g.blocks() {
+            for k in g.block_nodes(b) {
+                seen[k] += 1;
+                let (i, j) = g.node(k);
+                assert_eq!(g.block_of(i, j), b);
+            }
+        }
+        assert!(seen.iter().all(|&c| c == 1));
     }
 }

@@ -13,7 +13,7 @@
 use rayon::prelude::*;
 
 use super::constitutive::{frame_gradient, YarnEnergy};
-use super::grid::{Grid, GridGeom, ScatterBuffer, CHUNKS};
+use super::grid::{Grid, GridGeom, ScatterBuffer, BLOCK, CHUNKS};
 use super::particles::{Particles, Quads, Vertices, NONE};
 use crate::math::bspline::Stencil;
 use crate::math::qr::qr;
@@ -108,34 +108,32 @@ fn chunk_range(n: usize, k: usize) -> std::ops::Range<usize> {
     (n * k / CHUNKS)..(n * (k + 1) / CHUNKS)
 }
 
-/// Adds one particle's APIC mass and momentum plus `dt f` to a buffer.
+/// Adds one particle's mass and momentum to a buffer: node `i` of the
+/// stencil gets mass `w_i m` and momentum `w_i (p0 + A (x_i - x_p) / dx)`.
+///
+/// For APIC, `p0 = m v` (plus the impulse `dt f` of forces acting at the
+/// particle) and `A = m C dx`; a force that depends linearly on the node
+/// offset (the MLS normal force of a quadrature particle) folds into `A`.
 #[inline(always)]
-fn splat(
-    buf: &mut ScatterBuffer,
-    geom: &GridGeom,
-    st: &Stencil,
-    m: f64,
-    v: Vec2,
-    c: &Mat2,
-    impulse: Vec2,
-) {
+fn splat(buf: &mut ScatterBuffer, geom: &GridGeom, st: &Stencil, m: f64, p0: Vec2, a: &Mat2) {
     buf.touch_stencil(geom, st.base);
-    let dx = geom.dx;
-    // APIC momentum at node: m (v + C (x_i - x_p)) = m v + m C off dx.
-    let mc = c * (m * dx);
+    let oy = [-st.fx[1], 1.0 - st.fx[1], 2.0 - st.fx[1]];
+    let ay = [a[(0, 1)] * oy[0], a[(0, 1)] * oy[1], a[(0, 1)] * oy[2]];
+    let by = [a[(1, 1)] * oy[0], a[(1, 1)] * oy[1], a[(1, 1)] * oy[2]];
     let (bi, bj) = (st.base[0] as usize, st.base[1] as usize);
     for i in 0..3 {
-        let wi = st.w[0][i];
         let ox = i as f64 - st.fx[0];
+        let rx = p0.x + a[(0, 0)] * ox;
+        let ry = p0.y + a[(1, 0)] * ox;
+        let wi = st.w[0][i];
+        let start = geom.index(bi + i, bj);
+        let row = &mut buf.node[start..start + 3];
         for j in 0..3 {
             let w = wi * st.w[1][j];
-            let oy = j as f64 - st.fx[1];
-            let px = m * v.x + mc[(0, 0)] * ox + mc[(0, 1)] * oy + impulse.x;
-            let py = m * v.y + mc[(1, 0)] * ox + mc[(1, 1)] * oy + impulse.y;
-            let n = &mut buf.node[geom.index(bi + i, bj + j)];
+            let n = &mut row[j];
             n[0] += w * m;
-            n[1] += w * px;
-            n[2] += w * py;
+            n[1] += w * (rx + ay[j]);
+            n[2] += w * (ry + by[j]);
         }
     }
 }
@@ -146,101 +144,104 @@ pub fn scatter(p: &Particles, grid: &mut Grid, dt: f64) {
     let (nv, nq) = (p.vert.x.len(), p.quad.x.len());
     let vert = &p.vert;
     let quad = &p.quad;
+    let dx = geom.dx;
+    // the normal force per unit of (w_i (x_i - x_p) / dx . d2): -dt dE/dd2 4 / dx
+    let normal_scale = -dt * 4.0 * geom.inv_dx;
     grid.buffers
         .par_iter_mut()
         .enumerate()
         .for_each(|(k, buf)| {
             buf.clear(&geom);
             for i in chunk_range(nv, k) {
-                splat(
-                    buf,
-                    &geom,
-                    &vert.stencil[i],
-                    vert.m[i],
-                    vert.v[i],
-                    &vert.c[i],
-                    vert.force[i] * dt,
-                );
+                let m = vert.m[i];
+                let p0 = vert.v[i] * m + vert.force[i] * dt;
+                splat(buf, &geom, &vert.stencil[i], m, p0, &(vert.c[i] * (m * dx)));
             }
             for q in chunk_range(nq, k) {
-                scatter_quad(buf, &geom, quad, q, dt);
+                let m = quad.m[q];
+                let d2 = quad.d[q].column(1).into_owned();
+                let a = quad.c[q] * (m * dx) + quad.t2[q] * normal_scale * d2.transpose();
+                splat(buf, &geom, &quad.stencil[q], m, quad.v[q] * m, &a);
             }
         });
     grid.collect_active();
 }
 
-/// Quadrature particle: APIC mass/momentum and the normal-direction force
-/// `f_i = -dE/dd2 (grad w_i . d2)` with the MLS gradient `grad w_i = w_i 4 (x_i - x_p) / dx^2`.
-#[inline(always)]
-fn scatter_quad(buf: &mut ScatterBuffer, geom: &GridGeom, quad: &Quads, q: usize, dt: f64) {
-    let st = &quad.stencil[q];
-    buf.touch_stencil(geom, st.base);
-    let m = quad.m[q];
-    let v = quad.v[q];
-    let mc = quad.c[q] * (m * geom.dx);
-    let d2 = quad.d[q].column(1).into_owned();
-    // impulse per unit (w * offset . d2): -dt * t2 * 4 / dx
-    let g = quad.t2[q] * (-dt * 4.0 * geom.inv_dx);
-    let (bi, bj) = (st.base[0] as usize, st.base[1] as usize);
-    for i in 0..3 {
-        let wi = st.w[0][i];
-        let ox = i as f64 - st.fx[0];
-        for j in 0..3 {
-            let w = wi * st.w[1][j];
-            let oy = j as f64 - st.fx[1];
-            let s = ox * d2.x + oy * d2.y;
-            let px = m * v.x + mc[(0, 0)] * ox + mc[(0, 1)] * oy + g.x * s;
-            let py = m * v.y + mc[(1, 0)] * ox + mc[(1, 1)] * oy + g.y * s;
-            let n = &mut buf.node[geom.index(bi + i, bj + j)];
-            n[0] += w * m;
-            n[1] += w * px;
-            n[2] += w * py;
-        }
-    }
-}
-
 /// Pass 3: sums the chunk buffers on the active blocks, turns momentum into
-/// velocity and applies gravity, attractor, obstacles and walls.
+/// velocity and applies gravity, attractor, obstacles and walls. Work is
+/// done per active block; obstacle and wall tests only where a block is near one.
 pub fn grid_update(grid: &mut Grid, dt: f64, ext: &GridForces) {
     let geom = grid.geom;
-    let mut is_active = vec![false; geom.blocks()];
-    for &b in &grid.active {
-        is_active[b as usize] = true;
-    }
     let buffers = &grid.buffers;
+    let is_active = &grid.is_active;
+    let cells = ext.wall_cells;
+    let dx = geom.dx;
     grid.node
-        .par_chunks_mut(super::grid::BLOCK * super::grid::BLOCK)
+        .par_chunks_mut(geom.stride * BLOCK)
         .enumerate()
-        .filter(|(b, _)| is_active[*b])
-        .for_each(|(b, nodes)| {
-            let start = b * nodes.len();
-            for (o, out) in nodes.iter_mut().enumerate() {
-                let idx = start + o;
-                let mut acc = [0.0; 3];
-                for buf in buffers {
-                    if buf.touched[b] {
-                        let n = buf.node[idx];
-                        acc[0] += n[0];
-                        acc[1] += n[1];
-                        acc[2] += n[2];
-                    }
-                }
-                if acc[0] <= 0.0 {
-                    *out = [0.0; 3];
+        .for_each(|(bi, band)| {
+            for bj in 0..geom.nb {
+                let b = bi * geom.nb + bj;
+                if !is_active[b] {
                     continue;
                 }
-                let (i, j) = geom.node(idx);
-                let xi = Vec2::new(i as f64 * geom.dx, j as f64 * geom.dx);
-                let mut v = Vec2::new(acc[1], acc[2]) / acc[0] + ext.gravity * dt;
-                if let Some((pos, strength)) = ext.attractor {
-                    let r = pos - xi;
-                    v += r * (dt * strength / (r.norm() + 0.01));
+                let (i0, j0) = (bi * BLOCK, bj * BLOCK);
+                let mut srcs: [&ScatterBuffer; CHUNKS] = [&buffers[0]; CHUNKS];
+                let mut nsrc = 0;
+                for s in buffers.iter().filter(|s| s.touched[b]) {
+                    srcs[nsrc] = s;
+                    nsrc += 1;
                 }
-                for o in ext.obstacles {
-                    v = obstacle_velocity(o, xi, v);
+                let srcs = &srcs[..nsrc];
+                let lo = Vec2::new(i0 as f64, j0 as f64) * dx;
+                let hi = lo + Vec2::new((BLOCK - 1) as f64, (BLOCK - 1) as f64) * dx;
+                let near_obstacle = ext.obstacles.iter().any(|o| {
+                    let c = Vec2::from(o.center);
+                    let q = Vec2::new(c.x.clamp(lo.x, hi.x), c.y.clamp(lo.y, hi.y));
+                    (q - c).norm() < o.radius
+                });
+                let near_wall = ext.walls != WallMode::None
+                    && (i0 < cells
+                        || j0 < cells
+                        || i0 + BLOCK + cells > geom.n
+                        || j0 + BLOCK + cells > geom.n);
+                for r in 0..BLOCK {
+                    let i = i0 + r;
+                    let row = r * geom.stride + j0;
+                    let gidx = bi * BLOCK * geom.stride + row;
+                    for c in 0..BLOCK {
+                        let j = j0 + c;
+                        let mut acc = [0.0; 3];
+                        for s in srcs {
+                            let n = s.node[gidx + c];
+                            acc[0] += n[0];
+                            acc[1] += n[1];
+                            acc[2] += n[2];
+                        }
+                        let out = &mut band[row + c];
+                        if acc[0] <= 0.0 {
+                            *out = [0.0; 3];
+                            continue;
+                        }
+                        let mut v = Vec2::new(acc[1], acc[2]) / acc[0] + ext.gravity * dt;
+                        if ext.attractor.is_some() || near_obstacle {
+                            let xi = Vec2::new(i as f64, j as f64) * dx;
+                            if let Some((pos, strength)) = ext.attractor {
+                                let d = pos - xi;
+                                v += d * (dt * strength / (d.norm() + 0.01));
+                            }
+                            if near_obstacle {
+                                for o in ext.obstacles {
+                                    v = obstacle_velocity(o, xi, v);
+                                }
+                            }
+                        }
+                        if near_wall {
+                            v = wall_velocity(ext.walls, cells, geom.n, i, j, v);
+                        }
+                        *out = [acc[0], v.x, v.y];
+                    }
                 }
-                v = wall_velocity(ext.walls, ext.wall_cells, geom.n, i, j, v);
-                *out = [acc[0], v.x, v.y];
             }
         });
 }
@@ -310,23 +311,29 @@ fn wall_velocity(mode: WallMode, cells: usize, n: usize, i: usize, j: usize, mut
 fn interpolate(grid: &Grid, st: &Stencil) -> (Vec2, Mat2) {
     let geom = &grid.geom;
     let (bi, bj) = (st.base[0] as usize, st.base[1] as usize);
+    let oy = [-st.fx[1], 1.0 - st.fx[1], 2.0 - st.fx[1]];
     let mut v = Vec2::zeros();
     let (mut c00, mut c01, mut c10, mut c11) = (0.0, 0.0, 0.0, 0.0);
     for i in 0..3 {
+        let start = geom.index(bi + i, bj);
+        let row = &grid.node[start..start + 3];
+        let (mut sx, mut sy, mut sxo, mut syo) = (0.0, 0.0, 0.0, 0.0);
+        for j in 0..3 {
+            let w = st.w[1][j];
+            let (wx, wy) = (w * row[j][1], w * row[j][2]);
+            sx += wx;
+            sy += wy;
+            sxo += wx * oy[j];
+            syo += wy * oy[j];
+        }
         let wi = st.w[0][i];
         let ox = i as f64 - st.fx[0];
-        for j in 0..3 {
-            let w = wi * st.w[1][j];
-            let oy = j as f64 - st.fx[1];
-            let n = grid.node[geom.index(bi + i, bj + j)];
-            let (wx, wy) = (w * n[1], w * n[2]);
-            v.x += wx;
-            v.y += wy;
-            c00 += wx * ox;
-            c01 += wx * oy;
-            c10 += wy * ox;
-            c11 += wy * oy;
-        }
+        v.x += wi * sx;
+        v.y += wi * sy;
+        c00 += wi * sx * ox;
+        c10 += wi * sy * ox;
+        c01 += wi * sxo;
+        c11 += wi * syo;
     }
     let s = 4.0 * geom.inv_dx;
     (v, Mat2::new(c00 * s, c01 * s, c10 * s, c11 * s))
