@@ -10,7 +10,7 @@
 //!
 //! Linearising `f` about `(x, v)` with the clamped spring Hessian `H` and the
 //! damping block `B` gives the symmetric positive definite system
-//! `(M + theta h B + theta c H) dv = h f - theta h (H a + B dv_k)`, `a` being
+//! `(M + theta h B + theta h c H) dv = h f - theta h (H a + B dv_k)`, `a` being
 //! `h v` on free and the prescribed displacement on kinematic particles. One
 //! solve is Baraff-Witkin's step; for backward Euler without damping it is
 //! exactly seed 004's `(M - h^2 K) v' = M v + h f`. With
@@ -46,7 +46,7 @@ impl Scheme {
 #[derive(Clone, Debug)]
 pub struct StepSystem {
     pub map: DofMap,
-    /// `M + theta h B + theta c H` over the free dofs.
+    /// `M + theta h B + theta h c H` over the free dofs.
     pub matrix: CsrMatrix,
     /// Right-hand side of the first (linearised) solve.
     pub rhs: Vec<f64>,
@@ -74,7 +74,7 @@ pub fn step_system(sys: &System, s: &State, h: f64, scheme: Scheme) -> StepSyste
     let blocks: Vec<Matrix3<f64>> = hb
         .iter()
         .zip(&bb)
-        .map(|(hs, bs)| hs * (theta * c) + bs * (theta * h))
+        .map(|(hs, bs)| hs * (theta * h * c) + bs * (theta * h))
         .collect();
     let matrix = assemble_block_system(&map, &sys.masses, &sys.springs, &blocks);
     let mut corr = vec![V3::zeros(); n];
