@@ -1,0 +1,121 @@
+//! Packs the YarnBundle FMU.
+//!
+//! ```text
+//! cargo run --release -p yarnsim-fmu --bin build-fmu -- [--scene NAME_OR_FILE] [-o OUT.fmu]
+//!     [--lib libYarnBundle.so] [--model-description FILE]
+//! ```
+//!
+//! Without `--scene` it packs the default scene (`yarn-reference`) into
+//! `<target>/fmu/YarnBundle.fmu`; another scene goes to
+//! `<target>/fmu/YarnBundle-<scene name>.fmu` unless `-o` says otherwise.
+//! `--model-description FILE` only writes the generated modelDescription.xml
+//! (used to refresh `modelDescription/YarnBundle.xml`).
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use yarnsim::scene::{Scene, DEFAULT_SCENE};
+use YarnBundle::package::{build_fmu, check_library, zip_entries};
+use YarnBundle::{model_description, MODEL_IDENTIFIER};
+
+const USAGE: &str = "usage: build-fmu [--scene NAME_OR_FILE] [-o OUT.fmu] [--lib libYarnBundle.so] [--model-description FILE]";
+
+fn run() -> Result<(), String> {
+    let mut scene_arg: Option<String> = None;
+    let mut out: Option<PathBuf> = None;
+    let mut lib: Option<PathBuf> = None;
+    let mut xml_only: Option<PathBuf> = None;
+    let mut args = std::env::args().skip(1);
+    while let Some(a) = args.next() {
+        let mut value = |what: &str| args.next().ok_or(format!("{a} needs {what}\n{USAGE}"));
+        match a.as_str() {
+            "--scene" | "-s" => scene_arg = Some(value("a scene name or file")?),
+            "-o" | "--output" => out = Some(value("a file name")?.into()),
+            "--lib" => lib = Some(value("a shared library")?.into()),
+            "--model-description" => xml_only = Some(value("a file name")?.into()),
+            "-h" | "--help" => {
+                println!("{USAGE}");
+                return Ok(());
+            }
+            _ => return Err(format!("unknown argument {a:?}\n{USAGE}")),
+        }
+    }
+    let name = scene_arg.as_deref().unwrap_or(DEFAULT_SCENE);
+    let scene = match Scene::resolve(name).map_err(|e| e.to_string())? {
+        Scene::Yarn(s) => s,
+        Scene::MassSpring(_) => {
+            return Err(format!(
+                "{name}: a mass-spring scene; the YarnBundle FMU runs yarn scenes only"
+            ))
+        }
+    };
+    yarnsim::mpm::YarnSim::new(&scene).map_err(|e| format!("{name}: {e}"))?;
+    if let Some(path) = xml_only {
+        std::fs::write(&path, model_description(&scene))
+            .map_err(|e| format!("cannot write {}: {e}", path.display()))?;
+        println!("wrote {}", path.display());
+        return Ok(());
+    }
+    // The cdylib sits next to this executable (target/<profile>/).
+    let exe = std::env::current_exe().map_err(|e| e.to_string())?;
+    let exe_dir = exe.parent().ok_or("no executable directory")?.to_path_buf();
+    let lib = lib.unwrap_or_else(|| exe_dir.join(format!("lib{MODEL_IDENTIFIER}.so")));
+    let so = std::fs::read(&lib).map_err(|e| {
+        format!(
+            "cannot read {}: {e} (build it with `cargo build --release -p yarnsim-fmu`)",
+            lib.display()
+        )
+    })?;
+    let info = check_library(&so).map_err(|e| format!("{}: {e}", lib.display()))?;
+    let out = out.unwrap_or_else(|| {
+        let dir = exe_dir.parent().unwrap_or(&exe_dir).join("fmu");
+        if scene_arg.is_none() {
+            dir.join(format!("{MODEL_IDENTIFIER}.fmu"))
+        } else {
+            let tag: String = scene
+                .name
+                .chars()
+                .map(|c| {
+                    if c.is_ascii_alphanumeric() || c == '-' {
+                        c
+                    } else {
+                        '_'
+                    }
+                })
+                .collect();
+            let tag = if tag.is_empty() {
+                "scene".to_string()
+            } else {
+                tag
+            };
+            dir.join(format!("{MODEL_IDENTIFIER}-{tag}.fmu"))
+        }
+    });
+    let zip = build_fmu(&scene, &so)?;
+    zip_entries(&zip)?;
+    if let Some(dir) = out.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir)
+            .map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
+    }
+    std::fs::write(&out, &zip).map_err(|e| format!("cannot write {}: {e}", out.display()))?;
+    println!(
+        "wrote {} ({} bytes): scene {:?}, {} yarns, GUID {}, library needs {}",
+        out.display(),
+        zip.len(),
+        scene.name,
+        YarnBundle::model::num_yarns(&scene),
+        YarnBundle::guid(&scene),
+        info.needed.join(" ")
+    );
+    Ok(())
+}
+
+fn main() -> ExitCode {
+    match run() {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("build-fmu: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}

@@ -1,0 +1,738 @@
+//! The 34 exported FMI 2.0 functions (25 common, 9 co-simulation): a
+//! hand-written C ABI over [`Instance`]. Every export checks its pointers,
+//! catches panics (a panic becomes `fmi2Fatal` for that instance and never
+//! unwinds into the host) and logs every failure through the callback.
+
+#![allow(
+    non_snake_case,
+    non_camel_case_types,
+    non_upper_case_globals,
+    clippy::missing_safety_doc
+)]
+
+use std::ffi::{c_char, c_int, c_uint, c_void, CStr};
+use std::panic::{catch_unwind, AssertUnwindSafe};
+
+use libc::size_t;
+
+use crate::instance::{
+    error, Instance, Logger, Phase, Res, Snapshot, Status, LOG_ALL, LOG_DISCARD, LOG_ERROR,
+    LOG_FATAL,
+};
+
+pub type fmi2Component = *mut c_void;
+pub type fmi2ComponentEnvironment = *mut c_void;
+pub type fmi2FMUstate = *mut c_void;
+pub type fmi2ValueReference = c_uint;
+pub type fmi2Real = f64;
+pub type fmi2Integer = c_int;
+/// A C `int`, not a Rust `bool`.
+pub type fmi2Boolean = c_int;
+pub type fmi2Char = c_char;
+pub type fmi2String = *const fmi2Char;
+pub type fmi2Byte = c_char;
+pub type fmi2Status = c_int;
+pub type fmi2Type = c_int;
+pub type fmi2StatusKind = c_int;
+
+pub const fmi2True: fmi2Boolean = 1;
+pub const fmi2False: fmi2Boolean = 0;
+pub const fmi2ModelExchange: fmi2Type = 0;
+pub const fmi2CoSimulation: fmi2Type = 1;
+pub const fmi2DoStepStatus: fmi2StatusKind = 0;
+pub const fmi2PendingStatus: fmi2StatusKind = 1;
+pub const fmi2LastSuccessfulTime: fmi2StatusKind = 2;
+pub const fmi2Terminated: fmi2StatusKind = 3;
+
+pub const fmi2OK: fmi2Status = Status::Ok as c_int;
+pub const fmi2Warning: fmi2Status = Status::Warning as c_int;
+pub const fmi2Discard: fmi2Status = Status::Discard as c_int;
+pub const fmi2Error: fmi2Status = Status::Error as c_int;
+pub const fmi2Fatal: fmi2Status = Status::Fatal as c_int;
+
+/// `fmi2CallbackFunctions`.
+#[repr(C)]
+#[derive(Clone, Copy)]
+pub struct fmi2CallbackFunctions {
+    pub logger: Option<Logger>,
+    pub allocateMemory: Option<unsafe extern "C" fn(size_t, size_t) -> *mut c_void>,
+    pub freeMemory: Option<unsafe extern "C" fn(*mut c_void)>,
+    pub stepFinished: Option<unsafe extern "C" fn(fmi2ComponentEnvironment, fmi2Status)>,
+    pub componentEnvironment: fmi2ComponentEnvironment,
+}
+
+fn panic_message(p: &(dyn std::any::Any + Send)) -> String {
+    if let Some(s) = p.downcast_ref::<&str>() {
+        s.to_string()
+    } else if let Some(s) = p.downcast_ref::<String>() {
+        s.clone()
+    } else {
+        "unknown panic".to_string()
+    }
+}
+
+/// Runs `f` on the instance behind `c`: null or foreign pointers give
+/// fmi2Error, failures are logged (fmi2Error moves the instance to the error
+/// state), panics are caught and give fmi2Fatal.
+fn call(c: fmi2Component, func: &str, f: impl FnOnce(&mut Instance) -> Res<Status>) -> fmi2Status {
+    // SAFETY: `c` is null or a component this FMU handed out (FMI contract);
+    // the magic number rejects freed or foreign pointers in most cases.
+    let Some(inst) = (unsafe { Instance::from_ptr(c) }) else {
+        return fmi2Error;
+    };
+    if inst.phase == Phase::Fatal {
+        inst.log(
+            Status::Fatal,
+            LOG_FATAL,
+            &format!(
+                "{func}: the instance is in the fatal state; only fmi2FreeInstance is allowed"
+            ),
+        );
+        return fmi2Fatal;
+    }
+    if inst.log_all() {
+        inst.log(Status::Ok, LOG_ALL, func);
+    }
+    let ptr: *mut Instance = inst;
+    // SAFETY: `ptr` stays valid for the whole call; the closure is the only user.
+    let result = catch_unwind(AssertUnwindSafe(|| f(unsafe { &mut *ptr })));
+    // SAFETY: as above; the closure has returned.
+    let inst = unsafe { &mut *ptr };
+    match result {
+        Ok(Ok(s)) => s as fmi2Status,
+        Ok(Err(fail)) => {
+            let cat = match fail.status {
+                Status::Discard => LOG_DISCARD,
+                Status::Fatal => LOG_FATAL,
+                _ => LOG_ERROR,
+            };
+            let msg = if fail.msg.starts_with(func) {
+                fail.msg
+            } else {
+                format!("{func}: {}", fail.msg)
+            };
+            inst.log(fail.status, cat, &msg);
+            match fail.status {
+                Status::Error => inst.phase = Phase::Error,
+                Status::Fatal => inst.phase = Phase::Fatal,
+                _ => {}
+            }
+            fail.status as fmi2Status
+        }
+        Err(p) => {
+            inst.phase = Phase::Fatal;
+            inst.log(
+                Status::Fatal,
+                LOG_FATAL,
+                &format!("{func}: internal error: {}", panic_message(&*p)),
+            );
+            fmi2Fatal
+        }
+    }
+}
+
+fn ok(r: Res) -> Res<Status> {
+    r.map(|_| Status::Ok)
+}
+
+/// A slice from a C array; `None` for a null pointer with a nonzero length.
+unsafe fn slice<'a, T>(p: *const T, n: size_t) -> Option<&'a [T]> {
+    if n == 0 {
+        Some(&[])
+    } else if p.is_null() {
+        None
+    } else {
+        Some(std::slice::from_raw_parts(p, n))
+    }
+}
+
+unsafe fn slice_mut<'a, T>(p: *mut T, n: size_t) -> Option<&'a mut [T]> {
+    if n == 0 {
+        Some(&mut [])
+    } else if p.is_null() {
+        None
+    } else {
+        Some(std::slice::from_raw_parts_mut(p, n))
+    }
+}
+
+unsafe fn string(p: fmi2String) -> Option<String> {
+    (!p.is_null()).then(|| CStr::from_ptr(p).to_string_lossy().into_owned())
+}
+
+fn null(func: &str, what: &str) -> Res<Status> {
+    error(format!("{func}: {what} is a null pointer"))
+}
+
+// ---------------------------------------------------------------- common
+
+#[no_mangle]
+pub extern "C" fn fmi2GetTypesPlatform() -> *const c_char {
+    c"default".as_ptr()
+}
+
+#[no_mangle]
+pub extern "C" fn fmi2GetVersion() -> *const c_char {
+    c"2.0".as_ptr()
+}
+
+#[no_mangle]
+pub unsafe extern "C" fn fmi2SetDebugLogging(
+    c: fmi2Component,
+    loggingOn: fmi2Boolean,
+    nCategories: size_t,
+    categories: *const fmi2String,
+) -> fmi2Status {
+    call(c, "fmi2SetDebugLogging", |inst| {
+        let Some(cats) = slice(categories, nCategories) else {
+            return null("fmi2SetDebugLogging", "categories");
+        };
+        let mut names = Vec::with_capacity(cats.len());
+        for &p in cats {
+            match string(p) {
+                Some(s) => names.push(s),
+                None => return null("fmi2SetDebugLogging", "a category"),
+            }
+        }
+        let refs: Vec<&str> = names.iter().map(|s| s.as_str()).collect();
+        ok(inst.set_debug_logging(loggingOn != fmi2False, &refs))
+    })
+}
+
+#[no_mangle]
+pub unsafe extern "C" fn fmi2Instantiate(
+    instanceName: fmi2String,
+    fmuType: fmi2Type,
+    fmuGUID: fmi2String,
+    fmuResourceLocation: fmi2String,
+    functions: *const fmi2CallbackFunctions,
+    _visible: fmi2Boolean,
+    loggingOn: fmi2Boolean,
+) -> fmi2Component {
+    let Some(cb) = functions.as_ref().copied() else {
+        return std::ptr::null_mut();
+    };
+    let name = string(instanceName);
+    let fail = |msg: &str| {
+        if let Some(logger) = cb.logger {
+            let n = crate::instance::escape_nul(name.as_deref().unwrap_or("?"));
+            let m = crate::instance::escape_log(&format!("fmi2Instantiate: {msg}"));
+            logger(
+                cb.componentEnvironment,
+                n.as_ptr(),
+                fmi2Error,
+                c"logStatusError".as_ptr(),
+                m.as_ptr(),
+            );
+        }
+        std::ptr::null_mut()
+    };
+    let result = catch_unwind(AssertUnwindSafe(|| {
+        let Some(name) = name.as_deref().filter(|n| !n.is_empty()) else {
+            return Err("the instance name is null or empty".to_string());
+        };
+        if fmuType != fmi2CoSimulation {
+            return Err(format!(
+                "fmuType {fmuType} is not fmi2CoSimulation: YarnBundle is a Co-Simulation FMU only"
+            ));
+        }
+        let Some(guid) = string(fmuGUID) else {
+            return Err("the GUID is a null pointer".into());
+        };
+        let Some(res) = string(fmuResourceLocation) else {
+            return Err("the resource location is a null pointer".into());
+        };
+        Instance::new(
+            name,
+            &guid,
+            &res,
+            cb.logger,
+            cb.componentEnvironment,
+            loggingOn != fmi2False,
+        )
+    }));
+    match result {
+        Ok(Ok(inst)) => Box::into_raw(inst) as fmi2Component,
+        Ok(Err(msg)) => fail(&msg),
+        Err(p) => fail(&format!("internal error: {}", panic_message(&*p))),
+    }
+}
+
+#[no_mangle]
+pub unsafe extern "C" fn fmi2FreeInstance(c: fmi2Component) {
+    let Some(inst) = Instance::from_ptr(c) else {
+        return;
+    };
+    inst.invalidate();
+    let b = Box::from_raw(inst as *mut Instance);
+    let _ = catch_unwind(AssertUnwindSafe(move || drop(b)));
+}
+
+#[no_mangle]
+pub unsafe extern "C" fn fmi2SetupExperiment(
+    c: fmi2Component,
+    _toleranceDefined: fmi2Boolean,
+    _tolerance: fmi2Real,
+    startTime: fmi2Real,
+    stopTimeDefined: fmi2Boolean,
+    stopTime: fmi2Real,
+) -> fmi2Status {
+    call(c, "fmi2SetupExperiment", |inst| {
+        ok(inst.setup_experiment(
+            startTime,
+            (stopTimeDefined != fmi2False).then_some(stopTime),
+        ))
+    })
+}
+
+#[no_mangle]
+pub unsafe extern "C" fn fmi2EnterInitializationMode(c: fmi2Component) -> fmi2Status {
+    call(c, "fmi2EnterInitializationMode", |inst| {
+        ok(inst.enter_initialization_mode())
+    })
+}
+
+#[no_mangle]
+pub unsafe extern "C" fn fmi2ExitInitializationMode(c: fmi2Component) -> fmi2Status {
+    call(c, "fmi2ExitInitializationMode", |inst| {
+        ok(inst.exit_initialization_mode())
+    })
+}
+
+#[no_mangle]
+pub unsafe extern "C" fn fmi2Terminate(c: fmi2Component) -> fmi2Status {
+    call(c, "fmi2Terminate", |inst| ok(inst.terminate()))
+}
+
+#[no_mangle]
+pub unsafe extern "C" fn fmi2Reset(c: fmi2Component) -> fmi2Status {
+    call(c, "fmi2Reset", |inst| ok(inst.reset()))
+}
+
+#[no_mangle]
+pub unsafe extern "C" fn fmi2GetReal(
+    c: fmi2Component,
+    vr: *const fmi2ValueReference,
+    nvr: size_t,
+    value: *mut fmi2Real,
+) -> fmi2Status {
+    call(c, "fmi2GetReal", |inst| {
+        let (Some(vrs), Some(out)) = (slice(vr, nvr), slice_mut(value, nvr)) else {
+            return null("fmi2GetReal", "vr or value");
+        };
+        ok(inst.get_real(vrs, out))
+    })
+}
+
+#[no_mangle]
+pub unsafe extern "C" fn fmi2GetInteger(
+    c: fmi2Component,
+    vr: *const fmi2ValueReference,
+    nvr: size_t,
+    value: *mut fmi2Integer,
+) -> fmi2Status {
+    call(c, "fmi2GetInteger", |inst| {
+        let (Some(vrs), Some(out)) = (slice(vr, nvr), slice_mut(value, nvr)) else {
+            return null("fmi2GetInteger", "vr or value");
+        };
+        ok(inst.get_integer(vrs, out))
+    })
+}
+
+#[no_mangle]
+pub unsafe extern "C" fn fmi2GetBoolean(
+    c: fmi2Component,
+    vr: *const fmi2ValueReference,
+    nvr: size_t,
+    value: *mut fmi2Boolean,
+) -> fmi2Status {
+    call(c, "fmi2GetBoolean", |inst| {
+        let (Some(vrs), Some(out)) = (slice(vr, nvr), slice_mut(value, nvr)) else {
+            return null("fmi2GetBoolean", "vr or value");
+        };
+        ok(inst.get_boolean(vrs, out))
+    })
+}
+
+#[no_mangle]
+pub unsafe extern "C" fn fmi2GetString(
+    c: fmi2Component,
+    vr: *const fmi2ValueReference,
+    nvr: size_t,
+    value: *mut fmi2String,
+) -> fmi2Status {
+    call(c, "fmi2GetString", |inst| {
+        let (Some(vrs), Some(out)) = (slice(vr, nvr), slice_mut(value, nvr)) else {
+            return null("fmi2GetString", "vr or value");
+        };
+        let strings = inst.get_string(vrs)?;
+        for (o, s) in out.iter_mut().zip(strings) {
+            *o = s.as_ptr();
+        }
+        Ok(Status::Ok)
+    })
+}
+
+#[no_mangle]
+pub unsafe extern "C" fn fmi2SetReal(
+    c: fmi2Component,
+    vr: *const fmi2ValueReference,
+    nvr: size_t,
+    value: *const fmi2Real,
+) -> fmi2Status {
+    call(c, "fmi2SetReal", |inst| {
+        let (Some(vrs), Some(vals)) = (slice(vr, nvr), slice(value, nvr)) else {
+            return null("fmi2SetReal", "vr or value");
+        };
+        ok(inst.set_real(vrs, vals))
+    })
+}
+
+#[no_mangle]
+pub unsafe extern "C" fn fmi2SetInteger(
+    c: fmi2Component,
+    vr: *const fmi2ValueReference,
+    nvr: size_t,
+    value: *const fmi2Integer,
+) -> fmi2Status {
+    call(c, "fmi2SetInteger", |inst| {
+        let (Some(vrs), Some(vals)) = (slice(vr, nvr), slice(value, nvr)) else {
+            return null("fmi2SetInteger", "vr or value");
+        };
+        ok(inst.set_integer(vrs, vals))
+    })
+}
+
+#[no_mangle]
+pub unsafe extern "C" fn fmi2SetBoolean(
+    c: fmi2Component,
+    vr: *const fmi2ValueReference,
+    nvr: size_t,
+    value: *const fmi2Boolean,
+) -> fmi2Status {
+    call(c, "fmi2SetBoolean", |inst| {
+        let (Some(vrs), Some(vals)) = (slice(vr, nvr), slice(value, nvr)) else {
+            return null("fmi2SetBoolean", "vr or value");
+        };
+        ok(inst.set_boolean(vrs, vals))
+    })
+}
+
+#[no_mangle]
+pub unsafe extern "C" fn fmi2SetString(
+    c: fmi2Component,
+    vr: *const fmi2ValueReference,
+    nvr: size_t,
+    value: *const fmi2String,
+) -> fmi2Status {
+    call(c, "fmi2SetString", |inst| {
+        let (Some(vrs), Some(vals)) = (slice(vr, nvr), slice(value, nvr)) else {
+            return null("fmi2SetString", "vr or value");
+        };
+        let vals: Vec<Option<String>> = vals.iter().map(|&p| string(p)).collect();
+        ok(inst.set_string(vrs, &vals))
+    })
+}
+
+#[no_mangle]
+pub unsafe extern "C" fn fmi2GetFMUstate(
+    c: fmi2Component,
+    FMUstate: *mut fmi2FMUstate,
+) -> fmi2Status {
+    call(c, "fmi2GetFMUstate", |inst| {
+        let Some(slot) = FMUstate.as_mut() else {
+            return null("fmi2GetFMUstate", "FMUstate");
+        };
+        let existing = if slot.is_null() {
+            None
+        } else {
+            match Snapshot::from_ptr(*slot) {
+                Some(s) => Some(s),
+                None => return error("*FMUstate is not an FMU state of this FMU"),
+            }
+        };
+        if let Some(new) = inst.get_fmu_state(existing)? {
+            *slot = Box::into_raw(new) as fmi2FMUstate;
+        }
+        Ok(Status::Ok)
+    })
+}
+
+#[no_mangle]
+pub unsafe extern "C" fn fmi2SetFMUstate(c: fmi2Component, FMUstate: fmi2FMUstate) -> fmi2Status {
+    call(c, "fmi2SetFMUstate", |inst| {
+        let Some(s) = Snapshot::from_ptr(FMUstate) else {
+            return error("FMUstate is null or not an FMU state of this FMU");
+        };
+        ok(inst.set_fmu_state(s))
+    })
+}
+
+#[no_mangle]
+pub unsafe extern "C" fn fmi2FreeFMUstate(
+    c: fmi2Component,
+    FMUstate: *mut fmi2FMUstate,
+) -> fmi2Status {
+    call(c, "fmi2FreeFMUstate", |_inst| {
+        let Some(slot) = FMUstate.as_mut() else {
+            return Ok(Status::Ok);
+        };
+        if slot.is_null() {
+            return Ok(Status::Ok);
+        }
+        let Some(s) = Snapshot::from_ptr(*slot) else {
+            return error("*FMUstate is not an FMU state of this FMU");
+        };
+        drop(Box::from_raw(s as *mut Snapshot));
+        *slot = std::ptr::null_mut();
+        Ok(Status::Ok)
+    })
+}
+
+#[no_mangle]
+pub unsafe extern "C" fn fmi2SerializedFMUstateSize(
+    c: fmi2Component,
+    FMUstate: fmi2FMUstate,
+    size: *mut size_t,
+) -> fmi2Status {
+    call(c, "fmi2SerializedFMUstateSize", |inst| {
+        let Some(s) = Snapshot::from_ptr(FMUstate) else {
+            return error("FMUstate is null or not an FMU state of this FMU");
+        };
+        let Some(size) = size.as_mut() else {
+            return null("fmi2SerializedFMUstateSize", "size");
+        };
+        *size = inst.serialize("fmi2SerializedFMUstateSize", s)?.len();
+        Ok(Status::Ok)
+    })
+}
+
+#[no_mangle]
+pub unsafe extern "C" fn fmi2SerializeFMUstate(
+    c: fmi2Component,
+    FMUstate: fmi2FMUstate,
+    serializedState: *mut fmi2Byte,
+    size: size_t,
+) -> fmi2Status {
+    call(c, "fmi2SerializeFMUstate", |inst| {
+        let Some(s) = Snapshot::from_ptr(FMUstate) else {
+            return error("FMUstate is null or not an FMU state of this FMU");
+        };
+        let bytes = inst.serialize("fmi2SerializeFMUstate", s)?;
+        if size < bytes.len() {
+            return error(format!(
+                "buffer of {size} bytes is smaller than the state's {} (fmi2SerializedFMUstateSize)",
+                bytes.len()
+            ));
+        }
+        if serializedState.is_null() {
+            return null("fmi2SerializeFMUstate", "serializedState");
+        }
+        std::ptr::copy_nonoverlapping(bytes.as_ptr(), serializedState as *mut u8, bytes.len());
+        Ok(Status::Ok)
+    })
+}
+
+#[no_mangle]
+pub unsafe extern "C" fn fmi2DeSerializeFMUstate(
+    c: fmi2Component,
+    serializedState: *const fmi2Byte,
+    size: size_t,
+    FMUstate: *mut fmi2FMUstate,
+) -> fmi2Status {
+    call(c, "fmi2DeSerializeFMUstate", |inst| {
+        let Some(bytes) = slice(serializedState as *const u8, size) else {
+            return null("fmi2DeSerializeFMUstate", "serializedState");
+        };
+        let Some(slot) = FMUstate.as_mut() else {
+            return null("fmi2DeSerializeFMUstate", "FMUstate");
+        };
+        let old = if slot.is_null() {
+            None
+        } else {
+            match Snapshot::from_ptr(*slot) {
+                Some(s) => Some(s as *mut Snapshot),
+                None => return error("*FMUstate is not an FMU state of this FMU"),
+            }
+        };
+        let new = inst.deserialize(bytes)?;
+        if let Some(old) = old {
+            drop(Box::from_raw(old));
+        }
+        *slot = Box::into_raw(new) as fmi2FMUstate;
+        Ok(Status::Ok)
+    })
+}
+
+#[no_mangle]
+pub unsafe extern "C" fn fmi2GetDirectionalDerivative(
+    c: fmi2Component,
+    _vUnknown_ref: *const fmi2ValueReference,
+    _nUnknown: size_t,
+    _vKnown_ref: *const fmi2ValueReference,
+    _nKnown: size_t,
+    _dvKnown: *const fmi2Real,
+    _dvUnknown: *mut fmi2Real,
+) -> fmi2Status {
+    call(c, "fmi2GetDirectionalDerivative", |_| {
+        error("not supported (providesDirectionalDerivative=\"false\")")
+    })
+}
+
+// ---------------------------------------------------------- co-simulation
+
+#[no_mangle]
+pub unsafe extern "C" fn fmi2SetRealInputDerivatives(
+    c: fmi2Component,
+    _vr: *const fmi2ValueReference,
+    _nvr: size_t,
+    _order: *const fmi2Integer,
+    _value: *const fmi2Real,
+) -> fmi2Status {
+    call(c, "fmi2SetRealInputDerivatives", |_| {
+        error("not supported (canInterpolateInputs=\"false\")")
+    })
+}
+
+#[no_mangle]
+pub unsafe extern "C" fn fmi2GetRealOutputDerivatives(
+    c: fmi2Component,
+    _vr: *const fmi2ValueReference,
+    _nvr: size_t,
+    _order: *const fmi2Integer,
+    _value: *mut fmi2Real,
+) -> fmi2Status {
+    call(c, "fmi2GetRealOutputDerivatives", |_| {
+        error("not supported (maxOutputDerivativeOrder=\"0\")")
+    })
+}
+
+#[no_mangle]
+pub unsafe extern "C" fn fmi2DoStep(
+    c: fmi2Component,
+    currentCommunicationPoint: fmi2Real,
+    communicationStepSize: fmi2Real,
+    _noSetFMUStatePriorToCurrentPoint: fmi2Boolean,
+) -> fmi2Status {
+    call(c, "fmi2DoStep", |inst| {
+        if inst.log_all() {
+            inst.log(
+                Status::Ok,
+                LOG_ALL,
+                &format!(
+                    "fmi2DoStep(t = {currentCommunicationPoint}, h = {communicationStepSize})"
+                ),
+            );
+        }
+        inst.do_step(currentCommunicationPoint, communicationStepSize)
+    })
+}
+
+#[no_mangle]
+pub unsafe extern "C" fn fmi2CancelStep(c: fmi2Component) -> fmi2Status {
+    call(c, "fmi2CancelStep", |_| {
+        error("no asynchronous step is in progress (fmi2DoStep never returns fmi2Pending)")
+    })
+}
+
+fn require_status(inst: &Instance, func: &str) -> Res {
+    inst.require(
+        func,
+        &[Phase::StepComplete, Phase::StepFailed, Phase::Terminated],
+    )
+}
+
+fn discard(msg: String) -> Res<Status> {
+    Err(crate::instance::Fail {
+        status: Status::Discard,
+        msg,
+    })
+}
+
+#[no_mangle]
+pub unsafe extern "C" fn fmi2GetStatus(
+    c: fmi2Component,
+    s: fmi2StatusKind,
+    value: *mut fmi2Status,
+) -> fmi2Status {
+    call(c, "fmi2GetStatus", |inst| {
+        require_status(inst, "fmi2GetStatus")?;
+        if value.is_null() {
+            return null("fmi2GetStatus", "value");
+        }
+        discard(format!(
+            "status kind {s} is not available: fmi2DoStep never returns fmi2Pending"
+        ))
+    })
+}
+
+#[no_mangle]
+pub unsafe extern "C" fn fmi2GetRealStatus(
+    c: fmi2Component,
+    s: fmi2StatusKind,
+    value: *mut fmi2Real,
+) -> fmi2Status {
+    call(c, "fmi2GetRealStatus", |inst| {
+        require_status(inst, "fmi2GetRealStatus")?;
+        let Some(v) = value.as_mut() else {
+            return null("fmi2GetRealStatus", "value");
+        };
+        if s != fmi2LastSuccessfulTime {
+            return discard(format!("status kind {s} has no Real value"));
+        }
+        *v = inst.last_successful_time();
+        Ok(Status::Ok)
+    })
+}
+
+#[no_mangle]
+pub unsafe extern "C" fn fmi2GetIntegerStatus(
+    c: fmi2Component,
+    s: fmi2StatusKind,
+    value: *mut fmi2Integer,
+) -> fmi2Status {
+    call(c, "fmi2GetIntegerStatus", |inst| {
+        require_status(inst, "fmi2GetIntegerStatus")?;
+        if value.is_null() {
+            return null("fmi2GetIntegerStatus", "value");
+        }
+        discard(format!("status kind {s} has no Integer value"))
+    })
+}
+
+#[no_mangle]
+pub unsafe extern "C" fn fmi2GetBooleanStatus(
+    c: fmi2Component,
+    s: fmi2StatusKind,
+    value: *mut fmi2Boolean,
+) -> fmi2Status {
+    call(c, "fmi2GetBooleanStatus", |inst| {
+        require_status(inst, "fmi2GetBooleanStatus")?;
+        let Some(v) = value.as_mut() else {
+            return null("fmi2GetBooleanStatus", "value");
+        };
+        if s != fmi2Terminated {
+            return discard(format!("status kind {s} has no Boolean value"));
+        }
+        *v = inst.terminated() as fmi2Boolean;
+        Ok(Status::Ok)
+    })
+}
+
+#[no_mangle]
+pub unsafe extern "C" fn fmi2GetStringStatus(
+    c: fmi2Component,
+    s: fmi2StatusKind,
+    value: *mut fmi2String,
+) -> fmi2Status {
+    call(c, "fmi2GetStringStatus", |inst| {
+        require_status(inst, "fmi2GetStringStatus")?;
+        let Some(v) = value.as_mut() else {
+            return null("fmi2GetStringStatus", "value");
+        };
+        *v = c"".as_ptr();
+        discard(format!(
+            "status kind {s} has no String value: fmi2DoStep never returns fmi2Pending"
+        ))
+    })
+}

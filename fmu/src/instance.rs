@@ -1,0 +1,1266 @@
+//! One FMU instance: the FMI 2.0 Co-Simulation state machine around a
+//! [`YarnSim`], independent of the C ABI (which lives in [`crate::ffi`]).
+
+use std::ffi::{c_char, c_int, c_void, CString};
+use std::path::{Path, PathBuf};
+
+use yarnsim::math::Vec2;
+use yarnsim::mpm::state::fnv1a;
+use yarnsim::mpm::{Attractor, Diagnostics, SimError, YarnSim};
+use yarnsim::scene::YarnScene;
+
+use crate::model::*;
+
+/// `fmi2Status` values.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
+#[repr(i32)]
+pub enum Status {
+    Ok = 0,
+    Warning = 1,
+    Discard = 2,
+    Error = 3,
+    Fatal = 4,
+    Pending = 5,
+}
+
+/// A failed call: its status (Discard, Error or Fatal) and the message logged.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Fail {
+    pub status: Status,
+    pub msg: String,
+}
+
+pub type Res<T = ()> = Result<T, Fail>;
+
+pub fn error<T>(msg: impl Into<String>) -> Res<T> {
+    Err(Fail {
+        status: Status::Error,
+        msg: msg.into(),
+    })
+}
+
+/// The states of the FMI 2.0 Co-Simulation state machine this FMU can be in
+/// (no asynchronous steps, so never stepInProgress or stepCanceled).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Phase {
+    Instantiated,
+    InitializationMode,
+    StepComplete,
+    StepFailed,
+    Terminated,
+    Error,
+    Fatal,
+}
+
+impl Phase {
+    fn code(self) -> u8 {
+        self as u8
+    }
+    fn from_code(c: u8) -> Option<Phase> {
+        use Phase::*;
+        [
+            Instantiated,
+            InitializationMode,
+            StepComplete,
+            StepFailed,
+            Terminated,
+            Error,
+            Fatal,
+        ]
+        .get(c as usize)
+        .copied()
+    }
+}
+
+/// The logger callback: `(componentEnvironment, instanceName, status, category, message, ...)`.
+pub type Logger =
+    unsafe extern "C" fn(*mut c_void, *const c_char, c_int, *const c_char, *const c_char, ...);
+
+/// Log category indices into [`LOG_CATEGORIES`].
+pub const LOG_EVENTS: usize = 0;
+pub const LOG_WARNING: usize = 1;
+pub const LOG_DISCARD: usize = 2;
+pub const LOG_ERROR: usize = 3;
+pub const LOG_FATAL: usize = 4;
+pub const LOG_ALL: usize = 6;
+
+/// Values of the inputs.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Inputs {
+    pub attractor: [f64; 2],
+    pub strength: f64,
+    pub active: bool,
+    pub gravity: [f64; 2],
+}
+
+impl Inputs {
+    fn from_scene(s: &YarnScene) -> Self {
+        Inputs {
+            attractor: s.attractor.position,
+            strength: s.attractor.strength,
+            active: s.attractor.active,
+            gravity: s.gravity,
+        }
+    }
+
+    /// Checks the inputs the way the library does, then hands them to `sim`.
+    fn apply(&self, sim: &mut YarnSim) -> Res {
+        sim.set_gravity(Vec2::from(self.gravity))
+            .and_then(|_| {
+                sim.set_attractor(Attractor {
+                    position: Vec2::from(self.attractor),
+                    strength: self.strength,
+                    active: self.active,
+                })
+            })
+            .or_else(|e| error(e.to_string()))
+    }
+}
+
+/// The parameters as set by the environment (`None`: the scene's value).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Config {
+    pub scene_path: String,
+    /// Overrides of [`REAL_PARAMETERS`], in that order.
+    pub reals: [Option<f64>; 7],
+    pub plasticity: Option<bool>,
+}
+
+impl Default for Config {
+    fn default() -> Self {
+        Config {
+            scene_path: SCENE_FILE.to_string(),
+            reals: [None; 7],
+            plasticity: None,
+        }
+    }
+}
+
+fn real_param_index(vr: u32) -> Option<usize> {
+    REAL_PARAMETERS.iter().position(|&p| p == vr)
+}
+
+fn scene_real(scene: &YarnScene, vr: u32) -> f64 {
+    let m = &scene.material;
+    match vr {
+        VR_K => m.k,
+        VR_GAMMA => m.gamma,
+        VR_YOUNGS_MODULUS => m.youngs_modulus,
+        VR_FRICTION => m.friction,
+        VR_BENDING => m.bending,
+        VR_DENSITY => m.density,
+        VR_DT => scene.time.dt,
+        _ => unreachable!("not a real parameter: {vr}"),
+    }
+}
+
+fn set_scene_real(scene: &mut YarnScene, vr: u32, v: f64) {
+    let m = &mut scene.material;
+    match vr {
+        VR_K => m.k = v,
+        VR_GAMMA => m.gamma = v,
+        VR_YOUNGS_MODULUS => m.youngs_modulus = v,
+        VR_FRICTION => m.friction = v,
+        VR_BENDING => m.bending = v,
+        VR_DENSITY => m.density = v,
+        VR_DT => scene.time.dt = v,
+        _ => unreachable!("not a real parameter: {vr}"),
+    }
+}
+
+/// The base scene with the parameter overrides applied.
+fn effective_scene(base: &YarnScene, config: &Config) -> YarnScene {
+    let mut s = base.clone();
+    for (k, &vr) in REAL_PARAMETERS.iter().enumerate() {
+        if let Some(v) = config.reals[k] {
+            set_scene_real(&mut s, vr, v);
+        }
+    }
+    if let Some(p) = config.plasticity {
+        s.material.plasticity = p;
+    }
+    s
+}
+
+/// Everything an FMU state holds: what `fmi2GetFMUstate` copies and
+/// `fmi2Reset` rebuilds.
+#[derive(Clone, Debug)]
+pub struct Model {
+    pub config: Config,
+    /// The scene file as loaded (before parameter overrides).
+    pub base: YarnScene,
+    pub sim: YarnSim,
+    pub inputs: Inputs,
+    /// The simulation must be rebuilt from `base` and `config` before use.
+    pub dirty: bool,
+    pub start_time: f64,
+    pub stop_time: Option<f64>,
+    /// Current communication point.
+    pub time: f64,
+    pub last_successful_time: f64,
+    /// Substeps taken since initialization.
+    pub substeps: u64,
+    /// Set when a step diverged (`fmi2Terminated` status).
+    pub terminated: bool,
+    /// Diagnostics of the current state, computed on first use.
+    pub diag: Option<Diagnostics>,
+}
+
+impl Model {
+    fn new(base: YarnScene) -> Res<Self> {
+        let sim = YarnSim::new(&base).or_else(|e| error(format!("scene: {e}")))?;
+        Ok(Model {
+            config: Config::default(),
+            inputs: Inputs::from_scene(&base),
+            base,
+            sim,
+            dirty: false,
+            start_time: 0.0,
+            stop_time: None,
+            time: 0.0,
+            last_successful_time: 0.0,
+            substeps: 0,
+            terminated: false,
+            diag: None,
+        })
+    }
+
+    /// Rebuilds the simulation after parameter changes.
+    fn ensure_built(&mut self, yarns: usize) -> Res {
+        if !self.dirty {
+            return Ok(());
+        }
+        let scene = effective_scene(&self.base, &self.config);
+        let mut sim = YarnSim::new(&scene).or_else(|e| error(format!("parameters: {e}")))?;
+        if sim.num_yarns() != yarns {
+            return error(format!(
+                "scene {:?} creates {} yarns, but this FMU has outputs for {yarns}",
+                self.config.scene_path,
+                sim.num_yarns()
+            ));
+        }
+        self.inputs.apply(&mut sim)?;
+        self.sim = sim;
+        self.diag = None;
+        self.dirty = false;
+        Ok(())
+    }
+
+    fn diagnostics(&mut self) -> Diagnostics {
+        *self.diag.get_or_insert_with(|| self.sim.diagnostics())
+    }
+}
+
+/// A saved FMU state (`fmi2FMUstate`).
+pub struct Snapshot {
+    magic: u64,
+    phase: Phase,
+    model: Model,
+    /// Serialized form, made on first request.
+    bytes: Option<Vec<u8>>,
+}
+
+const SNAPSHOT_MAGIC: u64 = 0x5942_534e_4150_5348;
+
+impl Snapshot {
+    /// Validates a pointer handed back by the environment.
+    ///
+    /// # Safety
+    /// `p` must be null or a pointer this FMU returned and has not freed.
+    pub unsafe fn from_ptr<'a>(p: *mut c_void) -> Option<&'a mut Snapshot> {
+        let s = (p as *mut Snapshot).as_mut()?;
+        (s.magic == SNAPSHOT_MAGIC).then_some(s)
+    }
+}
+
+impl Drop for Snapshot {
+    fn drop(&mut self) {
+        self.magic = 0;
+    }
+}
+
+/// First bytes of a serialized FMU state.
+pub const STATE_MAGIC: &[u8; 8] = b"YBFMUST\0";
+/// Format version of the serialized FMU state.
+pub const STATE_VERSION: u32 = 1;
+const STATE_HEADER: usize = 8 + 4 + 8 + 8;
+
+/// One FMU instance.
+pub struct Instance {
+    magic: u64,
+    pub name: CString,
+    logger: Option<Logger>,
+    env: *mut c_void,
+    logging_on: bool,
+    categories: [bool; LOG_CATEGORIES.len()],
+    pub resources: PathBuf,
+    /// The scene bundled in `resources/`.
+    bundled: YarnScene,
+    yarns: usize,
+    pub phase: Phase,
+    pub model: Model,
+    /// Strings handed out by `fmi2GetString`, valid until the next call.
+    pub strings: Vec<CString>,
+}
+
+const INSTANCE_MAGIC: u64 = 0x5942_494e_5354_414e;
+
+/// Turns a resource location URI (`file:///a/b`, `file:/a/b`,
+/// `file://localhost/a/b`, with `%xx` escapes) or a plain path into a path.
+pub fn resource_path(uri: &str) -> Result<PathBuf, String> {
+    let rest = if let Some(r) = uri.strip_prefix("file://localhost/") {
+        format!("/{r}")
+    } else if let Some(r) = uri.strip_prefix("file:///") {
+        format!("/{r}")
+    } else if let Some(r) = uri.strip_prefix("file://") {
+        return Err(format!(
+            "resource location {uri:?} names a remote host ({})",
+            r.split('/').next().unwrap_or("")
+        ));
+    } else if let Some(r) = uri.strip_prefix("file:") {
+        r.to_string()
+    } else if uri.contains("://") {
+        return Err(format!("resource location {uri:?} is not a file URI"));
+    } else {
+        return Ok(PathBuf::from(uri));
+    };
+    let bytes = rest.as_bytes();
+    let mut out = Vec::with_capacity(bytes.len());
+    let mut i = 0;
+    while i < bytes.len() {
+        if bytes[i] == b'%' {
+            let hex = bytes
+                .get(i + 1..i + 3)
+                .and_then(|h| std::str::from_utf8(h).ok())
+                .and_then(|h| u8::from_str_radix(h, 16).ok());
+            match hex {
+                Some(b) => {
+                    out.push(b);
+                    i += 3;
+                    continue;
+                }
+                None => return Err(format!("resource location {uri:?} has a bad % escape")),
+            }
+        }
+        out.push(bytes[i]);
+        i += 1;
+    }
+    use std::os::unix::ffi::OsStringExt;
+    Ok(PathBuf::from(std::ffi::OsString::from_vec(out)))
+}
+
+fn read_scene(path: &Path) -> Result<YarnScene, String> {
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| format!("cannot read scene file {}: {e}", path.display()))?;
+    YarnScene::from_toml_str(&text).map_err(|e| format!("scene file {}: {e}", path.display()))
+}
+
+/// Escapes a message for the printf-style logger: `%` as `%%`, `#` as `##`
+/// (FMI variable references), and drops NUL bytes.
+pub fn escape_log(msg: &str) -> CString {
+    let mut s = String::with_capacity(msg.len() + 8);
+    for c in msg.chars() {
+        match c {
+            '%' => s.push_str("%%"),
+            '#' => s.push_str("##"),
+            '\0' => {}
+            c => s.push(c),
+        }
+    }
+    CString::new(s).expect("NUL bytes removed")
+}
+
+fn phase_name(p: Phase) -> &'static str {
+    match p {
+        Phase::Instantiated => "instantiated",
+        Phase::InitializationMode => "initialization mode",
+        Phase::StepComplete => "step complete",
+        Phase::StepFailed => "step failed",
+        Phase::Terminated => "terminated",
+        Phase::Error => "error",
+        Phase::Fatal => "fatal",
+    }
+}
+
+impl Instance {
+    /// Creates an instance for the scene in `resources`, checking the GUID.
+    /// On failure, the message to log.
+    pub fn new(
+        name: &str,
+        guid_arg: &str,
+        resource_uri: &str,
+        logger: Option<Logger>,
+        env: *mut c_void,
+        logging_on: bool,
+    ) -> Result<Box<Instance>, String> {
+        let resources = resource_path(resource_uri)?;
+        let bundled = read_scene(&resources.join(SCENE_FILE))?;
+        let expected = guid(&bundled);
+        if guid_arg != expected {
+            return Err(format!(
+                "GUID {guid_arg:?} does not match this FMU's {expected:?} (modelDescription.xml and binary/resources differ)"
+            ));
+        }
+        let model = Model::new(bundled.clone()).map_err(|f| f.msg)?;
+        let yarns = model.sim.num_yarns();
+        let inst = Box::new(Instance {
+            magic: INSTANCE_MAGIC,
+            // The instance name is an argument, not the format: no escaping.
+            name: escape_nul(name),
+            logger,
+            env,
+            logging_on,
+            categories: [true; LOG_CATEGORIES.len()],
+            resources,
+            bundled,
+            yarns,
+            phase: Phase::Instantiated,
+            model,
+            strings: Vec::new(),
+        });
+        inst.log(
+            Status::Ok,
+            LOG_EVENTS,
+            &format!(
+                "instantiated {name:?}: scene {:?}, {yarns} yarns, substep {} s",
+                inst.bundled.name, inst.bundled.time.dt
+            ),
+        );
+        Ok(inst)
+    }
+
+    /// Validates a component pointer handed back by the environment.
+    ///
+    /// # Safety
+    /// `p` must be null or a pointer this FMU returned and has not freed.
+    pub unsafe fn from_ptr<'a>(p: *mut c_void) -> Option<&'a mut Instance> {
+        let s = (p as *mut Instance).as_mut()?;
+        (s.magic == INSTANCE_MAGIC).then_some(s)
+    }
+
+    /// Marks the instance freed (the memory is released right after).
+    pub fn invalidate(&mut self) {
+        self.magic = 0;
+    }
+
+    pub fn yarns(&self) -> usize {
+        self.yarns
+    }
+
+    /// Sends a message to the logger: errors and fatal errors and discards
+    /// always, other messages when logging is on for their category.
+    pub fn log(&self, status: Status, category: usize, msg: &str) {
+        let Some(logger) = self.logger else { return };
+        let always = matches!(status, Status::Error | Status::Fatal | Status::Discard);
+        if !(always || (self.logging_on && self.categories[category])) {
+            return;
+        }
+        let cat = CString::new(LOG_CATEGORIES[category].0).expect("no NUL");
+        let text = escape_log(msg);
+        // SAFETY: the logger comes from the environment's callback struct;
+        // the message is pre-formatted and escaped, so no varargs are read.
+        unsafe {
+            logger(
+                self.env,
+                self.name.as_ptr(),
+                status as c_int,
+                cat.as_ptr(),
+                text.as_ptr(),
+            )
+        }
+    }
+
+    /// Whether `logAll` messages would be shown (to skip formatting them).
+    pub fn log_all(&self) -> bool {
+        self.logger.is_some() && self.logging_on && self.categories[LOG_ALL]
+    }
+
+    /// Fails unless the instance is in one of `allowed`.
+    pub fn require(&self, func: &str, allowed: &[Phase]) -> Res {
+        if allowed.contains(&self.phase) {
+            Ok(())
+        } else {
+            error(format!(
+                "{func} is not allowed in state {:?}",
+                phase_name(self.phase)
+            ))
+        }
+    }
+
+    pub fn set_debug_logging(&mut self, on: bool, cats: &[&str]) -> Res {
+        use Phase::*;
+        self.require(
+            "fmi2SetDebugLogging",
+            &[
+                Instantiated,
+                InitializationMode,
+                StepComplete,
+                StepFailed,
+                Terminated,
+                Error,
+            ],
+        )?;
+        let mut idx = Vec::new();
+        for c in cats {
+            match LOG_CATEGORIES.iter().position(|(n, _)| n == c) {
+                Some(i) => idx.push(i),
+                None => return error(format!("unknown log category {c:?}")),
+            }
+        }
+        self.logging_on = on || self.logging_on;
+        if idx.is_empty() {
+            self.categories = [on; LOG_CATEGORIES.len()];
+            self.logging_on = on;
+        } else {
+            for i in idx {
+                self.categories[i] = on;
+            }
+        }
+        Ok(())
+    }
+
+    pub fn setup_experiment(&mut self, start: f64, stop: Option<f64>) -> Res {
+        self.require("fmi2SetupExperiment", &[Phase::Instantiated])?;
+        if !start.is_finite() || start.abs() > 1e12 {
+            return error(format!("start time {start} must be finite"));
+        }
+        if let Some(s) = stop {
+            if !(s.is_finite() && s >= start) {
+                return error(format!(
+                    "stop time {s} must be finite and not before the start time {start}"
+                ));
+            }
+        }
+        let m = &mut self.model;
+        m.start_time = start;
+        m.stop_time = stop;
+        m.time = start;
+        m.last_successful_time = start;
+        Ok(())
+    }
+
+    pub fn enter_initialization_mode(&mut self) -> Res {
+        self.require("fmi2EnterInitializationMode", &[Phase::Instantiated])?;
+        self.phase = Phase::InitializationMode;
+        self.log(Status::Ok, LOG_EVENTS, "entered initialization mode");
+        Ok(())
+    }
+
+    pub fn exit_initialization_mode(&mut self) -> Res {
+        self.require("fmi2ExitInitializationMode", &[Phase::InitializationMode])?;
+        self.model.ensure_built(self.yarns)?;
+        let m = &mut self.model;
+        m.time = m.start_time;
+        m.last_successful_time = m.start_time;
+        m.substeps = 0;
+        m.terminated = false;
+        self.phase = Phase::StepComplete;
+        self.log(
+            Status::Ok,
+            LOG_EVENTS,
+            &format!(
+                "initialized at t = {}: {} yarns, substep {} s",
+                self.model.time,
+                self.yarns,
+                self.model.sim.dt()
+            ),
+        );
+        Ok(())
+    }
+
+    pub fn terminate(&mut self) -> Res {
+        self.require("fmi2Terminate", &[Phase::StepComplete, Phase::StepFailed])?;
+        self.phase = Phase::Terminated;
+        self.log(Status::Ok, LOG_EVENTS, "terminated");
+        Ok(())
+    }
+
+    pub fn reset(&mut self) -> Res {
+        self.require(
+            "fmi2Reset",
+            &[
+                Phase::Instantiated,
+                Phase::InitializationMode,
+                Phase::StepComplete,
+                Phase::StepFailed,
+                Phase::Terminated,
+                Phase::Error,
+            ],
+        )?;
+        self.model = Model::new(self.bundled.clone())?;
+        self.phase = Phase::Instantiated;
+        self.log(Status::Ok, LOG_EVENTS, "reset to the instantiated state");
+        Ok(())
+    }
+
+    /// One communication step from `t` to `t + h`.
+    pub fn do_step(&mut self, t: f64, h: f64) -> Res<Status> {
+        self.require("fmi2DoStep", &[Phase::StepComplete])?;
+        let m = &mut self.model;
+        if !(t.is_finite() && h.is_finite()) {
+            return error(format!(
+                "communication point {t} and step size {h} must be finite"
+            ));
+        }
+        if h <= 0.0 {
+            return error(format!("communication step size h = {h} must be > 0"));
+        }
+        let tol = 1e-9 * m.time.abs().max(t.abs()).max(h);
+        if (t - m.time).abs() > tol {
+            return error(format!(
+                "communication point {t} does not match the FMU's time {} (tolerance {tol:e})",
+                m.time
+            ));
+        }
+        let end = t + h;
+        if let Some(stop) = m.stop_time {
+            if end > stop + 1e-9 * stop.abs().max(h) {
+                return error(format!(
+                    "step from {t} by {h} ends past the stop time {stop}"
+                ));
+            }
+        }
+        // The substep count is an integer grid from the start time: the
+        // substeps done by a given time do not depend on how the master
+        // partitions its interval.
+        let target = ((end - m.start_time) / m.sim.dt()).round();
+        if !(0.0..9.0e15).contains(&target) {
+            return error(format!(
+                "step to {end} needs {target} substeps of {} s",
+                m.sim.dt()
+            ));
+        }
+        let target = target as u64;
+        let n = target.saturating_sub(m.substeps);
+        for _ in 0..n {
+            if let Err(e) = m.sim.step() {
+                m.substeps = m.sim.steps();
+                m.diag = None;
+                m.terminated = true;
+                self.phase = Phase::StepFailed;
+                let msg = match e {
+                    SimError::NonFinite { .. } => format!(
+                        "step from t = {t} by {h} failed: {e}; the simulation is terminated (restore a state or reset)"
+                    ),
+                    SimError::BadInput(_) => format!("step from t = {t} by {h} failed: {e}"),
+                };
+                return Err(Fail {
+                    status: Status::Discard,
+                    msg,
+                });
+            }
+        }
+        m.substeps += n;
+        m.diag = None;
+        m.time = end;
+        m.last_successful_time = end;
+        Ok(Status::Ok)
+    }
+
+    fn require_get(&self, func: &str) -> Res {
+        use Phase::*;
+        self.require(
+            func,
+            &[InitializationMode, StepComplete, StepFailed, Terminated],
+        )
+    }
+
+    /// Values that depend on the simulated state are not available after a
+    /// diverged step.
+    fn require_state(&mut self, func: &str) -> Res {
+        if self.phase == Phase::StepFailed {
+            return error(format!(
+                "{func}: the state diverged in the last step (t = {}); its outputs are not available until fmi2SetFMUstate or fmi2Reset",
+                self.model.last_successful_time
+            ));
+        }
+        self.model.ensure_built(self.yarns)
+    }
+
+    pub fn get_real(&mut self, vrs: &[u32], out: &mut [f64]) -> Res {
+        self.require_get("fmi2GetReal")?;
+        for (k, &vr) in vrs.iter().enumerate() {
+            let v = match vr {
+                VR_ATTRACTOR_X => self.model.inputs.attractor[0],
+                VR_ATTRACTOR_Y => self.model.inputs.attractor[1],
+                VR_ATTRACTOR_STRENGTH => self.model.inputs.strength,
+                VR_GRAVITY_X => self.model.inputs.gravity[0],
+                VR_GRAVITY_Y => self.model.inputs.gravity[1],
+                _ if real_param_index(vr).is_some() => {
+                    let i = real_param_index(vr).unwrap();
+                    self.model.config.reals[i].unwrap_or_else(|| scene_real(&self.model.base, vr))
+                }
+                VR_KINETIC_ENERGY | VR_ELASTIC_ENERGY | VR_MAX_STRETCH => {
+                    self.require_state("fmi2GetReal")?;
+                    let d = self.model.diagnostics();
+                    match vr {
+                        VR_KINETIC_ENERGY => d.kinetic_energy,
+                        VR_ELASTIC_ENERGY => d.elastic_energy,
+                        _ => d.max_stretch,
+                    }
+                }
+                _ if vr >= VR_YARN_BASE && ((vr - VR_YARN_BASE) / 4) < self.yarns as u32 => {
+                    self.require_state("fmi2GetReal")?;
+                    let i = (vr - VR_YARN_BASE) as usize;
+                    let (l, r) = self.model.sim.yarn_endpoints(i / 4);
+                    [l.x, l.y, r.x, r.y][i % 4]
+                }
+                _ => {
+                    return error(format!(
+                        "fmi2GetReal: no Real variable has value reference {vr}"
+                    ))
+                }
+            };
+            if !v.is_finite() {
+                return error(format!(
+                    "fmi2GetReal: value reference {vr} is not finite ({v}) at t = {}",
+                    self.model.time
+                ));
+            }
+            out[k] = v;
+        }
+        Ok(())
+    }
+
+    pub fn get_integer(&mut self, vrs: &[u32], out: &mut [c_int]) -> Res {
+        self.require_get("fmi2GetInteger")?;
+        for (k, &vr) in vrs.iter().enumerate() {
+            out[k] = match vr {
+                // Saturates instead of wrapping past 2^31 - 1 substeps.
+                VR_SUBSTEPS => self.model.substeps.min(c_int::MAX as u64) as c_int,
+                _ => {
+                    return error(format!(
+                        "fmi2GetInteger: no Integer variable has value reference {vr}"
+                    ))
+                }
+            };
+        }
+        Ok(())
+    }
+
+    pub fn get_boolean(&mut self, vrs: &[u32], out: &mut [c_int]) -> Res {
+        self.require_get("fmi2GetBoolean")?;
+        for (k, &vr) in vrs.iter().enumerate() {
+            out[k] = match vr {
+                VR_ATTRACTOR_ACTIVE => self.model.inputs.active as c_int,
+                VR_PLASTICITY => {
+                    self.model
+                        .config
+                        .plasticity
+                        .unwrap_or(self.model.base.material.plasticity) as c_int
+                }
+                _ => {
+                    return error(format!(
+                        "fmi2GetBoolean: no Boolean variable has value reference {vr}"
+                    ))
+                }
+            };
+        }
+        Ok(())
+    }
+
+    /// Returns the strings; they stay valid until the next call.
+    pub fn get_string(&mut self, vrs: &[u32]) -> Res<&[CString]> {
+        self.require_get("fmi2GetString")?;
+        self.strings.clear();
+        for &vr in vrs {
+            match vr {
+                VR_SCENE => self.strings.push(escape_nul(&self.model.config.scene_path)),
+                _ => {
+                    return error(format!(
+                        "fmi2GetString: no String variable has value reference {vr}"
+                    ))
+                }
+            }
+        }
+        Ok(&self.strings)
+    }
+
+    fn require_set_input(&self, func: &str) -> Res {
+        use Phase::*;
+        self.require(func, &[Instantiated, InitializationMode, StepComplete])
+    }
+
+    fn require_set_parameter(&self, func: &str, vr: u32) -> Res {
+        use Phase::*;
+        if matches!(self.phase, Instantiated | InitializationMode) {
+            Ok(())
+        } else {
+            error(format!(
+                "{func}: value reference {vr} is a fixed parameter, settable only before fmi2ExitInitializationMode (state is {:?})",
+                phase_name(self.phase)
+            ))
+        }
+    }
+
+    pub fn set_real(&mut self, vrs: &[u32], vals: &[f64]) -> Res {
+        self.require_set_input("fmi2SetReal")?;
+        // Check everything first, so a rejected call changes nothing.
+        let mut inputs = self.model.inputs;
+        let mut reals = self.model.config.reals;
+        for (&vr, &v) in vrs.iter().zip(vals) {
+            if !v.is_finite() {
+                return error(format!(
+                    "fmi2SetReal: value {v} for value reference {vr} is not finite"
+                ));
+            }
+            match vr {
+                VR_ATTRACTOR_X => inputs.attractor[0] = v,
+                VR_ATTRACTOR_Y => inputs.attractor[1] = v,
+                VR_ATTRACTOR_STRENGTH => inputs.strength = v,
+                VR_GRAVITY_X => inputs.gravity[0] = v,
+                VR_GRAVITY_Y => inputs.gravity[1] = v,
+                _ if real_param_index(vr).is_some() => {
+                    self.require_set_parameter("fmi2SetReal", vr)?;
+                    let ok = match vr {
+                        VR_DENSITY | VR_DT => v > 0.0,
+                        _ => v >= 0.0,
+                    } && v <= 1e12;
+                    if !ok {
+                        return error(format!(
+                            "fmi2SetReal: parameter value reference {vr} = {v} is out of range"
+                        ));
+                    }
+                    reals[real_param_index(vr).unwrap()] = Some(v);
+                }
+                _ => {
+                    return error(format!(
+                        "fmi2SetReal: value reference {vr} is not a Real input or parameter"
+                    ))
+                }
+            }
+        }
+        if inputs.attractor.iter().any(|c| c.abs() > 1e6) {
+            return error(format!(
+                "fmi2SetReal: attractor position ({}, {}) is absurd (beyond 1e6 m)",
+                inputs.attractor[0], inputs.attractor[1]
+            ));
+        }
+        // The library's own limits (|g| <= 1e6, strength in [0, 1e6]).
+        check_inputs(&inputs)?;
+        if inputs != self.model.inputs {
+            self.model.inputs = inputs;
+            inputs.apply(&mut self.model.sim)?;
+        }
+        if reals != self.model.config.reals {
+            self.model.config.reals = reals;
+            self.model.dirty = true;
+        }
+        Ok(())
+    }
+
+    pub fn set_integer(&mut self, vrs: &[u32], _vals: &[c_int]) -> Res {
+        self.require_set_input("fmi2SetInteger")?;
+        match vrs.first() {
+            None => Ok(()),
+            Some(vr) => error(format!(
+                "fmi2SetInteger: value reference {vr} is not an Integer input or parameter"
+            )),
+        }
+    }
+
+    pub fn set_boolean(&mut self, vrs: &[u32], vals: &[c_int]) -> Res {
+        self.require_set_input("fmi2SetBoolean")?;
+        let mut active = self.model.inputs.active;
+        let mut plasticity = self.model.config.plasticity;
+        for (&vr, &v) in vrs.iter().zip(vals) {
+            match vr {
+                VR_ATTRACTOR_ACTIVE => active = v != 0,
+                VR_PLASTICITY => {
+                    self.require_set_parameter("fmi2SetBoolean", vr)?;
+                    plasticity = Some(v != 0);
+                }
+                _ => {
+                    return error(format!(
+                        "fmi2SetBoolean: value reference {vr} is not a Boolean input or parameter"
+                    ))
+                }
+            }
+        }
+        if active != self.model.inputs.active {
+            self.model.inputs.active = active;
+            let inputs = self.model.inputs;
+            inputs.apply(&mut self.model.sim)?;
+        }
+        if plasticity != self.model.config.plasticity {
+            self.model.config.plasticity = plasticity;
+            self.model.dirty = true;
+        }
+        Ok(())
+    }
+
+    pub fn set_string(&mut self, vrs: &[u32], vals: &[Option<String>]) -> Res {
+        self.require_set_input("fmi2SetString")?;
+        for (&vr, v) in vrs.iter().zip(vals) {
+            if vr != VR_SCENE {
+                return error(format!(
+                    "fmi2SetString: value reference {vr} is not a String parameter"
+                ));
+            }
+            self.require_set_parameter("fmi2SetString", vr)?;
+            let Some(v) = v else {
+                return error("fmi2SetString: the scene file name is a null pointer");
+            };
+            let base = if v == SCENE_FILE {
+                self.bundled.clone()
+            } else {
+                read_scene(&self.resources.join(v)).or_else(error)?
+            };
+            let yarns = num_yarns(&base);
+            if yarns != self.yarns {
+                return error(format!(
+                    "fmi2SetString: scene {v:?} creates {yarns} yarns, but this FMU has outputs for {}",
+                    self.yarns
+                ));
+            }
+            self.model.config.scene_path = v.clone();
+            self.model.base = base;
+            self.model.dirty = true;
+        }
+        Ok(())
+    }
+
+    pub fn get_fmu_state(&mut self, into: Option<&mut Snapshot>) -> Res<Option<Box<Snapshot>>> {
+        use Phase::*;
+        self.require(
+            "fmi2GetFMUstate",
+            &[
+                Instantiated,
+                InitializationMode,
+                StepComplete,
+                StepFailed,
+                Terminated,
+            ],
+        )?;
+        // A snapshot always holds a simulation built from its parameters.
+        self.model.ensure_built(self.yarns)?;
+        match into {
+            Some(s) => {
+                s.phase = self.phase;
+                s.model = self.model.clone();
+                s.bytes = None;
+                Ok(None)
+            }
+            None => Ok(Some(Box::new(Snapshot {
+                magic: SNAPSHOT_MAGIC,
+                phase: self.phase,
+                model: self.model.clone(),
+                bytes: None,
+            }))),
+        }
+    }
+
+    pub fn set_fmu_state(&mut self, s: &Snapshot) -> Res {
+        use Phase::*;
+        self.require(
+            "fmi2SetFMUstate",
+            &[
+                Instantiated,
+                InitializationMode,
+                StepComplete,
+                StepFailed,
+                Terminated,
+                Error,
+            ],
+        )?;
+        if s.model.sim.num_yarns() != self.yarns {
+            return error(
+                "fmi2SetFMUstate: the state belongs to an FMU with another number of yarns",
+            );
+        }
+        self.model = s.model.clone();
+        self.phase = s.phase;
+        self.log(
+            Status::Ok,
+            LOG_EVENTS,
+            &format!("state restored: t = {}", self.model.time),
+        );
+        Ok(())
+    }
+
+    fn require_state_phase(&self, func: &str) -> Res {
+        use Phase::*;
+        self.require(
+            func,
+            &[
+                Instantiated,
+                InitializationMode,
+                StepComplete,
+                StepFailed,
+                Terminated,
+                Error,
+            ],
+        )
+    }
+
+    /// The serialized bytes of a snapshot (made once, then cached).
+    pub fn serialize<'a>(&self, func: &str, s: &'a mut Snapshot) -> Res<&'a [u8]> {
+        self.require_state_phase(func)?;
+        if s.bytes.is_none() {
+            s.bytes = Some(serialize(s.phase, &s.model));
+        }
+        Ok(s.bytes.as_deref().unwrap())
+    }
+
+    pub fn deserialize(&mut self, bytes: &[u8]) -> Res<Box<Snapshot>> {
+        self.require_state_phase("fmi2DeSerializeFMUstate")?;
+        let (phase, model) = deserialize(bytes, &self.model, self.yarns)
+            .or_else(|e| error(format!("fmi2DeSerializeFMUstate: {e}")))?;
+        Ok(Box::new(Snapshot {
+            magic: SNAPSHOT_MAGIC,
+            phase,
+            model,
+            bytes: Some(bytes.to_vec()),
+        }))
+    }
+
+    pub fn last_successful_time(&self) -> f64 {
+        self.model.last_successful_time
+    }
+
+    pub fn terminated(&self) -> bool {
+        self.model.terminated
+    }
+}
+
+/// A C string of `s` with NUL bytes dropped.
+pub fn escape_nul(s: &str) -> CString {
+    CString::new(s.replace('\0', "")).expect("NUL removed")
+}
+
+/// The library's input checks, without a simulation at hand.
+fn check_inputs(i: &Inputs) -> Res {
+    let g = Vec2::from(i.gravity);
+    if g.norm() > 1e6 {
+        return error(format!(
+            "fmi2SetReal: gravity ({}, {}) is absurd (|g| above 1e6 m/s2)",
+            g.x, g.y
+        ));
+    }
+    if !(0.0..=1e6).contains(&i.strength) {
+        return error(format!(
+            "fmi2SetReal: attractor strength {} must be in [0, 1e6] m/s2",
+            i.strength
+        ));
+    }
+    Ok(())
+}
+
+struct Writer(Vec<u8>);
+
+impl Writer {
+    fn u8(&mut self, v: u8) {
+        self.0.push(v);
+    }
+    fn u64(&mut self, v: u64) {
+        self.0.extend_from_slice(&v.to_le_bytes());
+    }
+    fn f64(&mut self, v: f64) {
+        self.0.extend_from_slice(&v.to_le_bytes());
+    }
+    fn opt_f64(&mut self, v: Option<f64>) {
+        self.u8(v.is_some() as u8);
+        self.f64(v.unwrap_or(0.0));
+    }
+    fn bytes(&mut self, b: &[u8]) {
+        self.u64(b.len() as u64);
+        self.0.extend_from_slice(b);
+    }
+}
+
+struct Reader<'a> {
+    b: &'a [u8],
+    at: usize,
+}
+
+impl<'a> Reader<'a> {
+    fn take(&mut self, n: usize) -> Result<&'a [u8], String> {
+        if self.b.len() - self.at < n {
+            return Err(format!(
+                "state is truncated: {} more bytes needed at offset {}",
+                n, self.at
+            ));
+        }
+        let s = &self.b[self.at..self.at + n];
+        self.at += n;
+        Ok(s)
+    }
+    fn u8(&mut self) -> Result<u8, String> {
+        Ok(self.take(1)?[0])
+    }
+    fn bool(&mut self) -> Result<bool, String> {
+        match self.u8()? {
+            0 => Ok(false),
+            1 => Ok(true),
+            b => Err(format!("bad flag byte {b}")),
+        }
+    }
+    fn u64(&mut self) -> Result<u64, String> {
+        Ok(u64::from_le_bytes(self.take(8)?.try_into().unwrap()))
+    }
+    fn f64(&mut self) -> Result<f64, String> {
+        let v = f64::from_le_bytes(self.take(8)?.try_into().unwrap());
+        if v.is_finite() {
+            Ok(v)
+        } else {
+            Err("state contains a non-finite number".into())
+        }
+    }
+    fn opt_f64(&mut self) -> Result<Option<f64>, String> {
+        let some = self.bool()?;
+        let v = self.f64()?;
+        Ok(some.then_some(v))
+    }
+    fn bytes(&mut self) -> Result<&'a [u8], String> {
+        let n = self.u64()?;
+        let n = usize::try_from(n).map_err(|_| "bad length".to_string())?;
+        self.take(n)
+    }
+    fn string(&mut self) -> Result<String, String> {
+        String::from_utf8(self.bytes()?.to_vec()).map_err(|_| "string is not UTF-8".to_string())
+    }
+}
+
+/// The FMU state as bytes: magic, version, body length, FNV-1a checksum of
+/// the body; the body holds the state machine state, the wrapper's time
+/// keeping, the inputs, the parameters, the scene text and the library's own
+/// state bytes (which carry their own header and checksum). No pointers.
+pub fn serialize(phase: Phase, m: &Model) -> Vec<u8> {
+    let mut w = Writer(Vec::new());
+    w.u8(phase.code());
+    w.u8(m.terminated as u8);
+    w.u8(m.dirty as u8);
+    w.f64(m.start_time);
+    w.opt_f64(m.stop_time);
+    w.f64(m.time);
+    w.f64(m.last_successful_time);
+    w.u64(m.substeps);
+    w.f64(m.inputs.attractor[0]);
+    w.f64(m.inputs.attractor[1]);
+    w.f64(m.inputs.strength);
+    w.u8(m.inputs.active as u8);
+    w.f64(m.inputs.gravity[0]);
+    w.f64(m.inputs.gravity[1]);
+    w.bytes(m.config.scene_path.as_bytes());
+    for v in m.config.reals {
+        w.opt_f64(v);
+    }
+    w.u8(m.config.plasticity.is_some() as u8);
+    w.u8(m.config.plasticity.unwrap_or(false) as u8);
+    w.bytes(m.base.to_toml_string().as_bytes());
+    w.bytes(&m.sim.save_state());
+    let body = w.0;
+    let mut out = Vec::with_capacity(STATE_HEADER + body.len());
+    out.extend_from_slice(STATE_MAGIC);
+    out.extend_from_slice(&STATE_VERSION.to_le_bytes());
+    out.extend_from_slice(&(body.len() as u64).to_le_bytes());
+    out.extend_from_slice(&fnv1a(&body).to_le_bytes());
+    out.extend_from_slice(&body);
+    out
+}
+
+/// Reads bytes written by [`serialize`]; `current` is reused when its scene
+/// and parameters match, else the simulation is rebuilt from the stored scene.
+pub fn deserialize(bytes: &[u8], current: &Model, yarns: usize) -> Result<(Phase, Model), String> {
+    if bytes.len() < STATE_HEADER {
+        return Err(format!(
+            "state has {} bytes, at least {STATE_HEADER} needed",
+            bytes.len()
+        ));
+    }
+    if &bytes[..8] != STATE_MAGIC {
+        return Err("state does not start with the YarnBundle FMU state magic".into());
+    }
+    let version = u32::from_le_bytes(bytes[8..12].try_into().unwrap());
+    if version != STATE_VERSION {
+        return Err(format!(
+            "state format version {version} is not {STATE_VERSION}"
+        ));
+    }
+    let len = u64::from_le_bytes(bytes[12..20].try_into().unwrap());
+    let sum = u64::from_le_bytes(bytes[20..28].try_into().unwrap());
+    let body = &bytes[STATE_HEADER..];
+    if len != body.len() as u64 {
+        return Err(format!(
+            "state declares {len} body bytes but has {}",
+            body.len()
+        ));
+    }
+    if fnv1a(body) != sum {
+        return Err("state checksum does not match: the bytes are corrupt".into());
+    }
+    let mut r = Reader { b: body, at: 0 };
+    let phase = Phase::from_code(r.u8()?).ok_or("bad state machine state")?;
+    if matches!(phase, Phase::Error | Phase::Fatal) {
+        return Err("state was saved in an error state".into());
+    }
+    let terminated = r.bool()?;
+    let dirty = r.bool()?;
+    let start_time = r.f64()?;
+    let stop_time = r.opt_f64()?;
+    let time = r.f64()?;
+    let last_successful_time = r.f64()?;
+    let substeps = r.u64()?;
+    let inputs = Inputs {
+        attractor: [r.f64()?, r.f64()?],
+        strength: r.f64()?,
+        active: r.bool()?,
+        gravity: [r.f64()?, r.f64()?],
+    };
+    check_inputs(&inputs).map_err(|f| f.msg)?;
+    let scene_path = r.string()?;
+    let mut reals = [None; 7];
+    for v in &mut reals {
+        *v = r.opt_f64()?;
+    }
+    let has_p = r.bool()?;
+    let p = r.bool()?;
+    let config = Config {
+        scene_path,
+        reals,
+        plasticity: has_p.then_some(p),
+    };
+    let scene_text = r.string()?;
+    let sim_bytes = r.bytes()?;
+    if r.at != body.len() {
+        return Err(format!(
+            "state has {} unexpected trailing bytes",
+            body.len() - r.at
+        ));
+    }
+    let base = if scene_text == current.base.to_toml_string() {
+        current.base.clone()
+    } else {
+        YarnScene::from_toml_str(&scene_text).map_err(|e| format!("stored scene: {e}"))?
+    };
+    let scene = effective_scene(&base, &config);
+    let mut sim = if !current.dirty && base == current.base && config == current.config {
+        current.sim.clone()
+    } else {
+        YarnSim::new(&scene).map_err(|e| format!("stored scene: {e}"))?
+    };
+    if sim.num_yarns() != yarns {
+        return Err(format!(
+            "state has {} yarns, this FMU {yarns}",
+            sim.num_yarns()
+        ));
+    }
+    sim.load_state(sim_bytes).map_err(|e| e.to_string())?;
+    Ok((
+        phase,
+        Model {
+            config,
+            base,
+            sim,
+            inputs,
+            dirty,
+            start_time,
+            stop_time,
+            time,
+            last_successful_time,
+            substeps,
+            terminated,
+            diag: None,
+        },
+    ))
+}

@@ -1,0 +1,489 @@
+//! The FMU's variables, its GUID and its `modelDescription.xml`, all derived
+//! from the scene the FMU runs: the number of yarns fixes the outputs, the
+//! scene's material, substep and inputs give the start values.
+
+use std::fmt::Write as _;
+
+use yarnsim::mpm::state::fnv1a;
+use yarnsim::scene::YarnScene;
+
+/// The FMI model identifier: the shared library's and the C symbols' name.
+pub const MODEL_IDENTIFIER: &str = "YarnBundle";
+
+/// Bumped whenever the variable layout changes; part of the GUID.
+pub const INTERFACE_VERSION: u32 = 1;
+
+/// Name of the scene file inside the FMU's `resources/` folder.
+pub const SCENE_FILE: &str = "scene.toml";
+
+// Value references. They are unique across all types.
+pub const VR_ATTRACTOR_X: u32 = 1;
+pub const VR_ATTRACTOR_Y: u32 = 2;
+pub const VR_ATTRACTOR_STRENGTH: u32 = 3;
+pub const VR_ATTRACTOR_ACTIVE: u32 = 4; // Boolean
+pub const VR_GRAVITY_X: u32 = 5;
+pub const VR_GRAVITY_Y: u32 = 6;
+pub const VR_K: u32 = 10;
+pub const VR_GAMMA: u32 = 11;
+pub const VR_YOUNGS_MODULUS: u32 = 12;
+pub const VR_FRICTION: u32 = 13;
+pub const VR_BENDING: u32 = 14;
+pub const VR_DENSITY: u32 = 15;
+pub const VR_DT: u32 = 16;
+pub const VR_PLASTICITY: u32 = 17; // Boolean
+pub const VR_KINETIC_ENERGY: u32 = 100;
+pub const VR_ELASTIC_ENERGY: u32 = 101;
+pub const VR_MAX_STRETCH: u32 = 102;
+pub const VR_SUBSTEPS: u32 = 200; // Integer
+pub const VR_SCENE: u32 = 300; // String
+/// `yarn[i].left.x` has `VR_YARN_BASE + 4 i`, then `left.y`, `right.x`, `right.y`.
+pub const VR_YARN_BASE: u32 = 1000;
+
+/// The real parameters in value-reference order `VR_K..=VR_DT`.
+pub const REAL_PARAMETERS: [u32; 7] = [
+    VR_K,
+    VR_GAMMA,
+    VR_YOUNGS_MODULUS,
+    VR_FRICTION,
+    VR_BENDING,
+    VR_DENSITY,
+    VR_DT,
+];
+
+/// The standard FMI 2.0 log categories, all of which this FMU uses.
+pub const LOG_CATEGORIES: [(&str, &str); 7] = [
+    (
+        "logEvents",
+        "Life-cycle events: instantiation, initialization, termination, reset, state restore",
+    ),
+    ("logStatusWarning", "Calls that return fmi2Warning"),
+    (
+        "logStatusDiscard",
+        "Calls that return fmi2Discard (a diverged step)",
+    ),
+    (
+        "logStatusError",
+        "Calls that return fmi2Error (always logged)",
+    ),
+    (
+        "logStatusFatal",
+        "Calls that return fmi2Fatal (always logged)",
+    ),
+    (
+        "logStatusPending",
+        "Calls that return fmi2Pending (never: no asynchronous steps)",
+    ),
+    ("logAll", "Every call with its arguments"),
+];
+
+/// The FMI base type of a variable.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum VarType {
+    Real,
+    Integer,
+    Boolean,
+    String,
+}
+
+/// A variable of the FMU as it appears in `modelDescription.xml`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Variable {
+    pub name: String,
+    pub vr: u32,
+    pub ty: VarType,
+    /// `"parameter"`, `"input"` or `"output"`.
+    pub causality: &'static str,
+    /// `"fixed"`, `"discrete"` or `"continuous"`.
+    pub variability: &'static str,
+    pub unit: Option<&'static str>,
+    /// Start value as written in the XML (inputs and parameters only).
+    pub start: Option<String>,
+    pub description: String,
+}
+
+/// Formats an `f64` so that it reads back to the same bits (shortest round trip).
+pub fn real(v: f64) -> String {
+    format!("{v:?}")
+}
+
+fn boolean(b: bool) -> String {
+    if b { "true" } else { "false" }.to_string()
+}
+
+/// Number of yarns the scene creates (fixes the outputs).
+pub fn num_yarns(scene: &YarnScene) -> usize {
+    scene.curves().len()
+}
+
+/// Every variable of the FMU for this scene, in `ModelVariables` order.
+pub fn variables(scene: &YarnScene) -> Vec<Variable> {
+    let mut v = Vec::new();
+    let mut add = |name: &str,
+                   vr: u32,
+                   ty: VarType,
+                   causality: &'static str,
+                   variability: &'static str,
+                   unit: Option<&'static str>,
+                   start: Option<String>,
+                   description: &str| {
+        v.push(Variable {
+            name: name.to_string(),
+            vr,
+            ty,
+            causality,
+            variability,
+            unit,
+            start,
+            description: description.to_string(),
+        })
+    };
+    use VarType::{Boolean, Integer, Real};
+    let a = &scene.attractor;
+    let m = &scene.material;
+    add(
+        "attractor.x",
+        VR_ATTRACTOR_X,
+        Real,
+        "input",
+        "continuous",
+        Some("m"),
+        Some(real(a.position[0])),
+        "Attractor position x",
+    );
+    add(
+        "attractor.y",
+        VR_ATTRACTOR_Y,
+        Real,
+        "input",
+        "continuous",
+        Some("m"),
+        Some(real(a.position[1])),
+        "Attractor position y",
+    );
+    add(
+        "attractor.strength",
+        VR_ATTRACTOR_STRENGTH,
+        Real,
+        "input",
+        "continuous",
+        Some("m/s2"),
+        Some(real(a.strength)),
+        "Attractor acceleration magnitude, 0 to 1e6",
+    );
+    add(
+        "attractor.active",
+        VR_ATTRACTOR_ACTIVE,
+        Boolean,
+        "input",
+        "discrete",
+        None,
+        Some(boolean(a.active)),
+        "Whether the attractor acts",
+    );
+    add(
+        "gravity.x",
+        VR_GRAVITY_X,
+        Real,
+        "input",
+        "continuous",
+        Some("m/s2"),
+        Some(real(scene.gravity[0])),
+        "Gravity x, |g| at most 1e6",
+    );
+    add(
+        "gravity.y",
+        VR_GRAVITY_Y,
+        Real,
+        "input",
+        "continuous",
+        Some("m/s2"),
+        Some(real(scene.gravity[1])),
+        "Gravity y, |g| at most 1e6",
+    );
+    add(
+        "material.k",
+        VR_K,
+        Real,
+        "parameter",
+        "fixed",
+        Some("Pa"),
+        Some(real(m.k)),
+        "Fiber stretch stiffness",
+    );
+    add(
+        "material.gamma",
+        VR_GAMMA,
+        Real,
+        "parameter",
+        "fixed",
+        Some("Pa"),
+        Some(real(m.gamma)),
+        "Fiber shear stiffness",
+    );
+    add(
+        "material.youngs_modulus",
+        VR_YOUNGS_MODULUS,
+        Real,
+        "parameter",
+        "fixed",
+        Some("Pa"),
+        Some(real(m.youngs_modulus)),
+        "Young's modulus of the cross-section",
+    );
+    add(
+        "material.friction",
+        VR_FRICTION,
+        Real,
+        "parameter",
+        "fixed",
+        None,
+        Some(real(m.friction)),
+        "Mohr-Coulomb friction coefficient",
+    );
+    add(
+        "material.bending",
+        VR_BENDING,
+        Real,
+        "parameter",
+        "fixed",
+        Some("Pa"),
+        Some(real(m.bending)),
+        "Bending modulus (0 disables bending)",
+    );
+    add(
+        "material.density",
+        VR_DENSITY,
+        Real,
+        "parameter",
+        "fixed",
+        Some("kg/m"),
+        Some(real(m.density)),
+        "Line density",
+    );
+    add(
+        "dt",
+        VR_DT,
+        Real,
+        "parameter",
+        "fixed",
+        Some("s"),
+        Some(real(scene.time.dt)),
+        "Substep size; a communication step runs an integer number of substeps",
+    );
+    add(
+        "material.plasticity",
+        VR_PLASTICITY,
+        Boolean,
+        "parameter",
+        "fixed",
+        None,
+        Some(boolean(m.plasticity)),
+        "Mohr-Coulomb return mapping on or off",
+    );
+    add("scene", VR_SCENE, VarType::String, "parameter", "fixed", None, Some(SCENE_FILE.to_string()), "Scene file: a path relative to the FMU's resources folder, or absolute; it must create as many yarns as the bundled scene");
+    add(
+        "kinetic_energy",
+        VR_KINETIC_ENERGY,
+        Real,
+        "output",
+        "continuous",
+        Some("J"),
+        None,
+        "Kinetic energy (per unit depth)",
+    );
+    add(
+        "elastic_energy",
+        VR_ELASTIC_ENERGY,
+        Real,
+        "output",
+        "continuous",
+        Some("J"),
+        None,
+        "Elastic energy (per unit depth)",
+    );
+    add(
+        "max_stretch",
+        VR_MAX_STRETCH,
+        Real,
+        "output",
+        "continuous",
+        None,
+        None,
+        "Largest segment stretch |x_r - x_l| / l0",
+    );
+    add(
+        "substeps",
+        VR_SUBSTEPS,
+        Integer,
+        "output",
+        "discrete",
+        None,
+        None,
+        "Substeps taken since initialization",
+    );
+    for i in 0..num_yarns(scene) {
+        for (k, end, axis) in [
+            (0, "left", "x"),
+            (1, "left", "y"),
+            (2, "right", "x"),
+            (3, "right", "y"),
+        ] {
+            add(
+                &format!("yarn[{i}].{end}.{axis}"),
+                VR_YARN_BASE + 4 * i as u32 + k,
+                Real,
+                "output",
+                "continuous",
+                Some("m"),
+                None,
+                &format!("Yarn {i}, {end} end, {axis}"),
+            );
+        }
+    }
+    v
+}
+
+/// The GUID of the FMU for this scene: a hash of the interface version and
+/// the scene's normalized TOML text.
+pub fn guid(scene: &YarnScene) -> String {
+    let text = format!(
+        "{MODEL_IDENTIFIER} fmi2 interface {INTERFACE_VERSION}\n{}",
+        scene.to_toml_string()
+    );
+    let a = fnv1a(text.as_bytes());
+    let b = fnv1a(format!("{text}\u{1}").as_bytes());
+    format!(
+        "{{{:08x}-{:04x}-{:04x}-{:04x}-{:012x}}}",
+        a >> 32,
+        (a >> 16) & 0xffff,
+        a & 0xffff,
+        b >> 48,
+        b & 0xffff_ffff_ffff
+    )
+}
+
+/// Escapes text for an XML attribute.
+pub fn xml_escape(s: &str) -> String {
+    let mut out = String::with_capacity(s.len());
+    for c in s.chars() {
+        match c {
+            '&' => out.push_str("&amp;"),
+            '<' => out.push_str("&lt;"),
+            '>' => out.push_str("&gt;"),
+            '"' => out.push_str("&quot;"),
+            '\'' => out.push_str("&apos;"),
+            c if (c as u32) < 0x20 => out.push(' '),
+            c => out.push(c),
+        }
+    }
+    out
+}
+
+/// Units used by the variables with their SI base-unit exponents.
+const UNITS: [(&str, &str); 6] = [
+    ("J", r#"kg="1" m="2" s="-2""#),
+    ("Pa", r#"kg="1" m="-1" s="-2""#),
+    ("kg/m", r#"kg="1" m="-1""#),
+    ("m", r#"m="1""#),
+    ("m/s2", r#"m="1" s="-2""#),
+    ("s", r#"s="1""#),
+];
+
+/// Stop time of the `DefaultExperiment`: 30 output frames of the scene.
+pub fn default_stop_time(scene: &YarnScene) -> f64 {
+    30.0 * scene.time.frame_dt
+}
+
+/// The complete `modelDescription.xml` of the FMU for this scene.
+pub fn model_description(scene: &YarnScene) -> String {
+    let vars = variables(scene);
+    let mut x = String::new();
+    let description = if scene.description.is_empty() {
+        format!("MPM yarn bundle, scene {}", scene.name)
+    } else {
+        format!(
+            "MPM yarn bundle, scene {}: {}",
+            scene.name, scene.description
+        )
+    };
+    x.push_str("<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n");
+    let _ = writeln!(
+        x,
+        "<fmiModelDescription fmiVersion=\"2.0\" modelName=\"{MODEL_IDENTIFIER}\" guid=\"{}\" description=\"{}\" generationTool=\"yarnsim-fmu {}\" variableNamingConvention=\"structured\" numberOfEventIndicators=\"0\">",
+        guid(scene),
+        xml_escape(&description),
+        env!("CARGO_PKG_VERSION"),
+    );
+    let _ = writeln!(
+        x,
+        "  <CoSimulation modelIdentifier=\"{MODEL_IDENTIFIER}\" canHandleVariableCommunicationStepSize=\"true\" canInterpolateInputs=\"false\" maxOutputDerivativeOrder=\"0\" canRunAsynchronuously=\"false\" canBeInstantiatedOnlyOncePerProcess=\"false\" canNotUseMemoryManagementFunctions=\"true\" canGetAndSetFMUstate=\"true\" canSerializeFMUstate=\"true\" providesDirectionalDerivative=\"false\"/>"
+    );
+    x.push_str("  <UnitDefinitions>\n");
+    for (name, base) in UNITS {
+        let _ = writeln!(
+            x,
+            "    <Unit name=\"{}\"><BaseUnit {base}/></Unit>",
+            xml_escape(name)
+        );
+    }
+    x.push_str("  </UnitDefinitions>\n  <LogCategories>\n");
+    for (name, d) in LOG_CATEGORIES {
+        let _ = writeln!(
+            x,
+            "    <Category name=\"{name}\" description=\"{}\"/>",
+            xml_escape(d)
+        );
+    }
+    x.push_str("  </LogCategories>\n");
+    let _ = writeln!(
+        x,
+        "  <DefaultExperiment startTime=\"0.0\" stopTime=\"{}\" stepSize=\"{}\"/>",
+        real(default_stop_time(scene)),
+        real(scene.time.frame_dt)
+    );
+    x.push_str("  <ModelVariables>\n");
+    for (i, v) in vars.iter().enumerate() {
+        let _ = writeln!(x, "    <!-- index {} -->", i + 1);
+        let _ = write!(
+            x,
+            "    <ScalarVariable name=\"{}\" valueReference=\"{}\" description=\"{}\" causality=\"{}\" variability=\"{}\"",
+            xml_escape(&v.name),
+            v.vr,
+            xml_escape(&v.description),
+            v.causality,
+            v.variability
+        );
+        // Parameters are initial="exact" by default, inputs take no initial,
+        // outputs default to initial="calculated".
+        x.push_str(">\n      <");
+        x.push_str(match v.ty {
+            VarType::Real => "Real",
+            VarType::Integer => "Integer",
+            VarType::Boolean => "Boolean",
+            VarType::String => "String",
+        });
+        if let Some(u) = v.unit {
+            let _ = write!(x, " unit=\"{}\"", xml_escape(u));
+        }
+        if let Some(s) = &v.start {
+            let _ = write!(x, " start=\"{}\"", xml_escape(s));
+        }
+        x.push_str("/>\n    </ScalarVariable>\n");
+    }
+    x.push_str("  </ModelVariables>\n  <ModelStructure>\n    <Outputs>\n");
+    let outputs: Vec<usize> = vars
+        .iter()
+        .enumerate()
+        .filter(|(_, v)| v.causality == "output")
+        .map(|(i, _)| i + 1)
+        .collect();
+    for i in &outputs {
+        let _ = writeln!(x, "      <Unknown index=\"{i}\"/>");
+    }
+    x.push_str("    </Outputs>\n    <InitialUnknowns>\n");
+    for i in &outputs {
+        let _ = writeln!(x, "      <Unknown index=\"{i}\"/>");
+    }
+    x.push_str("    </InitialUnknowns>\n  </ModelStructure>\n</fmiModelDescription>\n");
+    x
+}

@@ -1,0 +1,261 @@
+//! A small FMI 2.0 master for the tests: it calls the exported C functions
+//! (through the rlib; the same code as the cdylib) and collects log lines.
+#![allow(dead_code)]
+
+use std::ffi::{c_char, c_int, c_void, CStr, CString};
+use std::path::PathBuf;
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::Mutex;
+
+use yarnsim::scene::YarnScene;
+use YarnBundle::ffi::*;
+use YarnBundle::instance::Logger;
+use YarnBundle::model::*;
+
+pub const SMALL_SCENE: &str = include_str!("../../scenes/small.toml");
+
+pub fn small_scene() -> YarnScene {
+    YarnScene::from_toml_str(SMALL_SCENE).unwrap()
+}
+
+/// A fresh resources folder holding `scene` as `scene.toml`, as the
+/// packager writes it.
+pub fn resources(scene: &YarnScene) -> PathBuf {
+    static N: AtomicUsize = AtomicUsize::new(0);
+    let dir = std::env::temp_dir().join(format!(
+        "yarnbundle-test-{}-{}",
+        std::process::id(),
+        N.fetch_add(1, Ordering::Relaxed)
+    ));
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(dir.join(SCENE_FILE), scene.to_toml_string()).unwrap();
+    dir
+}
+
+/// One log line: status, category, message.
+pub type Line = (c_int, String, String);
+
+/// The logger as the environment supplies it. FMI declares it variadic; the
+/// FMU passes a pre-formatted message and no extra arguments, so a
+/// non-variadic function with the fixed parameters receives it correctly
+/// on the SysV x86-64 ABI.
+extern "C" fn logger(
+    env: *mut c_void,
+    _name: *const c_char,
+    status: c_int,
+    category: *const c_char,
+    message: *const c_char,
+) {
+    // SAFETY: `env` is the `Mutex<Vec<Line>>` of the `Fmu` that owns the
+    // instance; the strings are valid C strings for the call.
+    unsafe {
+        let lines = &*(env as *const Mutex<Vec<Line>>);
+        let cat = CStr::from_ptr(category).to_string_lossy().into_owned();
+        let msg = CStr::from_ptr(message).to_string_lossy().into_owned();
+        lines.lock().unwrap().push((status, cat, msg));
+    }
+}
+
+pub fn logger_fn() -> Logger {
+    // SAFETY: see `logger`: same fixed parameters, no variadic part is read.
+    unsafe {
+        std::mem::transmute::<
+            extern "C" fn(*mut c_void, *const c_char, c_int, *const c_char, *const c_char),
+            Logger,
+        >(logger)
+    }
+}
+
+pub struct Fmu {
+    pub c: fmi2Component,
+    pub log: Box<Mutex<Vec<Line>>>,
+    pub yarns: usize,
+    pub dir: PathBuf,
+}
+
+// The component is only used from the thread that owns the `Fmu`.
+unsafe impl Send for Fmu {}
+
+impl Fmu {
+    /// Instantiates the FMU for `scene` (GUID from the scene).
+    pub fn new(scene: &YarnScene) -> Fmu {
+        Self::try_new(scene, &guid(scene), "test").expect("fmi2Instantiate failed")
+    }
+
+    pub fn try_new(scene: &YarnScene, guid: &str, name: &str) -> Result<Fmu, Vec<Line>> {
+        let dir = resources(scene);
+        let log: Box<Mutex<Vec<Line>>> = Box::default();
+        let cb = fmi2CallbackFunctions {
+            logger: Some(logger_fn()),
+            allocateMemory: None,
+            freeMemory: None,
+            stepFinished: None,
+            componentEnvironment: &*log as *const _ as *mut c_void,
+        };
+        let uri = CString::new(format!("file://{}", dir.display())).unwrap();
+        let name = CString::new(name).unwrap();
+        let guid = CString::new(guid).unwrap();
+        let c = unsafe {
+            fmi2Instantiate(
+                name.as_ptr(),
+                fmi2CoSimulation,
+                guid.as_ptr(),
+                uri.as_ptr(),
+                &cb,
+                fmi2False,
+                fmi2False,
+            )
+        };
+        if c.is_null() {
+            return Err(log.lock().unwrap().clone());
+        }
+        Ok(Fmu {
+            c,
+            log,
+            yarns: num_yarns(scene),
+            dir,
+        })
+    }
+
+    pub fn lines(&self) -> Vec<Line> {
+        self.log.lock().unwrap().clone()
+    }
+
+    pub fn last_error(&self) -> String {
+        self.lines()
+            .iter()
+            .rev()
+            .find(|l| l.0 >= fmi2Discard)
+            .map(|l| l.2.clone())
+            .unwrap_or_default()
+    }
+
+    pub fn setup(&self, start: f64, stop: Option<f64>) -> fmi2Status {
+        unsafe {
+            fmi2SetupExperiment(
+                self.c,
+                fmi2False,
+                0.0,
+                start,
+                stop.is_some() as c_int,
+                stop.unwrap_or(0.0),
+            )
+        }
+    }
+
+    /// Setup at 0 without stop time, enter and exit initialization.
+    pub fn init(&self) {
+        assert_eq!(self.setup(0.0, None), fmi2OK);
+        self.init_mode();
+    }
+
+    pub fn init_mode(&self) {
+        unsafe {
+            assert_eq!(fmi2EnterInitializationMode(self.c), fmi2OK);
+            assert_eq!(
+                fmi2ExitInitializationMode(self.c),
+                fmi2OK,
+                "{:?}",
+                self.lines()
+            );
+        }
+    }
+
+    pub fn set_real(&self, vr: &[u32], v: &[f64]) -> fmi2Status {
+        assert_eq!(vr.len(), v.len());
+        unsafe { fmi2SetReal(self.c, vr.as_ptr(), vr.len(), v.as_ptr()) }
+    }
+
+    pub fn set_bool(&self, vr: u32, v: bool) -> fmi2Status {
+        let v = v as fmi2Boolean;
+        unsafe { fmi2SetBoolean(self.c, &vr, 1, &v) }
+    }
+
+    pub fn get_real(&self, vr: &[u32]) -> Result<Vec<f64>, fmi2Status> {
+        let mut out = vec![f64::NAN; vr.len()];
+        match unsafe { fmi2GetReal(self.c, vr.as_ptr(), vr.len(), out.as_mut_ptr()) } {
+            s if s == fmi2OK => Ok(out),
+            s => Err(s),
+        }
+    }
+
+    pub fn substeps(&self) -> i32 {
+        let mut v = -1;
+        assert_eq!(
+            unsafe { fmi2GetInteger(self.c, &VR_SUBSTEPS, 1, &mut v) },
+            fmi2OK
+        );
+        v
+    }
+
+    pub fn do_step(&self, t: f64, h: f64) -> fmi2Status {
+        unsafe { fmi2DoStep(self.c, t, h, fmi2True) }
+    }
+
+    /// Value references of every yarn end coordinate.
+    pub fn yarn_vrs(&self) -> Vec<u32> {
+        (0..4 * self.yarns as u32)
+            .map(|k| VR_YARN_BASE + k)
+            .collect()
+    }
+
+    /// Yarn ends followed by kinetic energy, elastic energy, max stretch.
+    pub fn outputs(&self) -> Vec<f64> {
+        let mut vrs = self.yarn_vrs();
+        vrs.extend([VR_KINETIC_ENERGY, VR_ELASTIC_ENERGY, VR_MAX_STRETCH]);
+        self.get_real(&vrs)
+            .unwrap_or_else(|s| panic!("fmi2GetReal: {s} {:?}", self.lines()))
+    }
+
+    pub fn get_state(&self) -> fmi2FMUstate {
+        let mut s: fmi2FMUstate = std::ptr::null_mut();
+        assert_eq!(unsafe { fmi2GetFMUstate(self.c, &mut s) }, fmi2OK);
+        assert!(!s.is_null());
+        s
+    }
+
+    pub fn serialize(&self, s: fmi2FMUstate) -> Vec<u8> {
+        let mut n = 0usize;
+        assert_eq!(
+            unsafe { fmi2SerializedFMUstateSize(self.c, s, &mut n) },
+            fmi2OK
+        );
+        let mut buf = vec![0u8; n];
+        assert_eq!(
+            unsafe { fmi2SerializeFMUstate(self.c, s, buf.as_mut_ptr() as *mut c_char, n) },
+            fmi2OK
+        );
+        buf
+    }
+
+    /// Deserializes into a new state; the status and the state (null on failure).
+    pub fn deserialize(&self, bytes: &[u8]) -> (fmi2Status, fmi2FMUstate) {
+        let mut s: fmi2FMUstate = std::ptr::null_mut();
+        let st = unsafe {
+            fmi2DeSerializeFMUstate(self.c, bytes.as_ptr() as *const c_char, bytes.len(), &mut s)
+        };
+        (st, s)
+    }
+
+    pub fn free_state(&self, mut s: fmi2FMUstate) {
+        assert_eq!(unsafe { fmi2FreeFMUstate(self.c, &mut s) }, fmi2OK);
+        assert!(s.is_null());
+    }
+}
+
+impl Drop for Fmu {
+    fn drop(&mut self) {
+        unsafe { fmi2FreeInstance(self.c) };
+        let _ = std::fs::remove_dir_all(&self.dir);
+    }
+}
+
+/// Formats outputs for snapshots: 9 significant digits, so the snapshot pins
+/// the trajectory without depending on the last bits of libm.
+pub fn fmt_row(t: f64, v: &[f64]) -> String {
+    let mut s = format!("t={t:.3}");
+    for x in v {
+        s.push_str(&format!(" {x:+.8e}"));
+    }
+    s
+}

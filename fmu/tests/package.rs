@@ -1,0 +1,160 @@
+//! The packaged artefacts: the shared library's exports and dependencies,
+//! the generated modelDescription.xml and the .fmu archive.
+
+mod common;
+
+use std::path::PathBuf;
+
+use yarnsim::scene::builtin::yarn_reference;
+use yarnsim::scene::YarnScene;
+use YarnBundle::model::*;
+use YarnBundle::package::*;
+
+/// The cdylib cargo built next to the test executable's `deps/` folder.
+fn cdylib() -> PathBuf {
+    let exe = std::env::current_exe().unwrap();
+    let dir = exe.parent().unwrap().parent().unwrap();
+    dir.join(format!("lib{MODEL_IDENTIFIER}.so"))
+}
+
+#[test]
+fn shared_library_exports_all_34_functions_and_needs_only_libc() {
+    let path = cdylib();
+    let so = std::fs::read(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let info = elf_info(&so).unwrap();
+    let mut fmi: Vec<&str> = info
+        .exported
+        .iter()
+        .map(|s| s.as_str())
+        .filter(|s| s.starts_with("fmi2"))
+        .collect();
+    fmi.sort();
+    fmi.dedup();
+    let mut expected = FMI2_FUNCTIONS.to_vec();
+    expected.sort();
+    assert_eq!(fmi, expected);
+    assert_eq!(fmi.len(), 34);
+    // libc and libm (plus the loader and libgcc_s, which Rust's unwinder
+    // needs for catch_unwind); nothing else.
+    assert!(
+        info.needed.iter().any(|n| n == "libc.so.6"),
+        "{:?}",
+        info.needed
+    );
+    for n in &info.needed {
+        assert!(
+            ALLOWED_NEEDED.contains(&n.as_str()),
+            "unexpected dependency {n}"
+        );
+    }
+    check_library(&so).unwrap();
+}
+
+#[test]
+fn checked_in_model_description_is_current() {
+    let checked_in = include_str!("../../modelDescription/YarnBundle.xml");
+    let generated = model_description(&yarn_reference());
+    assert!(
+        checked_in == generated,
+        "modelDescription/YarnBundle.xml drifted from the generator; refresh it with\n  cargo run --release -p yarnsim-fmu --bin build-fmu -- --model-description modelDescription/YarnBundle.xml"
+    );
+}
+
+/// Structure rules fmpy's validation checks: unique value references and
+/// names, outputs listed by their 1-based index, inputs with start values.
+#[test]
+fn model_description_structure() {
+    let scene = common::small_scene();
+    let vars = variables(&scene);
+    let xml = model_description(&scene);
+    let yarns = num_yarns(&scene);
+    assert_eq!(yarns, 3);
+    let outputs: Vec<usize> = vars
+        .iter()
+        .enumerate()
+        .filter(|(_, v)| v.causality == "output")
+        .map(|(i, _)| i + 1)
+        .collect();
+    assert_eq!(outputs.len(), 4 * yarns + 4);
+    for i in &outputs {
+        assert_eq!(xml.matches(&format!("<Unknown index=\"{i}\"/>")).count(), 2);
+    }
+    let mut vrs: Vec<(u32, String)> = vars.iter().map(|v| (v.vr, format!("{:?}", v.ty))).collect();
+    vrs.sort();
+    vrs.dedup();
+    assert_eq!(vrs.len(), vars.len());
+    let mut names: Vec<&str> = vars.iter().map(|v| v.name.as_str()).collect();
+    names.sort();
+    names.dedup();
+    assert_eq!(names.len(), vars.len());
+    for v in &vars {
+        if v.causality == "input" || v.causality == "parameter" {
+            assert!(v.start.is_some(), "{}", v.name);
+        } else {
+            assert!(v.start.is_none(), "{}", v.name);
+        }
+        if let Some(u) = v.unit {
+            assert!(xml.contains(&format!("<Unit name=\"{u}\">")), "{u}");
+        }
+    }
+    for name in [
+        "yarn[2].right.y",
+        "attractor.active",
+        "gravity.y",
+        "substeps",
+        "kinetic_energy",
+    ] {
+        assert!(xml.contains(&format!("name=\"{name}\"")), "{name}");
+    }
+    assert!(xml.contains(&format!("guid=\"{}\"", guid(&scene))));
+    // Gravity starts at the scene's (0, -9.8).
+    let g = vars.iter().find(|v| v.name == "gravity.y").unwrap();
+    assert_eq!(g.start.as_deref(), Some("-9.8"));
+}
+
+#[test]
+fn guid_follows_the_scene_and_survives_the_scene_file() {
+    let scene = common::small_scene();
+    let text = scene.to_toml_string();
+    let back = YarnScene::from_toml_str(&text).unwrap();
+    assert_eq!(guid(&back), guid(&scene));
+    let mut other = scene.clone();
+    other.time.dt *= 0.5;
+    assert_ne!(guid(&other), guid(&scene));
+    assert_ne!(guid(&yarn_reference()), guid(&scene));
+}
+
+#[test]
+fn fmu_archive_layout_and_contents() {
+    let scene = common::small_scene();
+    let so = b"\x7fELF not really".to_vec();
+    let zip = build_fmu(&scene, &so).unwrap();
+    let entries = zip_entries(&zip).unwrap();
+    let names: Vec<&str> = entries.iter().map(|(n, _)| n.as_str()).collect();
+    assert_eq!(
+        names,
+        [
+            "modelDescription.xml",
+            "binaries/linux64/YarnBundle.so",
+            "resources/scene.toml",
+            "documentation/index.html"
+        ]
+    );
+    assert_eq!(entries[0].1, model_description(&scene).into_bytes());
+    assert_eq!(entries[1].1, so);
+    let packed = YarnScene::from_toml_str(std::str::from_utf8(&entries[2].1).unwrap()).unwrap();
+    assert_eq!(guid(&packed), guid(&scene));
+    // Reproducible: the same inputs give the same bytes.
+    assert_eq!(build_fmu(&scene, &so).unwrap(), zip);
+    // A corrupted archive is detected.
+    let mut bad = zip.clone();
+    let at = zip.windows(4).position(|w| w == b"kind").unwrap();
+    bad[at] ^= 1;
+    assert!(zip_entries(&bad).is_err());
+}
+
+#[test]
+fn crc32_known_value() {
+    assert_eq!(crc32(b"123456789"), 0xCBF4_3926);
+    assert_eq!(crc32(b""), 0);
+}
