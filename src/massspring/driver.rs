@@ -158,12 +158,26 @@ impl Simulation {
             Integrator::ChebyshevJacobi => {
                 chebyshev::step(sys, s, h, opt.rho, opt.iterations, None)
             }
-            Integrator::Pbd => pbd::step(sys, s, h, limit.unwrap_or(0.0), opt.strain_iterations),
+            Integrator::Pbd => pbd::step(
+                sys,
+                s,
+                h,
+                limit.unwrap_or(0.0),
+                opt.strain_iterations,
+                opt.strain_solver,
+            ),
         };
         if self.integrator != Integrator::Pbd {
             if let Some(limit) = limit {
-                let (n, after) =
-                    pbd::strain_limit(sys, &mut s.x, &mut s.v, h, limit, opt.strain_iterations);
+                let (n, after) = pbd::strain_limit(
+                    sys,
+                    &mut s.x,
+                    &mut s.v,
+                    h,
+                    limit,
+                    opt.strain_iterations,
+                    opt.strain_solver,
+                );
                 stats.strain_passes = n;
                 stats.strain_after_limiting = after;
             }

@@ -28,7 +28,7 @@ use std::fmt;
 
 pub use driver::{Energies, FrameReport, RunTotals, Simulation};
 pub use integrators::stability::StabilityInfo;
-pub use integrators::{Integrator, IntegratorOptions, State, StepStats};
+pub use integrators::{Integrator, IntegratorOptions, State, StepStats, StrainSolver};
 pub use layout::{Layout, System, V3};
 pub use linear::PreconditionerKind;
 

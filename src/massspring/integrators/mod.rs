@@ -22,6 +22,7 @@ use std::str::FromStr;
 
 use super::layout::{System, V3};
 use super::linear::PreconditionerKind;
+pub use pbd::StrainSolver;
 
 /// Positions, velocities and time of a simulation.
 #[derive(Clone, Debug, PartialEq)]
@@ -155,8 +156,10 @@ pub struct IntegratorOptions {
     pub iterations: usize,
     /// Strain limit; overrides the layout's `time.strain_limit`.
     pub strain_limit: Option<f64>,
-    /// Jacobi passes of the strain-limiting projection (default 32, seed 001).
+    /// Passes of the strain-limiting projection (default 32, seed 001).
     pub strain_iterations: usize,
+    /// How a strain-limiting pass visits the springs (default Jacobi, seed 001).
+    pub strain_solver: StrainSolver,
 }
 
 impl Default for IntegratorOptions {
@@ -173,13 +176,14 @@ impl Default for IntegratorOptions {
             iterations: 32,
             strain_limit: None,
             strain_iterations: 32,
+            strain_solver: StrainSolver::Jacobi,
         }
     }
 }
 
 impl IntegratorOptions {
     /// The option names [`IntegratorOptions::set`] knows.
-    pub const KEYS: [&'static str; 11] = [
+    pub const KEYS: [&'static str; 12] = [
         "dt",
         "cfl",
         "preconditioner",
@@ -191,6 +195,7 @@ impl IntegratorOptions {
         "iterations",
         "strain-limit",
         "strain-iterations",
+        "strain-solver",
     ];
 
     /// Sets one option from text, e.g. `set("rho", "0.99")`,
@@ -255,6 +260,7 @@ impl IntegratorOptions {
                 self.strain_limit = Some(v)
             }
             "strain-iterations" => self.strain_iterations = count(0)?,
+            "strain-solver" => self.strain_solver = value.parse()?,
             _ => {
                 return Err(format!(
                     "unknown integrator option {key:?}; known: {}",
