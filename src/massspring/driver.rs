@@ -52,6 +52,30 @@ pub struct FrameReport {
     pub last_step: StepStats,
 }
 
+/// Per-frame diagnostics of a simulation ([`Simulation::diagnostics`]): what
+/// the CLI prints or writes as one CSV row per frame.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Diagnostics {
+    /// Frames completed.
+    pub frame: u32,
+    /// Time in s.
+    pub time: f64,
+    /// Nominal step size in s.
+    pub dt: f64,
+    /// Kinetic, elastic and gravitational energy in J.
+    pub energies: Energies,
+    /// Largest `|l/l0 - 1|` over the springs.
+    pub max_strain: f64,
+    /// Linear momentum `sum m v` in kg m/s.
+    pub momentum: [f64; 3],
+    /// Lowest particle height (y) in m.
+    pub min_height: f64,
+    /// Statistics of the last step.
+    pub last_step: StepStats,
+    /// Totals since the start.
+    pub totals: RunTotals,
+}
+
 /// Totals since the simulation was built.
 #[derive(Clone, Copy, Debug, PartialEq, Default)]
 pub struct RunTotals {
@@ -317,6 +341,37 @@ impl Simulation {
             elastic: elastic_energy(&self.system.springs, &self.state.x),
             gravity: gravity_energy(&self.system, &self.state.x),
         }
+    }
+    /// Everything worth printing about the current state (see [`Diagnostics`]).
+    pub fn diagnostics(&self) -> Diagnostics {
+        let mut p = V3::zeros();
+        for (m, v) in self.system.masses.iter().zip(&self.state.v) {
+            p += v * *m;
+        }
+        Diagnostics {
+            frame: self.frame,
+            time: self.state.t,
+            dt: self.dt,
+            energies: self.energies(),
+            max_strain: self.max_strain(),
+            momentum: [p.x, p.y, p.z],
+            min_height: self
+                .state
+                .x
+                .iter()
+                .map(|x| x.y)
+                .fold(f64::INFINITY, f64::min),
+            last_step: self.last,
+            totals: self.totals,
+        }
+    }
+    /// Frames of a full run (the layout's `time.frames`).
+    pub fn frames(&self) -> u32 {
+        self.system.frames
+    }
+    /// Frame interval in s (the layout's `time.frame_time`).
+    pub fn frame_time(&self) -> f64 {
+        self.system.frame_time
     }
     /// Largest `|l/l0 - 1|` over the springs now.
     pub fn max_strain(&self) -> f64 {

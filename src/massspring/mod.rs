@@ -26,7 +26,7 @@ pub mod scenes;
 
 use std::fmt;
 
-pub use driver::{Energies, FrameReport, RunTotals, Simulation};
+pub use driver::{Diagnostics, Energies, FrameReport, RunTotals, Simulation};
 pub use integrators::stability::StabilityInfo;
 pub use integrators::{Integrator, IntegratorOptions, State, StepStats, StrainSolver};
 pub use layout::{Layout, System, V3};

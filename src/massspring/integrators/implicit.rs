@@ -13,7 +13,12 @@
 //! `(M + theta h B + theta h c H) dv = h f - theta h (H a + B dv_k)`, `a` being
 //! `h v` on free and the prescribed displacement on kinematic particles. One
 //! solve is Baraff-Witkin's step; for backward Euler without damping it is
-//! exactly seed 004's `(M - h^2 K) v' = M v + h f`. With
+//! exactly seed 004's `(M - h^2 K) v' = M v + h f`. The trapezoidal rule
+//! keeps the same matrix but evaluates the known part exactly, right-hand
+//! side `h/2 (f(x, v) + f(x + a, v + dv_k))`: linearising about `(x, v)`
+//! would make it first order wherever the Hessian clamp is active or the
+//! springs are damped (the matrix omits the position derivative of the
+//! damping force), since then `f(x + a) - f(x) + H a = O(h)`. With
 //! `newton_iterations > 1`, chord-Newton corrections with the same matrix
 //! solve the nonlinear equations to `newton_tolerance`.
 
@@ -77,13 +82,32 @@ pub fn step_system(sys: &System, s: &State, h: f64, scheme: Scheme) -> StepSyste
         .map(|(hs, bs)| hs * (theta * h * c) + bs * (theta * h))
         .collect();
     let matrix = assemble_block_system(&map, &sys.masses, &sys.springs, &blocks);
-    let mut corr = vec![V3::zeros(); n];
-    add_block_product(&sys.springs, &hb, &a, &mut corr);
-    add_block_product(&sys.springs, &bb, &dvk, &mut corr);
     let mut rhs = vec![0.0; map.dofs()];
-    for (fi, &p) in map.particle.iter().enumerate() {
-        let r = f[p] * h - corr[p] * (theta * h);
-        rhs[3 * fi..3 * fi + 3].copy_from_slice(r.as_slice());
+    match scheme {
+        Scheme::BackwardEuler => {
+            // Baraff-Witkin / seed 004: f(x + a, v + dvk) ~ f - H a - B dvk.
+            let mut corr = vec![V3::zeros(); n];
+            add_block_product(&sys.springs, &hb, &a, &mut corr);
+            add_block_product(&sys.springs, &bb, &dvk, &mut corr);
+            for (fi, &p) in map.particle.iter().enumerate() {
+                let r = f[p] * h - corr[p] * (theta * h);
+                rhs[3 * fi..3 * fi + 3].copy_from_slice(r.as_slice());
+            }
+        }
+        Scheme::Trapezoidal => {
+            // The known part of the end state is evaluated exactly: only the
+            // dv-dependent part is linearised, so the clamped Hessian and
+            // the omitted position derivative of the damping force cost
+            // O(h^3) per step and the rule stays second order.
+            let xp: Vec<V3> = (0..n).map(|i| s.x[i] + a[i]).collect();
+            let vp: Vec<V3> = (0..n).map(|i| s.v[i] + dvk[i]).collect();
+            let mut fp = vec![V3::zeros(); n];
+            total_forces(sys, &xp, &vp, &mut fp);
+            for (fi, &p) in map.particle.iter().enumerate() {
+                let r = (f[p] * (1.0 - theta) + fp[p] * theta) * h;
+                rhs[3 * fi..3 * fi + 3].copy_from_slice(r.as_slice());
+            }
+        }
     }
     StepSystem { map, matrix, rhs }
 }

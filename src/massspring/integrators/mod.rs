@@ -96,6 +96,35 @@ impl Integrator {
         }
     }
 
+    /// The canonical names of every integrator, in documentation order.
+    pub fn names() -> [&'static str; 6] {
+        Integrator::ALL.map(|i| i.name())
+    }
+
+    /// One line describing the scheme.
+    pub fn description(self) -> &'static str {
+        match self {
+            Integrator::ForwardEuler => {
+                "explicit Euler, step cfl x the computed stability bound (seed 002); needs spring damping"
+            }
+            Integrator::SymplecticEuler => {
+                "semi-implicit Euler (velocity first), step cfl x the bound 2/w_max"
+            }
+            Integrator::Trapezoidal => {
+                "trapezoidal rule, velocity system by PCG with IC(0) or Jacobi (seed 002), 2nd order"
+            }
+            Integrator::BackwardEuler => {
+                "backward Euler, velocity system by PCG (seeds 002/004), 1st order, unconditionally stable"
+            }
+            Integrator::ChebyshevJacobi => {
+                "backward Euler as a minimisation, Jacobi iterations with Chebyshev acceleration (seed 001)"
+            }
+            Integrator::Pbd => {
+                "position-based dynamics: inertia + gravity, then strain limiting (seed 001)"
+            }
+        }
+    }
+
     /// Whether the step is limited by the explicit stability bound.
     pub fn is_explicit(self) -> bool {
         matches!(self, Integrator::ForwardEuler | Integrator::SymplecticEuler)
@@ -318,6 +347,13 @@ mod tests {
             assert_eq!(i.name().parse::<Integrator>().unwrap(), i);
         }
         assert!("leapfrog".parse::<Integrator>().is_err());
+        assert_eq!(
+            "chebyshev".parse::<Integrator>().unwrap(),
+            Integrator::ChebyshevJacobi
+        );
+        assert_eq!(Integrator::names().len(), Integrator::ALL.len());
+        let e = "leapfrog".parse::<Integrator>().unwrap_err();
+        assert!(Integrator::names().iter().all(|n| e.contains(n)), "{e}");
     }
 
     #[test]
