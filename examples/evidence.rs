@@ -1,0 +1,42 @@
+//! Runs the evidence studies without the CLI:
+//! `cargo run --release --example evidence -- precision|stress|skip [--quick] [--out DIR]`.
+
+use std::path::PathBuf;
+
+use yarnsim::evidence::{precision, skip, stress, write_report};
+
+fn main() {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let quick = args.iter().any(|a| a == "--quick");
+    let out = args
+        .iter()
+        .position(|a| a == "--out")
+        .and_then(|i| args.get(i + 1))
+        .map_or(PathBuf::from("evidence-out"), PathBuf::from);
+    let what = args.first().map(String::as_str).unwrap_or("precision");
+    let t0 = std::time::Instant::now();
+    let (text, files) = match what {
+        "precision" => {
+            let r = precision::run(&precision::PrecisionOptions {
+                quick,
+                yarn_reference: args.iter().any(|a| a == "--yarn-reference"),
+            })
+            .unwrap_or_else(|e| panic!("{e}"));
+            (r.to_text(), r.files())
+        }
+        "stress" => {
+            let r = stress::run(&stress::StressOptions { quick });
+            (r.to_text(), r.files())
+        }
+        "skip" => {
+            let r = skip::run(&skip::SkipOptions::default()).unwrap_or_else(|e| panic!("{e}"));
+            (r.to_text(), r.files())
+        }
+        other => panic!("unknown study {other:?}: precision, stress or skip"),
+    };
+    println!("{text}");
+    for f in write_report(&out, &files).expect("output directory writable") {
+        println!("wrote {f}");
+    }
+    println!("elapsed {:.1} s", t0.elapsed().as_secs_f64());
+}
