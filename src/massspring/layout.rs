@@ -497,7 +497,10 @@ impl Layout {
                 return Err(invalid(
                     format!("springs[{si}].particles"),
                     line,
-                    format!("particle index out of range: the scene has {n_total} particles"),
+                    format!(
+                        "particle index {} out of range: the scene has {n_total} particles",
+                        a.max(b)
+                    ),
                 ));
             }
             if a == b {
