@@ -9,10 +9,10 @@ use crate::massspring::layout::{System, V3};
 pub fn forward_euler(sys: &System, s: &mut State, h: f64) -> StepStats {
     let mut f = vec![V3::zeros(); sys.len()];
     total_forces(sys, &s.x, &s.v, &mut f);
-    for i in 0..sys.len() {
+    for (i, fi) in f.iter().enumerate() {
         if sys.is_free(i) {
             s.x[i] += s.v[i] * h;
-            s.v[i] += f[i] * (h / sys.masses[i]);
+            s.v[i] += fi * (h / sys.masses[i]);
         }
     }
     set_kinematics(sys, s.t + h, &mut s.x, &mut s.v);
@@ -23,9 +23,9 @@ pub fn forward_euler(sys: &System, s: &mut State, h: f64) -> StepStats {
 pub fn symplectic_euler(sys: &System, s: &mut State, h: f64) -> StepStats {
     let mut f = vec![V3::zeros(); sys.len()];
     total_forces(sys, &s.x, &s.v, &mut f);
-    for i in 0..sys.len() {
+    for (i, fi) in f.iter().enumerate() {
         if sys.is_free(i) {
-            s.v[i] += f[i] * (h / sys.masses[i]);
+            s.v[i] += fi * (h / sys.masses[i]);
             s.x[i] += s.v[i] * h;
         }
     }

@@ -156,7 +156,10 @@ pub fn step(
     stats.cg_iterations += r.iterations;
     stats.cg_residual = r.relative_residual;
     stats.linear_solves = 1;
-    if !r.converged && !(r.relative_residual < 1e-3) {
+    // A solve stopped by the iteration cap is accepted when it got close
+    // (the step then carries that residual in its statistics).
+    let close = r.relative_residual < 1e-3;
+    if !r.converged && !close {
         return Err(MassSpringError::Solver {
             time: s.t,
             message: format!(
