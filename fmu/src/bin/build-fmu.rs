@@ -2,12 +2,14 @@
 //!
 //! ```text
 //! cargo run --release -p yarnsim-fmu --bin build-fmu -- [--scene NAME_OR_FILE] [-o OUT.fmu]
-//!     [--lib libYarnBundle.so] [--model-description FILE]
+//!     [--lib libYarnBundle.so | --no-build] [--model-description FILE]
 //! ```
 //!
 //! Without `--scene` it packs the default scene (`yarn-reference`) into
 //! `<target>/fmu/YarnBundle.fmu`; another scene goes to
 //! `<target>/fmu/YarnBundle-<scene name>.fmu` unless `-o` says otherwise.
+//! The packager first builds the cdylib (`cargo build -p yarnsim-fmu --lib`,
+//! same profile) unless `--lib` names one or `--no-build` is given.
 //! `--model-description FILE` only writes the generated modelDescription.xml
 //! (used to refresh `modelDescription/YarnBundle.xml`).
 
@@ -18,13 +20,14 @@ use yarnsim::scene::{Scene, DEFAULT_SCENE};
 use YarnBundle::package::{build_fmu, check_library, zip_entries};
 use YarnBundle::{model_description, MODEL_IDENTIFIER};
 
-const USAGE: &str = "usage: build-fmu [--scene NAME_OR_FILE] [-o OUT.fmu] [--lib libYarnBundle.so] [--model-description FILE]";
+const USAGE: &str = "usage: build-fmu [--scene NAME_OR_FILE] [-o OUT.fmu] [--lib libYarnBundle.so | --no-build] [--model-description FILE]";
 
 fn run() -> Result<(), String> {
     let mut scene_arg: Option<String> = None;
     let mut out: Option<PathBuf> = None;
     let mut lib: Option<PathBuf> = None;
     let mut xml_only: Option<PathBuf> = None;
+    let mut no_build = false;
     let mut args = std::env::args().skip(1);
     while let Some(a) = args.next() {
         let mut value = |what: &str| args.next().ok_or(format!("{a} needs {what}\n{USAGE}"));
@@ -33,6 +36,7 @@ fn run() -> Result<(), String> {
             "-o" | "--output" => out = Some(value("a file name")?.into()),
             "--lib" => lib = Some(value("a shared library")?.into()),
             "--model-description" => xml_only = Some(value("a file name")?.into()),
+            "--no-build" => no_build = true,
             "-h" | "--help" => {
                 println!("{USAGE}");
                 return Ok(());
@@ -59,7 +63,15 @@ fn run() -> Result<(), String> {
     // The cdylib sits next to this executable (target/<profile>/).
     let exe = std::env::current_exe().map_err(|e| e.to_string())?;
     let exe_dir = exe.parent().ok_or("no executable directory")?.to_path_buf();
-    let lib = lib.unwrap_or_else(|| exe_dir.join(format!("lib{MODEL_IDENTIFIER}.so")));
+    let lib = match lib {
+        Some(l) => l,
+        None => {
+            if !no_build {
+                build_cdylib(&exe_dir)?;
+            }
+            exe_dir.join(format!("lib{MODEL_IDENTIFIER}.so"))
+        }
+    };
     let so = std::fs::read(&lib).map_err(|e| {
         format!(
             "cannot read {}: {e} (build it with `cargo build --release -p yarnsim-fmu`)",
@@ -107,6 +119,29 @@ fn run() -> Result<(), String> {
         YarnBundle::guid(&scene),
         info.needed.join(" ")
     );
+    Ok(())
+}
+
+/// `cargo run --bin build-fmu` builds the library only as an rlib, so the
+/// packager builds the cdylib itself (same profile and target folder as this
+/// executable) before packing it; `--no-build` skips this.
+fn build_cdylib(exe_dir: &std::path::Path) -> Result<(), String> {
+    let cargo = std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into());
+    let mut cmd = std::process::Command::new(cargo);
+    cmd.current_dir(env!("CARGO_MANIFEST_DIR"))
+        .args(["build", "-p", "yarnsim-fmu", "--lib"]);
+    if exe_dir.file_name().is_some_and(|n| n == "release") {
+        cmd.arg("--release");
+    }
+    if let Some(target) = exe_dir.parent() {
+        cmd.env("CARGO_TARGET_DIR", target);
+    }
+    let status = cmd
+        .status()
+        .map_err(|e| format!("cannot run cargo to build the library: {e} (or pass --lib)"))?;
+    if !status.success() {
+        return Err(format!("building the library failed: {status}"));
+    }
     Ok(())
 }
 

@@ -1,0 +1,152 @@
+//! Measures the FMU's communication-step overhead: what an `fmi2DoStep`
+//! costs beyond the substeps it runs.
+//!
+//! ```text
+//! cargo run --release -p yarnsim-fmu --example step_overhead [SCENE] [CALLS]
+//! ```
+//!
+//! 1. `fmi2DoStep` with h = 1e-9 dt: the substep grid is not reached, so no
+//!    substep runs and the call is pure overhead (pointer and state checks,
+//!    catch_unwind, time and substep bookkeeping).
+//! 2. The fmpy-like cycle: `fmi2SetReal` of 4 inputs + that `fmi2DoStep` +
+//!    `fmi2GetReal` of 4 yarn-end outputs.
+//! 3. For scale: `fmi2DoStep` with h = dt (one substep) against
+//!    `YarnSim::step` called directly, interleaved, alternating which goes
+//!    first (each evicts the other's data from the caches).
+
+use std::ffi::CString;
+use std::hint::black_box;
+use std::time::Instant;
+
+use yarnsim::mpm::YarnSim;
+use yarnsim::scene::Scene;
+use YarnBundle::ffi::*;
+use YarnBundle::model::*;
+
+fn main() {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let scene_arg = args
+        .first()
+        .cloned()
+        .unwrap_or_else(|| concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/small.toml").to_string());
+    let calls: usize = args.get(1).map(|s| s.parse().unwrap()).unwrap_or(2_000_000);
+    let Scene::Yarn(scene) = Scene::resolve(&scene_arg).unwrap() else {
+        panic!("not a yarn scene")
+    };
+    let dir = std::env::temp_dir().join(format!("yarnbundle-bench-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(dir.join(SCENE_FILE), scene.to_toml_string()).unwrap();
+    let uri = CString::new(format!("file://{}", dir.display())).unwrap();
+    let guid = CString::new(guid(&scene)).unwrap();
+    let name = CString::new("bench").unwrap();
+    let cb = fmi2CallbackFunctions {
+        logger: None,
+        allocateMemory: None,
+        freeMemory: None,
+        stepFinished: None,
+        componentEnvironment: std::ptr::null_mut(),
+    };
+    let dt = scene.time.dt;
+    unsafe {
+        let c = fmi2Instantiate(
+            name.as_ptr(),
+            fmi2CoSimulation,
+            guid.as_ptr(),
+            uri.as_ptr(),
+            &cb,
+            0,
+            0,
+        );
+        assert!(!c.is_null());
+        assert_eq!(fmi2SetupExperiment(c, 0, 0.0, 0.0, 0, 0.0), fmi2OK);
+        assert_eq!(fmi2EnterInitializationMode(c), fmi2OK);
+        assert_eq!(fmi2ExitInitializationMode(c), fmi2OK);
+
+        // 1. Bare DoStep: h = 1e-9 dt, so 5 x CALLS steps stay far below the
+        // first substep's grid point and no substep runs.
+        let h = dt * 1e-9;
+        let mut t = 0.0;
+        let mut best = f64::INFINITY;
+        for _round in 0..5 {
+            let t0 = Instant::now();
+            for _ in 0..calls {
+                let s = fmi2DoStep(c, t, h, 1);
+                debug_assert_eq!(s, fmi2OK);
+                black_box(s);
+                t += h;
+            }
+            best = best.min(t0.elapsed().as_secs_f64() / calls as f64);
+        }
+        let mut n = 0;
+        assert_eq!(fmi2GetInteger(c, &VR_SUBSTEPS, 1, &mut n), fmi2OK);
+        assert_eq!(n, 0, "a substep ran during the overhead loop");
+        println!(
+            "fmi2DoStep without substeps:            {:.1} ns per call (best of 5 x {calls})",
+            best * 1e9
+        );
+
+        // 2. set 4 inputs + DoStep + get 4 outputs.
+        let in_vr = [VR_ATTRACTOR_X, VR_ATTRACTOR_Y, VR_GRAVITY_X, VR_GRAVITY_Y];
+        let out_vr = [
+            VR_YARN_BASE,
+            VR_YARN_BASE + 1,
+            VR_YARN_BASE + 2,
+            VR_YARN_BASE + 3,
+        ];
+        let mut out = [0.0; 4];
+        let mut best = f64::INFINITY;
+        for _round in 0..5 {
+            let t0 = Instant::now();
+            for k in 0..calls {
+                let v = [0.5, 0.5 + 1e-3 * (k & 7) as f64, 0.0, -9.8];
+                assert_eq!(fmi2SetReal(c, in_vr.as_ptr(), 4, v.as_ptr()), fmi2OK);
+                assert_eq!(fmi2DoStep(c, t, h, 1), fmi2OK);
+                assert_eq!(fmi2GetReal(c, out_vr.as_ptr(), 4, out.as_mut_ptr()), fmi2OK);
+                black_box(&out);
+                t += h;
+            }
+            best = best.min(t0.elapsed().as_secs_f64() / calls as f64);
+        }
+        println!(
+            "SetReal(4) + DoStep + GetReal(4):       {:.1} ns per cycle",
+            best * 1e9
+        );
+        fmi2FreeInstance(c);
+
+        // 3. One substep per DoStep against YarnSim::step, interleaved.
+        let c = fmi2Instantiate(
+            name.as_ptr(),
+            fmi2CoSimulation,
+            guid.as_ptr(),
+            uri.as_ptr(),
+            &cb,
+            0,
+            0,
+        );
+        assert_eq!(fmi2SetupExperiment(c, 0, 0.0, 0.0, 0, 0.0), fmi2OK);
+        assert_eq!(fmi2EnterInitializationMode(c), fmi2OK);
+        assert_eq!(fmi2ExitInitializationMode(c), fmi2OK);
+        let mut sim = YarnSim::new(&scene).unwrap();
+        let steps = 2000.min(calls);
+        let (mut fmu_s, mut lib_s) = (0.0, 0.0);
+        for k in 0..steps {
+            for first in [k % 2 == 0, k % 2 == 1] {
+                let t0 = Instant::now();
+                if first {
+                    assert_eq!(fmi2DoStep(c, k as f64 * dt, dt, 1), fmi2OK);
+                    fmu_s += t0.elapsed().as_secs_f64();
+                } else {
+                    sim.step().unwrap();
+                    lib_s += t0.elapsed().as_secs_f64();
+                }
+            }
+        }
+        println!(
+            "one substep: fmi2DoStep {:.2} us, YarnSim::step {:.2} us (mean of {steps})",
+            fmu_s / steps as f64 * 1e6,
+            lib_s / steps as f64 * 1e6
+        );
+        fmi2FreeInstance(c);
+    }
+    let _ = std::fs::remove_dir_all(dir);
+}

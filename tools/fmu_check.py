@@ -1,0 +1,143 @@
+"""fmpy checks of the YarnBundle FMU (run by tools/fmu_check.sh).
+
+usage: fmu_check.py SMALL.fmu REFERENCE_SCENE.fmu WORKDIR REPLAY_EXE SMALL_SCENE
+
+1. fmpy's validation of both FMUs (schema, structure, start values, units).
+2. fmpy.simulate_fmu of SMALL.fmu with an input signal (attractor on a
+   circle, switched on at 0.1 s; gravity turning), compared bit for bit
+   with the Rust library run of the same inputs (fmu-replay).
+3. FMU state through fmpy: get + serialize at t1, run on, deserialize +
+   set, run on again: identical outputs.
+4. A short simulate_fmu of the default (reference) scene FMU.
+Exits non-zero on any problem.
+"""
+import csv
+import math
+import subprocess
+import sys
+
+import numpy as np
+from fmpy import read_model_description, simulate_fmu, extract
+from fmpy.fmi2 import FMU2Slave
+from fmpy.validation import validate_fmu
+
+small_fmu, ref_fmu, work, replay, small_scene = sys.argv[1:6]
+failures = []
+
+# 1. validation
+for f in (small_fmu, ref_fmu):
+    problems = validate_fmu(f)
+    if problems:
+        failures.append(f"{f}: fmpy validation: {problems}")
+    print(f"validate {f}: {len(problems)} problems")
+
+# 2. simulate with an input signal and compare with the Rust side
+H, STOP = 0.01, 0.4
+n = int(round(STOP / H)) + 1
+t = np.array([k * H for k in range(n)])
+w = 2 * math.pi * t / 0.4
+cols = [
+    ("time", t),
+    ("attractor.x", 0.5 + 0.2 * np.cos(w)),
+    ("attractor.y", 0.5 + 0.2 * np.sin(w)),
+    ("attractor.strength", np.full(n, 30.0)),
+    ("attractor.active", t >= 0.1 - 1e-12),
+    ("gravity.x", 4.0 * np.sin(3.0 * t)),
+    ("gravity.y", -9.8 * np.cos(3.0 * t)),
+]
+dtype = [(name, np.bool_ if name == "attractor.active" else np.double) for name, _ in cols]
+signals = np.array(list(zip(*[c for _, c in cols])), dtype=dtype)
+in_csv = f"{work}/inputs.csv"
+with open(in_csv, "w") as fh:
+    fh.write(",".join(name for name, _ in cols) + "\n")
+    for row in signals:
+        fh.write(",".join(repr(float(v)) for v in row) + "\n")
+
+md = read_model_description(small_fmu)
+outputs = [v.name for v in md.modelVariables if v.causality == "output"]
+result = simulate_fmu(
+    small_fmu,
+    start_time=0.0,
+    stop_time=STOP,
+    output_interval=H,
+    input=signals,
+    output=outputs,
+    validate=True,
+)
+out_csv = f"{work}/rust.csv"
+subprocess.run(
+    [replay, "--scene", small_scene, "--inputs", in_csv, "--step", repr(H), "--stop", repr(STOP), "-o", out_csv],
+    check=True,
+)
+with open(out_csv) as fh:
+    rust = list(csv.DictReader(fh))
+if len(rust) != len(result):
+    failures.append(f"fmpy gave {len(result)} rows, the Rust run {len(rust)}")
+max_diff = 0.0
+compared = 0
+for k, (row, ref) in enumerate(zip(result, rust)):
+    if float(ref["time"]) != row["time"] and not math.isclose(float(ref["time"]), row["time"]):
+        failures.append(f"row {k}: time {row['time']} vs {ref['time']}")
+    for name in outputs:
+        a, b = float(row[name]), float(ref[name])
+        compared += 1
+        if not math.isfinite(a):
+            failures.append(f"row {k}: {name} is {a}")
+        d = abs(a - b)
+        max_diff = max(max_diff, d)
+        if d != 0.0:
+            failures.append(f"row {k} (t = {row['time']}): {name}: fmpy {a!r}, Rust {b!r}")
+print(f"simulate_fmu vs Rust: {len(result)} rows x {len(outputs)} outputs, {compared} values, max |diff| = {max_diff}")
+moved = max(abs(result[-1][n] - result[0][n]) for n in outputs if n.startswith("yarn"))
+if not moved > 0.05:
+    failures.append(f"the yarn ends moved only {moved} m: the inputs had no effect")
+
+# 3. FMU state through fmpy's C calls
+unzip = extract(small_fmu)
+fmu = FMU2Slave(guid=md.guid, unzipDirectory=unzip, modelIdentifier=md.coSimulation.modelIdentifier, instanceName="state")
+fmu.instantiate()
+fmu.setupExperiment(startTime=0.0)
+fmu.enterInitializationMode()
+fmu.exitInitializationMode()
+vrs = [v.valueReference for v in md.modelVariables if v.causality == "output" and v.type == "Real"]
+tt = 0.0
+for _ in range(5):
+    fmu.doStep(tt, H)
+    tt += H
+state = fmu.getFMUstate()
+blob = fmu.serializeFMUstate(state)
+t1 = tt
+first = []
+for _ in range(5):
+    fmu.doStep(tt, H)
+    tt += H
+    first.append(fmu.getReal(vrs))
+restored = fmu.deSerializeFMUstate(blob)
+fmu.setFMUstate(restored)
+tt = t1
+second = []
+for _ in range(5):
+    fmu.doStep(tt, H)
+    tt += H
+    second.append(fmu.getReal(vrs))
+if first != second:
+    failures.append("FMU state round trip through fmpy: outputs differ")
+print(f"state round trip through fmpy: {len(bytes(blob))} bytes, {'identical' if first == second else 'DIFFERENT'} outputs")
+fmu.freeFMUstate(state)
+fmu.freeFMUstate(restored)
+fmu.terminate()
+fmu.freeInstance()
+
+# 4. the default scene FMU runs in fmpy
+ref = simulate_fmu(ref_fmu, stop_time=2 / 60, output_interval=1 / 60, validate=True)
+ok = all(math.isfinite(ref[-1][name]) for name in ref.dtype.names)
+print(f"default scene FMU: {len(ref)} rows, {len(ref.dtype.names) - 1} outputs, finite: {ok}")
+if not ok:
+    failures.append("default scene FMU gave non-finite outputs")
+
+if failures:
+    print(f"FMU check FAILED ({len(failures)} problems):")
+    for f in failures[:40]:
+        print("  " + f)
+    sys.exit(1)
+print("FMU check passed")
