@@ -121,6 +121,11 @@ impl YarnEnergy {
             return (0.0, 1.0);
         }
         let r22 = r22.max(R22_MIN);
+        // -log r22 >= 1 - r22: a state inside the cone of that lower bound is
+        // inside the yield surface, no logarithm needed (the common case).
+        if self.gamma * r12.abs() * r22 <= self.friction * self.normal * (1.0 - r22) {
+            return (r12, r22);
+        }
         let pressure = -self.normal * r22.ln(); // >= 0
         let limit = self.friction * pressure;
         let shear = self.gamma * r12.abs() * r22;
@@ -147,8 +152,13 @@ impl YarnEnergy {
 /// `dE/dd2` for energy `E = V psi(d / l0)`.
 #[inline]
 pub fn frame_gradient(energy: &YarnEnergy, d: &Mat2, l0: f64, volume: f64) -> (Vec2, Vec2) {
-    let g = d * (1.0 / l0);
-    let p = energy.stress_qr(&qr(&g));
+    frame_gradient_qr(energy, &qr(&(d * (1.0 / l0))), l0, volume)
+}
+
+/// [`frame_gradient`] from the QR factorisation of `G = d / l0`.
+#[inline]
+pub fn frame_gradient_qr(energy: &YarnEnergy, g: &Qr2, l0: f64, volume: f64) -> (Vec2, Vec2) {
+    let p = energy.stress_qr(g);
     let s = volume / l0;
     (p.column(0) * s, p.column(1) * s)
 }

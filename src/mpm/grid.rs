@@ -13,6 +13,17 @@ const BLOCK_SHIFT: usize = 3;
 /// Number of scatter chunks (fixed for determinism).
 pub const CHUNKS: usize = 4;
 
+/// One grid node: `[px, py, m, 0]` in a scatter buffer (momentum, mass),
+/// `[vx, vy, m, 0]` on the summed grid. Four lanes so that a node is one
+/// SIMD register (or two) and the momentum pair is 16-byte aligned.
+pub type Node = [f64; 4];
+/// Lane of the x component (momentum or velocity).
+pub const X: usize = 0;
+/// Lane of the y component.
+pub const Y: usize = 1;
+/// Lane of the mass.
+pub const M: usize = 2;
+
 /// Grid geometry: `n x n` nodes at `(i dx, j dx)`, stored with row stride
 /// `stride` (`n` rounded up to whole blocks): node `(i, j)` is at `i * stride + j`.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -76,11 +87,11 @@ impl GridGeom {
     }
 }
 
-/// One chunk's scatter target: mass and momentum (`[m, px, py]`) per node,
-/// plus the blocks it touched.
+/// One chunk's scatter target: momentum and mass per node,
+/// plus the blocks it touched (see [`Node`]).
 #[derive(Clone, Debug)]
 pub struct ScatterBuffer {
-    pub node: Vec<[f64; 3]>,
+    pub node: Vec<Node>,
     pub touched: Vec<bool>,
     pub touched_list: Vec<u32>,
 }
@@ -88,7 +99,7 @@ pub struct ScatterBuffer {
 impl ScatterBuffer {
     pub fn new(geom: &GridGeom) -> Self {
         ScatterBuffer {
-            node: vec![[0.0; 3]; geom.storage()],
+            node: vec![[0.0; 4]; geom.storage()],
             touched: vec![false; geom.blocks()],
             touched_list: Vec::new(),
         }
@@ -100,7 +111,7 @@ impl ScatterBuffer {
             let (bi, bj) = (b as usize / geom.nb, b as usize % geom.nb);
             for r in 0..BLOCK {
                 let start = ((bi << BLOCK_SHIFT) + r) * geom.stride + (bj << BLOCK_SHIFT);
-                self.node[start..start + BLOCK].fill([0.0; 3]);
+                self.node[start..start + BLOCK].fill([0.0; 4]);
             }
             self.touched[b as usize] = false;
         }
@@ -139,11 +150,11 @@ impl ScatterBuffer {
     }
 }
 
-/// The summed grid: `[m, vx, vy]` per node on the active blocks.
+/// The summed grid: `[vx, vy, m, 0]` per node on the active blocks.
 #[derive(Clone, Debug)]
 pub struct Grid {
     pub geom: GridGeom,
-    pub node: Vec<[f64; 3]>,
+    pub node: Vec<Node>,
     /// Blocks touched this substep, sorted.
     pub active: Vec<u32>,
     /// `is_active[b]` for every block.
@@ -155,7 +166,7 @@ impl Grid {
     pub fn new(geom: GridGeom) -> Self {
         Grid {
             geom,
-            node: vec![[0.0; 3]; geom.storage()],
+            node: vec![[0.0; 4]; geom.storage()],
             active: Vec::new(),
             is_active: vec![false; geom.blocks()],
             buffers: (0..CHUNKS).map(|_| ScatterBuffer::new(&geom)).collect(),

@@ -9,6 +9,7 @@
 //! positions are re-interpolated from the vertices each step.
 
 use crate::math::bspline::Stencil;
+use crate::math::qr::{qr, Qr2};
 use crate::math::{perp, Mat2, Vec2};
 use crate::scene::YarnScene;
 
@@ -59,10 +60,25 @@ pub struct Quads {
     /// Index of the left vertex; the right one is `left + 1`.
     pub left: Vec<u32>,
     pub stencil: Vec<Stencil>,
+    /// QR factorisation of `G = d / l0` for the current `d` (kept by the
+    /// quadrature gather for the next step's stress; see [`Quads::refresh_frames`]).
+    pub frame: Vec<Qr2>,
     /// `dE/dd1` (scratch).
     pub t1: Vec<Vec2>,
     /// `dE/dd2` (scratch).
     pub t2: Vec<Vec2>,
+}
+
+impl Quads {
+    /// Recomputes [`Quads::frame`] from `d` (after `d` was set from outside the stepper).
+    pub fn refresh_frames(&mut self) {
+        self.frame = self
+            .d
+            .iter()
+            .zip(&self.l0)
+            .map(|(d, l0)| qr(&(d * (1.0 / l0))))
+            .collect();
+    }
 }
 
 /// All particles and the yarn topology.
@@ -138,6 +154,7 @@ impl Particles {
         p.quad.stencil = vec![Stencil::default(); nq];
         p.quad.t1 = vec![Vec2::zeros(); nq];
         p.quad.t2 = vec![Vec2::zeros(); nq];
+        p.quad.refresh_frames();
         p
     }
 

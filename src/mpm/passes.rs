@@ -12,8 +12,8 @@
 
 use rayon::prelude::*;
 
-use super::constitutive::{frame_gradient, YarnEnergy};
-use super::grid::{Grid, GridGeom, ScatterBuffer, BLOCK, CHUNKS};
+use super::constitutive::{frame_gradient_qr, YarnEnergy};
+use super::grid::{Grid, GridGeom, Node, ScatterBuffer, BLOCK, CHUNKS, M, X, Y};
 use super::particles::{Particles, Quads, Vertices, NONE};
 use crate::math::bspline::Stencil;
 use crate::math::qr::qr;
@@ -43,15 +43,15 @@ pub fn particle_forces(p: &mut Particles, geom: &GridGeom, energy: &YarnEnergy, 
         &mut q.t1,
         &mut q.t2,
         &q.x,
-        &q.d,
+        &q.frame,
         &q.l0,
         &q.vol,
     )
         .into_par_iter()
         .with_min_len(PAR_MIN)
-        .for_each(|(st, t1, t2, x, d, l0, vol)| {
+        .for_each(|(st, t1, t2, x, g, l0, vol)| {
             *st = Stencil::new(*x, inv_dx);
-            let (a, b) = frame_gradient(energy, d, *l0, *vol);
+            let (a, b) = frame_gradient_qr(energy, g, *l0, *vol);
             *t1 = a;
             *t2 = b;
         });
@@ -130,10 +130,11 @@ fn splat(buf: &mut ScatterBuffer, geom: &GridGeom, st: &Stencil, m: f64, p0: Vec
         let row = &mut buf.node[start..start + 3];
         for j in 0..3 {
             let w = wi * st.w[1][j];
+            let add: Node = [rx + ay[j], ry + by[j], m, 0.0];
             let n = &mut row[j];
-            n[0] += w * m;
-            n[1] += w * (rx + ay[j]);
-            n[2] += w * (ry + by[j]);
+            for l in 0..4 {
+                n[l] += w * add[l];
+            }
         }
     }
 }
@@ -211,19 +212,19 @@ pub fn grid_update(grid: &mut Grid, dt: f64, ext: &GridForces) {
                     let gidx = bi * BLOCK * geom.stride + row;
                     for c in 0..BLOCK {
                         let j = j0 + c;
-                        let mut acc = [0.0; 3];
+                        let mut acc: Node = [0.0; 4];
                         for s in srcs {
-                            let n = s.node[gidx + c];
-                            acc[0] += n[0];
-                            acc[1] += n[1];
-                            acc[2] += n[2];
+                            let n = &s.node[gidx + c];
+                            for l in 0..4 {
+                                acc[l] += n[l];
+                            }
                         }
                         let out = &mut band[row + c];
-                        if acc[0] <= 0.0 {
-                            *out = [0.0; 3];
+                        if acc[M] <= 0.0 {
+                            *out = [0.0; 4];
                             continue;
                         }
-                        let mut v = Vec2::new(acc[1], acc[2]) / acc[0] + ext.gravity * dt;
+                        let mut v = Vec2::new(acc[X], acc[Y]) / acc[M] + ext.gravity * dt;
                         if ext.attractor.is_some() || near_obstacle {
                             let xi = Vec2::new(i as f64, j as f64) * dx;
                             if let Some((pos, strength)) = ext.attractor {
@@ -239,7 +240,7 @@ pub fn grid_update(grid: &mut Grid, dt: f64, ext: &GridForces) {
                         if near_wall {
                             v = wall_velocity(ext.walls, cells, geom.n, i, j, v);
                         }
-                        *out = [acc[0], v.x, v.y];
+                        *out = [v.x, v.y, acc[M], 0.0];
                     }
                 }
             }
@@ -320,7 +321,7 @@ fn interpolate(grid: &Grid, st: &Stencil) -> (Vec2, Mat2) {
         let (mut sx, mut sy, mut sxo, mut syo) = (0.0, 0.0, 0.0, 0.0);
         for j in 0..3 {
             let w = st.w[1][j];
-            let (wx, wy) = (w * row[j][1], w * row[j][2]);
+            let (wx, wy) = (w * row[j][X], w * row[j][Y]);
             sx += wx;
             sy += wy;
             sxo += wx * oy[j];
@@ -359,8 +360,9 @@ fn clamp_to_grid(x: &mut Vec2, v: &mut Vec2, lo: f64, hi: f64) {
 fn project_out(o: &Obstacle, x: &mut Vec2, v: &mut Vec2) {
     let c = Vec2::from(o.center);
     let r = *x - c;
-    let dist = r.norm();
-    if dist < o.radius {
+    let dist2 = r.norm_squared();
+    if dist2 < o.radius * o.radius {
+        let dist = dist2.sqrt();
         let n = if dist > 0.0 {
             r / dist
         } else {
@@ -403,7 +405,7 @@ pub fn gather_vertices(
             let ok = x.x.is_finite()
                 && x.y.is_finite()
                 && c.iter().all(|e| e.is_finite())
-                && nv.norm() * dt <= geom.dx;
+                && nv.norm_squared() * (dt * dt) <= geom.dx * geom.dx;
             if ok {
                 None
             } else {
@@ -430,6 +432,7 @@ pub fn gather_quads(
         &mut quad.c,
         &mut quad.d,
         &mut quad.f,
+        &mut quad.frame,
         &quad.stencil,
         &quad.left,
         &quad.d_rest_inv,
@@ -438,7 +441,7 @@ pub fn gather_quads(
         .into_par_iter()
         .with_min_len(PAR_MIN)
         .enumerate()
-        .filter_map(|(k, (x, v, c, d, f, st, left, dinv, l0))| {
+        .filter_map(|(k, (x, v, c, d, f, frame, st, left, dinv, l0))| {
             let (nv, nc) = interpolate(grid, st);
             *v = nv;
             *c = nc;
@@ -447,14 +450,18 @@ pub fn gather_quads(
             let d1 = xr - xl;
             let d2o = d.column(1).into_owned();
             let mut d2 = d2o + nc * d2o * dt;
+            let inv_l0 = 1.0 / *l0;
+            let mut r = qr(&(Mat2::from_columns(&[d1, d2]) * inv_l0));
             if let Some(energy) = plastic {
-                let g = Mat2::from_columns(&[d1, d2]) / *l0;
-                let r = qr(&g);
                 let (r12, r22) = energy.return_map(r.r12, r.r22);
                 if r12 != r.r12 || r22 != r.r22 {
                     d2 = r.rotate(Vec2::new(r12, r22)) * *l0;
+                    // refactor (rather than patch r12, r22) so that `frame` is
+                    // always bitwise qr(d / l0), as after a state restore
+                    r = qr(&(Mat2::from_columns(&[d1, d2]) * inv_l0));
                 }
             }
+            *frame = r;
             *d = Mat2::from_columns(&[d1, d2]);
             *f = *d * dinv;
             if d.iter().all(|e| e.is_finite()) && v.x.is_finite() && v.y.is_finite() {

@@ -114,6 +114,8 @@ pub struct YarnSim {
     pub(crate) time: f64,
     pub(crate) steps: u64,
     pub(crate) failed: Option<SimError>,
+    /// `particles.quad.frame` must be recomputed from `d` before the next step.
+    pub(crate) frames_stale: bool,
     timings: PassTimes,
 }
 
@@ -136,6 +138,7 @@ impl YarnSim {
             time: 0.0,
             steps: 0,
             failed: None,
+            frames_stale: false,
             timings: PassTimes::default(),
             scene: scene.clone(),
         })
@@ -148,7 +151,9 @@ impl YarnSim {
         &self.particles
     }
     /// Mutable particles, to set up initial conditions in tests and tools.
+    /// The cached frame factorisations are recomputed at the next step.
     pub fn particles_mut(&mut self) -> &mut Particles {
+        self.frames_stale = true;
         &mut self.particles
     }
     pub fn time(&self) -> f64 {
@@ -277,6 +282,10 @@ impl YarnSim {
             &empty
         };
 
+        if self.frames_stale {
+            self.particles.quad.refresh_frames();
+            self.frames_stale = false;
+        }
         let t0 = Instant::now();
         passes::particle_forces(&mut self.particles, &self.grid.geom, &self.energy, bending);
         let t1 = Instant::now();

@@ -248,6 +248,7 @@ impl YarnSim {
         (p.vert.x, p.vert.v, p.vert.c) = vert;
         (p.quad.x, p.quad.v, p.quad.c, p.quad.d, p.quad.f) = quad;
         self.failed = None;
+        self.frames_stale = true;
         Ok(())
     }
 }
