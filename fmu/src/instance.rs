@@ -652,6 +652,22 @@ impl Instance {
         }
         m.substeps += n;
         m.diag = None;
+        // The library reports divergence itself; the outputs are checked
+        // too, so a step never ends OK with a non-finite output.
+        let finite = (0..self.yarns).all(|y| {
+            let (l, r) = m.sim.yarn_endpoints(y);
+            l.x.is_finite() && l.y.is_finite() && r.x.is_finite() && r.y.is_finite()
+        });
+        if !finite {
+            m.terminated = true;
+            self.phase = Phase::StepFailed;
+            return Err(Fail {
+                status: Status::Discard,
+                msg: format!(
+                    "step from t = {t} by {h} left non-finite yarn ends; the simulation is terminated (restore a state or reset)"
+                ),
+            });
+        }
         m.time = end;
         m.last_successful_time = end;
         Ok(Status::Ok)
