@@ -1,0 +1,161 @@
+//! `yarnsim bench precision`, `yarnsim stress` and `yarnsim bench skip`: the
+//! evidence studies of [`yarnsim::evidence`], writing CSV, SVG and a text
+//! report into a directory and printing the report.
+//!
+//! `bench precision` and `bench skip` are spelled `bench-precision` and
+//! `bench-skip` internally; [`rewrite_args`] maps the two-word forms onto them
+//! before clap parses, so `yarnsim bench SCENE` keeps working.
+
+use std::ffi::OsString;
+use std::path::{Path, PathBuf};
+
+use clap::Subcommand;
+use yarnsim::evidence::{precision, skip, stress, write_report};
+
+use crate::error::CliError;
+
+/// The evidence commands (flattened into the top-level command list).
+#[derive(Subcommand, Debug, Clone, PartialEq)]
+pub enum EvidenceCommand {
+    /// Work-precision: run time against error per scene and integrator
+    /// (`yarnsim bench precision`): CSV, SVG plots, convergence orders and
+    /// the fastest method per error level.
+    #[command(name = "bench-precision", visible_alias = "precision")]
+    BenchPrecision {
+        /// Output directory for precision*.csv, precision_<scene>.svg, precision.txt.
+        #[arg(long, value_name = "DIR", default_value = "evidence")]
+        out: PathBuf,
+        /// Fewer step sizes and shorter runs (seconds instead of a minute or two).
+        #[arg(long)]
+        quick: bool,
+        /// Also run the (slow) yarn reference scene.
+        #[arg(long)]
+        yarn_reference: bool,
+    },
+    /// Stability stress: largest stable dt per integrator and stiffness / yarn
+    /// parameter by bisection, next to the theoretical bound.
+    Stress {
+        /// Output directory for stress.csv, stress*.svg, stress.txt.
+        #[arg(long, value_name = "DIR", default_value = "evidence")]
+        out: PathBuf,
+        /// Fewer configurations and bisection steps.
+        #[arg(long)]
+        quick: bool,
+    },
+    /// Skip what a scene doesn't need (`yarnsim bench skip`): optional passes
+    /// on/off, 256^2 vs 1024^2 grid, per-pass breakdown of the reference scene.
+    #[command(name = "bench-skip")]
+    BenchSkip {
+        /// Output directory for skip*.csv, skip.svg, skip.txt.
+        #[arg(long, value_name = "DIR", default_value = "evidence")]
+        out: PathBuf,
+        /// Timed substeps per variant and repeat.
+        #[arg(long, default_value_t = 60)]
+        steps: u64,
+        /// Repeats (round-robin over the variants; the fastest is kept).
+        #[arg(long, default_value_t = 12)]
+        repeats: usize,
+    },
+}
+
+/// Maps `yarnsim bench precision ...` to `yarnsim bench-precision ...` and
+/// `yarnsim bench skip ...` to `yarnsim bench-skip ...`; other arguments
+/// pass unchanged.
+pub fn rewrite_args(args: impl IntoIterator<Item = OsString>) -> Vec<OsString> {
+    let mut v: Vec<OsString> = args.into_iter().collect();
+    if v.len() >= 3 && v[1] == "bench" && (v[2] == "precision" || v[2] == "skip") {
+        let joined = format!("bench-{}", v[2].to_string_lossy());
+        v.splice(1..3, [OsString::from(joined)]);
+    }
+    v
+}
+
+fn write(out: &Path, files: &[(String, String)]) -> Result<Vec<String>, CliError> {
+    write_report(out, files).map_err(|e| CliError::output(out, e))
+}
+
+/// Runs one evidence command; returns the report text and the files written.
+pub fn execute(cmd: &EvidenceCommand) -> Result<(String, Vec<String>), CliError> {
+    match cmd {
+        EvidenceCommand::BenchPrecision {
+            out,
+            quick,
+            yarn_reference,
+        } => {
+            let r = precision::run(&precision::PrecisionOptions {
+                quick: *quick,
+                yarn_reference: *yarn_reference,
+            })
+            .map_err(CliError::Failed)?;
+            Ok((r.to_text(), write(out, &r.files())?))
+        }
+        EvidenceCommand::Stress { out, quick } => {
+            let r = stress::run(&stress::StressOptions { quick: *quick });
+            Ok((r.to_text(), write(out, &r.files())?))
+        }
+        EvidenceCommand::BenchSkip {
+            out,
+            steps,
+            repeats,
+        } => {
+            if *steps == 0 || *repeats == 0 {
+                return Err(CliError::Usage(
+                    "--steps and --repeats must be at least 1".into(),
+                ));
+            }
+            let r = skip::run(&skip::SkipOptions {
+                steps: *steps,
+                warmup: 20,
+                repeats: *repeats,
+            })
+            .map_err(CliError::Failed)?;
+            Ok((r.to_text(), write(out, &r.files())?))
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn os(v: &[&str]) -> Vec<OsString> {
+        v.iter().map(OsString::from).collect()
+    }
+
+    #[test]
+    fn two_word_bench_commands_are_rewritten() {
+        assert_eq!(
+            rewrite_args(os(&["yarnsim", "bench", "precision", "--out", "d"])),
+            os(&["yarnsim", "bench-precision", "--out", "d"])
+        );
+        assert_eq!(
+            rewrite_args(os(&["yarnsim", "bench", "skip"])),
+            os(&["yarnsim", "bench-skip"])
+        );
+        assert_eq!(
+            rewrite_args(os(&["yarnsim", "bench", "yarn-reference"])),
+            os(&["yarnsim", "bench", "yarn-reference"])
+        );
+        assert_eq!(
+            rewrite_args(os(&["yarnsim", "bench"])),
+            os(&["yarnsim", "bench"])
+        );
+    }
+
+    #[test]
+    #[cfg_attr(debug_assertions, ignore = "runs the quick studies; release only")]
+    fn quick_precision_writes_csv_and_svg() {
+        let dir = std::env::temp_dir().join(format!("yarnsim-evidence-{}", std::process::id()));
+        let (text, files) = execute(&EvidenceCommand::BenchPrecision {
+            out: dir.clone(),
+            quick: true,
+            yarn_reference: false,
+        })
+        .unwrap();
+        assert!(text.contains("Fastest method per error level"));
+        assert!(files.iter().any(|f| f.ends_with("precision.csv")));
+        let svg = std::fs::read_to_string(dir.join("precision_wire.svg")).unwrap();
+        assert!(svg.starts_with("<svg") && svg.contains("polyline"));
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+}

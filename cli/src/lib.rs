@@ -1,0 +1,23 @@
+//! The `yarnsim` command-line program as a library: each command is a
+//! function over the `yarnsim` library, so tests can call them directly;
+//! `main.rs` only parses arguments and prints.
+//!
+//! * [`scenes`]: `yarnsim scenes`, `yarnsim scene show`.
+//! * [`run`]: `yarnsim run` (+ [`table`] for its summary).
+//! * [`record`]: `yarnsim record`, the only module that talks to Rerun.
+//! * [`bench`]: `yarnsim bench`.
+//! * [`driver`], [`schedule`]: the frame loop, progress bar and Ctrl-C.
+
+pub mod bench;
+pub mod driver;
+pub mod duration;
+pub mod error;
+pub mod evidence;
+pub mod massspring;
+pub mod record;
+pub mod run;
+pub mod scenes;
+pub mod schedule;
+pub mod table;
+
+pub use error::CliError;

@@ -1,0 +1,629 @@
+//! `yarnsim record`: the full simulation state, frame by frame, as a Rerun
+//! recording (`.rrd`). All Rerun code of the project lives in this module.
+//!
+//! Layout (see docs/cli.md for the full list):
+//! * `world` carries a static mirror transform so the 2D view shows +y up;
+//!   positions below it are the library's coordinates (m), unchanged.
+//! * `world/vertices` (type-2 particles): `Points2D` coloured by stretch, with
+//!   extra per-particle values (`velocity`, `stretch`).
+//! * `world/quadrature` (type-3 particles): `Points2D` coloured by plastic
+//!   state, with values `velocity`, `stretch`, `shear`, `r22`, `yield`, `plastic`.
+//! * `world/yarns`: one line strip per yarn.
+//! * `world/domain`, `world/walls`, `world/obstacles`, `world/attractor`: static geometry.
+//! * `plots/...`: one scalar series per diagnostic.
+//! * `timing/step_time`: wall-clock seconds per substep, the only entity that
+//!   differs between two recordings of the same run.
+//!
+//! Mass-spring scenes are 3D: `world/particles` (`Points3D`), `world/springs`
+//! (one two-point line strip per spring, coloured by stretch), `world/spheres`,
+//! and their own `plots/...` series.
+//!
+//! Timelines: `frame` (sequence) and `sim_time` (duration). The automatic
+//! wall-clock `log_time` timeline is switched off, so two recordings of the
+//! same scene hold the same data everywhere except under `timing/`.
+
+use std::path::Path;
+
+use rerun::blueprint::{
+    Blueprint, Horizontal, Spatial2DView, Spatial3DView, TimePanel, TimeSeriesView, Vertical,
+};
+use rerun::components::{Color, Scalar, Vector2D, Vector3D};
+use rerun::{
+    AnyValues, Boxes2D, Ellipses2D, Ellipsoids3D, LineStrips2D, LineStrips3D, Points2D, Points3D,
+    RecordingStream, RecordingStreamBuilder, Scalars, SeriesLines, Transform3D,
+};
+use yarnsim::math::qr::qr;
+use yarnsim::scene::{Scene, WallMode};
+use yarnsim::YarnSim;
+
+use crate::driver::{interrupt_flag, progress_bar, run_frames, FrameInfo, Outcome, Stepper};
+use crate::error::CliError;
+use crate::massspring::{spring_stretches, IntegratorArgs, MassSpringRun};
+use crate::run::no_integrator_for_yarn;
+use crate::schedule::Schedule;
+
+/// Rerun application id of the recordings.
+pub const APP_ID: &str = "yarnsim";
+/// Timeline of frame indices (frame 0 = initial state).
+pub const TIMELINE_FRAME: &str = "frame";
+/// Timeline of simulated time in seconds.
+pub const TIMELINE_SIM_TIME: &str = "sim_time";
+
+/// Entity paths of a yarn recording.
+pub mod paths {
+    pub const WORLD: &str = "world";
+    pub const VERTICES: &str = "world/vertices";
+    pub const QUADRATURE: &str = "world/quadrature";
+    pub const YARNS: &str = "world/yarns";
+    pub const DOMAIN: &str = "world/domain";
+    pub const WALLS: &str = "world/walls";
+    pub const OBSTACLES: &str = "world/obstacles";
+    pub const ATTRACTOR: &str = "world/attractor";
+    pub const KINETIC: &str = "plots/energy/kinetic";
+    pub const ELASTIC: &str = "plots/energy/elastic";
+    pub const POTENTIAL: &str = "plots/energy/potential";
+    pub const MOMENTUM_X: &str = "plots/momentum/x";
+    pub const MOMENTUM_Y: &str = "plots/momentum/y";
+    pub const ANGULAR_MOMENTUM: &str = "plots/angular_momentum";
+    pub const MAX_STRETCH: &str = "plots/stretch/max";
+    pub const MIN_STRETCH: &str = "plots/stretch/min";
+    /// Wall-clock seconds per substep: not reproducible, kept apart from `plots`.
+    pub const STEP_TIME: &str = "timing/step_time";
+
+    /// Mass-spring particles (`Points3D`).
+    pub const MS_PARTICLES: &str = "world/particles";
+    /// Mass-spring springs (`LineStrips3D`, one strip per spring).
+    pub const MS_SPRINGS: &str = "world/springs";
+    /// Mass-spring sphere colliders (`Ellipsoids3D`, static).
+    pub const MS_SPHERES: &str = "world/spheres";
+    pub const GRAVITY: &str = "plots/energy/gravity";
+    pub const MOMENTUM_Z: &str = "plots/momentum/z";
+    pub const ANGULAR_MOMENTUM_X: &str = "plots/angular_momentum/x";
+    pub const ANGULAR_MOMENTUM_Y: &str = "plots/angular_momentum/y";
+    pub const ANGULAR_MOMENTUM_Z: &str = "plots/angular_momentum/z";
+    pub const MAX_STRAIN: &str = "plots/strain/max";
+    /// CG iterations of the frame's last substep (implicit integrators).
+    pub const CG_ITERATIONS: &str = "plots/cg_iterations";
+
+    /// Every scalar series of a mass-spring recording, with its display name.
+    pub const MS_SERIES: [(&str, &str); 12] = [
+        (KINETIC, "kinetic energy [J]"),
+        (ELASTIC, "elastic energy [J]"),
+        (GRAVITY, "gravity energy [J]"),
+        (MOMENTUM_X, "momentum x [kg m/s]"),
+        (MOMENTUM_Y, "momentum y [kg m/s]"),
+        (MOMENTUM_Z, "momentum z [kg m/s]"),
+        (ANGULAR_MOMENTUM_X, "angular momentum x [kg m^2/s]"),
+        (ANGULAR_MOMENTUM_Y, "angular momentum y [kg m^2/s]"),
+        (ANGULAR_MOMENTUM_Z, "angular momentum z [kg m^2/s]"),
+        (MAX_STRAIN, "max |l/l0 - 1|"),
+        (STEP_TIME, "wall time per substep [s]"),
+        (
+            CG_ITERATIONS,
+            "CG iterations per substep (last substep of the frame)",
+        ),
+    ];
+
+    /// Every scalar series of a yarn recording, with its display name.
+    pub const SERIES: [(&str, &str); 9] = [
+        (KINETIC, "kinetic energy [J]"),
+        (ELASTIC, "elastic energy [J]"),
+        (POTENTIAL, "potential energy [J]"),
+        (MOMENTUM_X, "momentum x [kg m/s]"),
+        (MOMENTUM_Y, "momentum y [kg m/s]"),
+        (ANGULAR_MOMENTUM, "angular momentum [kg m^2/s]"),
+        (MAX_STRETCH, "max stretch"),
+        (MIN_STRETCH, "min stretch"),
+        (STEP_TIME, "wall time per substep [s]"),
+    ];
+}
+
+/// Names of the extra per-particle values logged next to the positions.
+pub mod values {
+    /// Velocity (m/s), a `Vector2D` per particle.
+    pub const VELOCITY: &str = "velocity";
+    /// Segment stretch `|x_r - x_l| / l0`; for a vertex, the mean over its segments.
+    pub const STRETCH: &str = "stretch";
+    /// Shear `r12` of the QR factor of the material frame `d / l0` (quadrature only).
+    pub const SHEAR: &str = "shear";
+    /// Normal compression `r22` of that factor; the return mapping keeps it in check (quadrature only).
+    pub const R22: &str = "r22";
+    /// Mohr-Coulomb yield function `gamma |r12| r22 + c_f (2 mu + lambda) log r22`
+    /// (quadrature only): negative inside the elastic region, 0 on the yield surface.
+    pub const YIELD: &str = "yield";
+    /// Plastic state (quadrature only): 0 elastic, 1 on the yield surface
+    /// (sliding), 2 separated (`r22 = 1`, cross-section in tension).
+    pub const PLASTIC: &str = "plastic";
+}
+
+/// Plastic state of a quadrature particle, see [`values::PLASTIC`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum PlasticState {
+    Elastic = 0,
+    Yielding = 1,
+    Separated = 2,
+}
+
+impl PlasticState {
+    /// Classifies `(r12, r22)` of a particle's frame after the return mapping.
+    pub fn of(energy: &yarnsim::mpm::constitutive::YarnEnergy, r12: f64, r22: f64) -> Self {
+        if r22 >= 1.0 - 1e-9 {
+            return PlasticState::Separated;
+        }
+        let f = energy.yield_function(r12, r22);
+        let scale = energy.friction * energy.normal * (-r22.ln()).abs();
+        if f >= -1e-6 * scale && r12 != 0.0 {
+            PlasticState::Yielding
+        } else {
+            PlasticState::Elastic
+        }
+    }
+
+    /// Colour of the state: grey elastic, orange yielding, violet separated.
+    pub fn color(self) -> Color {
+        match self {
+            PlasticState::Elastic => Color::from_rgb(170, 170, 170),
+            PlasticState::Yielding => Color::from_rgb(255, 140, 0),
+            PlasticState::Separated => Color::from_rgb(160, 60, 220),
+        }
+    }
+}
+
+/// How a `record` command ended.
+#[derive(Clone, Copy, Debug)]
+pub struct RecordOutcome {
+    pub outcome: Outcome,
+    pub particles: usize,
+    pub frames_logged: u64,
+}
+
+/// Records `scene` for `duration` seconds to `out`; `integrator` applies to
+/// mass-spring scenes only.
+pub fn record(
+    scene: &Scene,
+    duration: f64,
+    out: &Path,
+    integrator: &IntegratorArgs,
+) -> Result<RecordOutcome, CliError> {
+    match scene {
+        Scene::Yarn(y) => {
+            no_integrator_for_yarn(integrator)?;
+            record_yarn(&mut YarnSim::new(y)?, duration, out)
+        }
+        Scene::MassSpring(l) => {
+            record_massspring(&mut MassSpringRun::new(l, integrator)?, duration, out)
+        }
+    }
+}
+
+/// Opens the recording file, without the wall-clock `log_time` timeline.
+fn open(name: &str, blueprint: Blueprint, out: &Path) -> Result<RecordingStream, CliError> {
+    let rec = RecordingStreamBuilder::new(APP_ID)
+        .recording_name(name.to_string())
+        .with_blueprint(blueprint)
+        .save(out)
+        .map_err(|e| CliError::output(out, e))?;
+    rec.set_log_time_enabled(false);
+    Ok(rec)
+}
+
+/// Runs `schedule` on `sim`, logging each frame with `log`, then writes the
+/// file's end whatever happened (error, Ctrl-C), so the file stays readable.
+fn record_frames<S: Stepper>(
+    rec: RecordingStream,
+    sim: &mut S,
+    schedule: &Schedule,
+    label: &str,
+    out: &Path,
+    mut log: impl FnMut(&RecordingStream, &S, FrameInfo) -> rerun::RecordingStreamResult<()>,
+) -> Result<RecordOutcome, CliError> {
+    let progress = progress_bar(schedule.total_steps, label);
+    let mut frames_logged = 0;
+    let result = run_frames(sim, schedule, &interrupt_flag(), &progress, |sim, frame| {
+        log(&rec, sim, frame).map_err(|e| CliError::output(out, e))?;
+        frames_logged += 1;
+        Ok(())
+    });
+    let flushed = rec.flush_blocking();
+    drop(rec);
+    let outcome = result?;
+    flushed.map_err(|e| CliError::output(out, e))?;
+    Ok(RecordOutcome {
+        outcome,
+        particles: sim.num_particles(),
+        frames_logged,
+    })
+}
+
+/// Records a yarn simulation from its current state.
+pub fn record_yarn(
+    sim: &mut YarnSim,
+    duration: f64,
+    out: &Path,
+) -> Result<RecordOutcome, CliError> {
+    let schedule = Schedule::new(duration, sim.dt(), sim.scene().time.frame_dt)?;
+    let name = sim.scene().name.clone();
+    let rec = open(&name, yarn_blueprint(), out)?;
+    log_yarn_static(&rec, sim).map_err(|e| CliError::output(out, e))?;
+    let t0 = sim.time();
+    record_frames(rec, sim, &schedule, &name, out, |rec, sim, frame| {
+        log_yarn_frame(rec, sim, frame, sim.time() - t0)
+    })
+}
+
+/// Records a mass-spring simulation from its current state.
+pub fn record_massspring(
+    run: &mut MassSpringRun,
+    duration: f64,
+    out: &Path,
+) -> Result<RecordOutcome, CliError> {
+    let schedule = Schedule::new(duration, run.h, run.sim.system().frame_time)?;
+    let name = run.name.clone();
+    let rec = open(&name, massspring_blueprint(), out)?;
+    log_massspring_static(&rec, run).map_err(|e| CliError::output(out, e))?;
+    let t0 = run.time();
+    record_frames(rec, run, &schedule, &name, out, |rec, run, frame| {
+        log_massspring_frame(rec, run, frame, run.time() - t0)
+    })
+}
+
+/// The layout the recording opens with: the 2D scene on the left, the plots on the right.
+pub fn yarn_blueprint() -> Blueprint {
+    let plot = |name: &str, origin: &str| TimeSeriesView::new(name).with_origin(origin);
+    Blueprint::new(
+        Horizontal::new([
+            Spatial2DView::new("scene").with_origin("/").into(),
+            Vertical::new([
+                plot("energy", "/plots/energy").into(),
+                TimeSeriesView::new("momentum")
+                    .with_origin("/plots")
+                    .with_contents(["/plots/momentum/**", "/plots/angular_momentum"])
+                    .into(),
+                plot("stretch", "/plots/stretch").into(),
+                plot("step time (wall clock)", "/timing").into(),
+            ])
+            .into(),
+        ])
+        .with_column_shares([3.0, 2.0]),
+    )
+    .with_time_panel(TimePanel::new().with_timeline(TIMELINE_SIM_TIME))
+}
+
+fn p2(v: &yarnsim::math::Vec2) -> [f32; 2] {
+    [v.x as f32, v.y as f32]
+}
+
+/// The layout of a mass-spring recording: the 3D scene on the left, the plots on the right.
+pub fn massspring_blueprint() -> Blueprint {
+    let plot = |name: &str, origin: &str| TimeSeriesView::new(name).with_origin(origin);
+    Blueprint::new(
+        Horizontal::new([
+            Spatial3DView::new("scene").with_origin("/world").into(),
+            Vertical::new([
+                plot("energy", "/plots/energy").into(),
+                plot("momentum", "/plots/momentum").into(),
+                plot("angular momentum", "/plots/angular_momentum").into(),
+                TimeSeriesView::new("strain and solver")
+                    .with_origin("/plots")
+                    .with_contents(["/plots/strain/**", "/plots/cg_iterations"])
+                    .into(),
+                plot("step time (wall clock)", "/timing").into(),
+            ])
+            .into(),
+        ])
+        .with_column_shares([3.0, 2.0]),
+    )
+    .with_time_panel(TimePanel::new().with_timeline(TIMELINE_SIM_TIME))
+}
+
+/// Colour of a stretch value: blue when compressed, light grey at rest
+/// length, red when stretched; saturates at +-10 %.
+pub fn stretch_color(s: f64) -> Color {
+    let t = ((s - 1.0) / 0.1).clamp(-1.0, 1.0);
+    let grey = [200.0, 200.0, 200.0];
+    let end = if t < 0.0 {
+        [40.0, 90.0, 255.0]
+    } else {
+        [255.0, 50.0, 30.0]
+    };
+    let a = t.abs();
+    let c = |i: usize| (grey[i] * (1.0 - a) + end[i] * a).round() as u8;
+    Color::from_rgb(c(0), c(1), c(2))
+}
+
+/// A distinct colour per yarn (golden-angle hues).
+pub fn yarn_color(i: usize) -> Color {
+    let h = (i as f64 * 0.618_033_988_75).fract() * 6.0;
+    let x = 1.0 - (h % 2.0 - 1.0).abs();
+    let (r, g, b) = match h as u32 {
+        0 => (1.0, x, 0.0),
+        1 => (x, 1.0, 0.0),
+        2 => (0.0, 1.0, x),
+        3 => (0.0, x, 1.0),
+        4 => (x, 0.0, 1.0),
+        _ => (1.0, 0.0, x),
+    };
+    let c = |v: f64| (60.0 + 170.0 * v) as u8;
+    Color::from_rgb(c(r), c(g), c(b))
+}
+
+/// Mean stretch of the segments around every vertex.
+pub fn vertex_stretches(sim: &YarnSim, seg: &[f64]) -> Vec<f64> {
+    let p = sim.particles();
+    let none = yarnsim::mpm::particles::NONE;
+    (0..p.vert.x.len())
+        .map(|i| {
+            let (l, r) = (p.vert.q_left[i], p.vert.q_right[i]);
+            match (l != none, r != none) {
+                (true, true) => 0.5 * (seg[l as usize] + seg[r as usize]),
+                (true, false) => seg[l as usize],
+                (false, true) => seg[r as usize],
+                (false, false) => 1.0,
+            }
+        })
+        .collect()
+}
+
+/// Scene geometry that never changes, logged once without time.
+fn log_yarn_static(rec: &RecordingStream, sim: &YarnSim) -> rerun::RecordingStreamResult<()> {
+    let sc = sim.scene();
+    let size = sc.grid.size as f32;
+    let dx = sc.dx() as f32;
+    // Rerun's 2D views draw +y downwards; mirror the world so +y is up.
+    rec.log_static(
+        paths::WORLD,
+        &Transform3D::from_translation_scale([0.0, size, 0.0], [1.0, -1.0, 1.0]),
+    )?;
+    rec.log_static(
+        paths::DOMAIN,
+        &Boxes2D::from_mins_and_sizes([[0.0, 0.0]], [[size, size]])
+            .with_colors([Color::from_rgb(120, 120, 120)])
+            .with_labels([format!("grid {0}x{0}", sc.grid.resolution)]),
+    )?;
+    if sc.walls.mode != WallMode::None {
+        let w = sc.walls.cells as f32 * dx;
+        let mode = match sc.walls.mode {
+            WallMode::Sticky => "sticky",
+            WallMode::Slip => "slip",
+            WallMode::None => "none",
+        };
+        rec.log_static(
+            paths::WALLS,
+            &Boxes2D::from_mins_and_sizes([[w, w]], [[size - 2.0 * w, size - 2.0 * w]])
+                .with_colors([Color::from_rgb(160, 120, 60)])
+                .with_labels([format!("{mode} walls, {} cells", sc.walls.cells)]),
+        )?;
+    }
+    if !sc.obstacles.is_empty() {
+        rec.log_static(
+            paths::OBSTACLES,
+            &Ellipses2D::from_centers_and_half_sizes(
+                sc.obstacles
+                    .iter()
+                    .map(|o| [o.center[0] as f32, o.center[1] as f32]),
+                sc.obstacles
+                    .iter()
+                    .map(|o| [o.radius as f32, o.radius as f32]),
+            )
+            .with_colors([Color::from_rgb(90, 200, 120)])
+            .with_labels(
+                sc.obstacles
+                    .iter()
+                    .map(|o| format!("friction {}", o.friction)),
+            ),
+        )?;
+    }
+    let a = sim.attractor();
+    if a.active {
+        rec.log_static(
+            paths::ATTRACTOR,
+            &Points2D::new([p2(&a.position)])
+                .with_radii([2.0 * dx])
+                .with_colors([Color::from_rgb(255, 220, 0)])
+                .with_labels([format!("attractor {} m/s^2", a.strength)]),
+        )?;
+    }
+    for (path, name) in paths::SERIES {
+        rec.log_static(path, &SeriesLines::new().with_names([name]))?;
+    }
+    Ok(())
+}
+
+/// Everything that changes, at frame `frame.frame` and simulated time `t`.
+fn log_yarn_frame(
+    rec: &RecordingStream,
+    sim: &YarnSim,
+    frame: FrameInfo,
+    t: f64,
+) -> rerun::RecordingStreamResult<()> {
+    rec.set_time_sequence(TIMELINE_FRAME, frame.frame as i64);
+    rec.set_duration_secs(TIMELINE_SIM_TIME, t);
+    let p = sim.particles();
+    let dx = sim.scene().dx() as f32;
+    let seg = sim.stretches();
+    let vs = vertex_stretches(sim, &seg);
+
+    let positions: Vec<[f32; 2]> = p.vert.x.iter().map(p2).collect();
+    rec.log(
+        paths::VERTICES,
+        &Points2D::new(positions.iter().copied())
+            .with_radii([0.35 * dx])
+            .with_colors(vs.iter().map(|&s| stretch_color(s))),
+    )?;
+    rec.log(
+        paths::VERTICES,
+        &AnyValues::default()
+            .with_component::<Vector2D>(values::VELOCITY, p.vert.v.iter().map(p2))
+            .with_component::<Scalar>(values::STRETCH, vs.iter().copied()),
+    )?;
+
+    let n = seg.len();
+    let energy = sim.energy_model();
+    let (mut shear, mut r22) = (Vec::with_capacity(n), Vec::with_capacity(n));
+    let (mut yield_f, mut state) = (Vec::with_capacity(n), Vec::with_capacity(n));
+    for (d, l0) in p.quad.d.iter().zip(&p.quad.l0) {
+        let r = qr(&(*d / *l0));
+        shear.push(r.r12);
+        r22.push(r.r22);
+        yield_f.push(energy.yield_function(r.r12, r.r22));
+        state.push(PlasticState::of(energy, r.r12, r.r22));
+    }
+    rec.log(
+        paths::QUADRATURE,
+        &Points2D::new(p.quad.x.iter().map(p2))
+            .with_radii([0.2 * dx])
+            .with_colors(state.iter().map(|s| s.color())),
+    )?;
+    rec.log(
+        paths::QUADRATURE,
+        &AnyValues::default()
+            .with_component::<Vector2D>(values::VELOCITY, p.quad.v.iter().map(p2))
+            .with_component::<Scalar>(values::STRETCH, seg.iter().copied())
+            .with_component::<Scalar>(values::SHEAR, shear)
+            .with_component::<Scalar>(values::R22, r22)
+            .with_component::<Scalar>(values::YIELD, yield_f)
+            .with_component::<Scalar>(values::PLASTIC, state.iter().map(|&s| s as u8 as f64)),
+    )?;
+
+    let yv = &p.yarn_vertices;
+    rec.log(
+        paths::YARNS,
+        &LineStrips2D::new((0..sim.num_yarns()).map(|y| positions[yv[y]..yv[y + 1]].to_vec()))
+            .with_radii([0.15 * dx])
+            .with_colors((0..sim.num_yarns()).map(yarn_color)),
+    )?;
+
+    let d = sim.diagnostics();
+    let scalars = [
+        (paths::KINETIC, d.kinetic_energy),
+        (paths::ELASTIC, d.elastic_energy),
+        (paths::POTENTIAL, d.potential_energy),
+        (paths::MOMENTUM_X, d.momentum.x),
+        (paths::MOMENTUM_Y, d.momentum.y),
+        (paths::ANGULAR_MOMENTUM, d.angular_momentum),
+        (paths::MAX_STRETCH, d.max_stretch),
+        (paths::MIN_STRETCH, d.min_stretch),
+    ];
+    for (path, value) in scalars {
+        rec.log(path, &Scalars::single(value))?;
+    }
+    if frame.substeps > 0 {
+        rec.log(
+            paths::STEP_TIME,
+            &Scalars::single(frame.step_seconds / frame.substeps as f64),
+        )?;
+    }
+    Ok(())
+}
+
+fn p3(v: &yarnsim::massspring::V3) -> [f32; 3] {
+    [v.x as f32, v.y as f32, v.z as f32]
+}
+
+/// Mass-spring geometry that never changes: sphere colliders, series names.
+fn log_massspring_static(
+    rec: &RecordingStream,
+    run: &MassSpringRun,
+) -> rerun::RecordingStreamResult<()> {
+    let sys = run.sim.system();
+    if !sys.spheres.is_empty() {
+        rec.log_static(
+            paths::MS_SPHERES,
+            &Ellipsoids3D::from_centers_and_radii(
+                sys.spheres.iter().map(|s| p3(&s.center)),
+                sys.spheres.iter().map(|s| s.radius as f32),
+            )
+            .with_colors([Color::from_rgb(90, 200, 120)]),
+        )?;
+    }
+    for (path, name) in paths::MS_SERIES {
+        rec.log_static(path, &SeriesLines::new().with_names([name]))?;
+    }
+    Ok(())
+}
+
+/// Radius for drawing mass-spring particles: a fifth of the shortest rest length.
+fn ms_point_radius(run: &MassSpringRun) -> f32 {
+    let l = run
+        .sim
+        .system()
+        .springs
+        .iter()
+        .map(|s| s.rest_length)
+        .fold(f64::INFINITY, f64::min);
+    if l.is_finite() && l > 0.0 {
+        (0.2 * l) as f32
+    } else {
+        0.02
+    }
+}
+
+/// Everything of a mass-spring state that changes.
+fn log_massspring_frame(
+    rec: &RecordingStream,
+    run: &MassSpringRun,
+    frame: FrameInfo,
+    t: f64,
+) -> rerun::RecordingStreamResult<()> {
+    rec.set_time_sequence(TIMELINE_FRAME, frame.frame as i64);
+    rec.set_duration_secs(TIMELINE_SIM_TIME, t);
+    let sim = &run.sim;
+    let sys = sim.system();
+    let x: Vec<[f32; 3]> = sim.positions().iter().map(p3).collect();
+    let radius = ms_point_radius(run);
+    rec.log(
+        paths::MS_PARTICLES,
+        &Points3D::new(x.iter().copied())
+            .with_radii([radius])
+            .with_colors((0..sys.len()).map(|i| {
+                if sys.is_free(i) {
+                    Color::from_rgb(80, 160, 255)
+                } else {
+                    Color::from_rgb(255, 60, 40)
+                }
+            })),
+    )?;
+    rec.log(
+        paths::MS_PARTICLES,
+        &AnyValues::default()
+            .with_component::<Vector3D>(values::VELOCITY, sim.velocities().iter().map(p3)),
+    )?;
+    let stretch = spring_stretches(sim);
+    rec.log(
+        paths::MS_SPRINGS,
+        &LineStrips3D::new(sys.springs.iter().map(|s| [x[s.a], x[s.b]]))
+            .with_radii([0.3 * radius])
+            .with_colors(stretch.iter().map(|&s| stretch_color(s))),
+    )?;
+    rec.log(
+        paths::MS_SPRINGS,
+        &AnyValues::default().with_component::<Scalar>(values::STRETCH, stretch),
+    )?;
+    let d = run.diagnostics();
+    let scalars = [
+        (paths::KINETIC, d.kinetic_energy),
+        (paths::ELASTIC, d.elastic_energy),
+        (paths::GRAVITY, d.gravity_energy),
+        (paths::MOMENTUM_X, d.momentum.x),
+        (paths::MOMENTUM_Y, d.momentum.y),
+        (paths::MOMENTUM_Z, d.momentum.z),
+        (paths::ANGULAR_MOMENTUM_X, d.angular_momentum.x),
+        (paths::ANGULAR_MOMENTUM_Y, d.angular_momentum.y),
+        (paths::ANGULAR_MOMENTUM_Z, d.angular_momentum.z),
+        (paths::MAX_STRAIN, d.max_strain),
+    ];
+    for (path, value) in scalars {
+        rec.log(path, &Scalars::single(value))?;
+    }
+    if frame.substeps > 0 {
+        rec.log(
+            paths::CG_ITERATIONS,
+            &Scalars::single(sim.last_step().cg_iterations as f64),
+        )?;
+        rec.log(
+            paths::STEP_TIME,
+            &Scalars::single(frame.step_seconds / frame.substeps as f64),
+        )?;
+    }
+    Ok(())
+}

@@ -1,0 +1,329 @@
+//! `yarnsim run`: run a scene, print a summary table, optionally write a CSV
+//! of the yarn endpoints and diagnostics per frame.
+
+use std::fs::File;
+use std::io::{BufWriter, Write};
+use std::path::Path;
+
+use yarnsim::mpm::Diagnostics;
+use yarnsim::scene::Scene;
+use yarnsim::YarnSim;
+
+use crate::driver::{interrupt_flag, progress_bar, run_frames};
+use crate::error::CliError;
+use crate::massspring::{IntegratorArgs, MassSpringRun, MsDiagnostics};
+use crate::schedule::Schedule;
+use crate::table::{yarn_rows, DiagRow, Summary};
+
+/// Runs `scene` for `duration` seconds; writes the CSV to `csv` if given.
+/// `integrator` applies to mass-spring scenes only.
+pub fn run(
+    scene: &Scene,
+    duration: f64,
+    csv: Option<&Path>,
+    integrator: &IntegratorArgs,
+) -> Result<Summary, CliError> {
+    match scene {
+        Scene::Yarn(y) => {
+            no_integrator_for_yarn(integrator)?;
+            run_yarn(&mut YarnSim::new(y)?, duration, csv)
+        }
+        Scene::MassSpring(l) => {
+            run_massspring(&mut MassSpringRun::new(l, integrator)?, duration, csv)
+        }
+    }
+}
+
+/// Runs a mass-spring simulation from its current state for `duration` seconds.
+pub fn run_massspring(
+    run: &mut MassSpringRun,
+    duration: f64,
+    csv: Option<&Path>,
+) -> Result<Summary, CliError> {
+    let sys = run.sim.system();
+    let schedule = Schedule::new(duration, run.h, sys.frame_time)?;
+    let mut writer = match csv {
+        Some(path) => Some(CsvWriter::create_with(path, &ms_csv_header())?),
+        None => None,
+    };
+    let (particles, springs, spheres) = (sys.len(), sys.springs.len(), sys.spheres.len());
+    let fixed = sys.len() - sys.free_count();
+    let initial = run.diagnostics();
+    let mut last = initial;
+    let progress = progress_bar(schedule.total_steps, &run.name);
+    let outcome = run_frames(
+        run,
+        &schedule,
+        &interrupt_flag(),
+        &progress,
+        |run, frame| {
+            last = run.diagnostics();
+            if let Some(w) = writer.as_mut() {
+                w.ms_row(frame.frame, &last)?;
+            }
+            Ok(())
+        },
+    )?;
+    if let Some(w) = writer {
+        w.finish()?;
+    }
+    Ok(Summary {
+        scene: run.name.clone(),
+        model: format!("mass-spring, {}", run.sim.integrator()),
+        particles,
+        particles_detail: format!("{fixed} pinned or driven, {springs} springs, {spheres} spheres"),
+        dt: run.h,
+        substeps: outcome.substeps,
+        frames: outcome.last_frame,
+        sim_time: last.time - initial.time,
+        wall_seconds: outcome.step_seconds,
+        interrupted: outcome.interrupted,
+        diagnostics: ms_rows(&initial, &last),
+    })
+}
+
+/// The summary rows of a mass-spring run.
+pub fn ms_rows(a: &MsDiagnostics, b: &MsDiagnostics) -> Vec<DiagRow> {
+    let total = |d: &MsDiagnostics| d.kinetic_energy + d.elastic_energy + d.gravity_energy;
+    vec![
+        ("time [s]", a.time, b.time),
+        ("kinetic energy", a.kinetic_energy, b.kinetic_energy),
+        ("elastic energy", a.elastic_energy, b.elastic_energy),
+        ("gravity energy", a.gravity_energy, b.gravity_energy),
+        ("total energy", total(a), total(b)),
+        ("momentum x", a.momentum.x, b.momentum.x),
+        ("momentum y", a.momentum.y, b.momentum.y),
+        ("momentum z", a.momentum.z, b.momentum.z),
+        (
+            "ang. momentum x",
+            a.angular_momentum.x,
+            b.angular_momentum.x,
+        ),
+        (
+            "ang. momentum y",
+            a.angular_momentum.y,
+            b.angular_momentum.y,
+        ),
+        (
+            "ang. momentum z",
+            a.angular_momentum.z,
+            b.angular_momentum.z,
+        ),
+        ("max strain", a.max_strain, b.max_strain),
+    ]
+}
+
+/// Refuses integrator settings for a yarn scene (the MPM solver has one scheme).
+pub fn no_integrator_for_yarn(args: &IntegratorArgs) -> Result<(), CliError> {
+    if args.is_empty() {
+        Ok(())
+    } else {
+        Err(CliError::Usage(
+            "--integrator and --option apply to mass-spring scenes only; yarn scenes use the MPM solver".into(),
+        ))
+    }
+}
+
+/// Runs a yarn simulation from its current state for `duration` seconds.
+pub fn run_yarn(sim: &mut YarnSim, duration: f64, csv: Option<&Path>) -> Result<Summary, CliError> {
+    let sc = sim.scene();
+    let schedule = Schedule::new(duration, sim.dt(), sc.time.frame_dt)?;
+    let mut writer = match csv {
+        Some(path) => Some(CsvWriter::create(path, sim.num_yarns())?),
+        None => None,
+    };
+    let initial = sim.diagnostics();
+    let mut last = initial;
+    let progress = progress_bar(schedule.total_steps, &sc.name);
+    let outcome = run_frames(
+        sim,
+        &schedule,
+        &interrupt_flag(),
+        &progress,
+        |sim, frame| {
+            last = sim.diagnostics();
+            if let Some(w) = writer.as_mut() {
+                w.row(frame.frame, sim, &last)?;
+            }
+            Ok(())
+        },
+    )?;
+    if let Some(w) = writer {
+        w.finish()?;
+    }
+    let p = sim.particles();
+    Ok(Summary {
+        scene: sim.scene().name.clone(),
+        model: "yarn (MPM)".into(),
+        particles: p.len(),
+        particles_detail: format!(
+            "{} vertices + {} quadrature, {} yarns",
+            p.vert.x.len(),
+            p.quad.x.len(),
+            sim.num_yarns()
+        ),
+        dt: sim.dt(),
+        substeps: outcome.substeps,
+        frames: outcome.last_frame,
+        sim_time: last.time - initial.time,
+        wall_seconds: outcome.step_seconds,
+        interrupted: outcome.interrupted,
+        diagnostics: yarn_rows(&initial, &last),
+    })
+}
+
+/// A number for the CSV: shortest form that reads back to the same `f64`,
+/// in scientific notation for very small or large magnitudes.
+pub fn csv_num(x: f64) -> String {
+    if x == 0.0 || (1e-4..1e7).contains(&x.abs()) || !x.is_finite() {
+        format!("{x}")
+    } else {
+        format!("{x:e}")
+    }
+}
+
+/// The per-frame CSV: frame, time, diagnostics, then both endpoints of every yarn.
+pub struct CsvWriter {
+    out: BufWriter<File>,
+    path: String,
+}
+
+/// CSV column names of a mass-spring run.
+pub fn ms_csv_header() -> Vec<String> {
+    [
+        "frame",
+        "time",
+        "steps",
+        "kinetic_energy",
+        "elastic_energy",
+        "gravity_energy",
+        "momentum_x",
+        "momentum_y",
+        "momentum_z",
+        "angular_momentum_x",
+        "angular_momentum_y",
+        "angular_momentum_z",
+        "max_strain",
+        "com_x",
+        "com_y",
+        "com_z",
+    ]
+    .iter()
+    .map(|s| s.to_string())
+    .collect()
+}
+
+/// CSV column names for `yarns` yarns.
+pub fn csv_header(yarns: usize) -> Vec<String> {
+    let mut h: Vec<String> = [
+        "frame",
+        "time",
+        "steps",
+        "kinetic_energy",
+        "elastic_energy",
+        "potential_energy",
+        "momentum_x",
+        "momentum_y",
+        "angular_momentum",
+        "min_stretch",
+        "max_stretch",
+        "mean_stretch",
+        "com_x",
+        "com_y",
+    ]
+    .iter()
+    .map(|s| s.to_string())
+    .collect();
+    for y in 0..yarns {
+        for end in ["left", "right"] {
+            h.push(format!("yarn{y}_{end}_x"));
+            h.push(format!("yarn{y}_{end}_y"));
+        }
+    }
+    h
+}
+
+impl CsvWriter {
+    /// Creates the file and writes the header.
+    pub fn create(path: &Path, yarns: usize) -> Result<Self, CliError> {
+        Self::create_with(path, &csv_header(yarns))
+    }
+
+    /// Creates the file and writes the given header.
+    pub fn create_with(path: &Path, header: &[String]) -> Result<Self, CliError> {
+        let file = File::create(path).map_err(|e| CliError::output(path, e))?;
+        let mut w = CsvWriter {
+            out: BufWriter::new(file),
+            path: path.display().to_string(),
+        };
+        w.line(&header.join(","))?;
+        Ok(w)
+    }
+
+    fn line(&mut self, text: &str) -> Result<(), CliError> {
+        writeln!(self.out, "{text}").map_err(|e| CliError::Output {
+            path: self.path.clone(),
+            message: e.to_string(),
+        })
+    }
+
+    /// Writes one frame; numbers read back exactly (see [`csv_num`]).
+    pub fn row(&mut self, frame: u64, sim: &YarnSim, d: &Diagnostics) -> Result<(), CliError> {
+        let mut cols: Vec<String> = vec![frame.to_string(), csv_num(d.time), d.steps.to_string()];
+        cols.extend(
+            [
+                d.kinetic_energy,
+                d.elastic_energy,
+                d.potential_energy,
+                d.momentum.x,
+                d.momentum.y,
+                d.angular_momentum,
+                d.min_stretch,
+                d.max_stretch,
+                d.mean_stretch,
+                d.center_of_mass.x,
+                d.center_of_mass.y,
+            ]
+            .iter()
+            .map(|&x| csv_num(x)),
+        );
+        for y in 0..sim.num_yarns() {
+            let (l, r) = sim.yarn_endpoints(y);
+            cols.extend([l.x, l.y, r.x, r.y].iter().map(|&x| csv_num(x)));
+        }
+        self.line(&cols.join(","))
+    }
+
+    /// Writes one mass-spring frame.
+    pub fn ms_row(&mut self, frame: u64, d: &MsDiagnostics) -> Result<(), CliError> {
+        let mut cols: Vec<String> = vec![frame.to_string(), csv_num(d.time), d.steps.to_string()];
+        cols.extend(
+            [
+                d.kinetic_energy,
+                d.elastic_energy,
+                d.gravity_energy,
+                d.momentum.x,
+                d.momentum.y,
+                d.momentum.z,
+                d.angular_momentum.x,
+                d.angular_momentum.y,
+                d.angular_momentum.z,
+                d.max_strain,
+                d.center_of_mass.x,
+                d.center_of_mass.y,
+                d.center_of_mass.z,
+            ]
+            .iter()
+            .map(|&x| csv_num(x)),
+        );
+        self.line(&cols.join(","))
+    }
+
+    /// Flushes the file.
+    pub fn finish(mut self) -> Result<(), CliError> {
+        self.out.flush().map_err(|e| CliError::Output {
+            path: self.path.clone(),
+            message: e.to_string(),
+        })
+    }
+}

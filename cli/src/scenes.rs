@@ -1,0 +1,30 @@
+//! `yarnsim scenes` and `yarnsim scene show`.
+
+use std::fmt::Write as _;
+
+use yarnsim::scene::{builtin_names, Scene, DEFAULT_SCENE};
+
+use crate::error::CliError;
+
+/// One line per built-in scene: name, then description; the default is marked.
+pub fn list_scenes() -> String {
+    let names = builtin_names();
+    let width = names.iter().map(|(n, _)| n.len()).max().unwrap_or(0);
+    let mut out = String::new();
+    for (name, description) in names {
+        let mark = if name == DEFAULT_SCENE { "*" } else { " " };
+        let _ = writeln!(out, "{mark} {name:<width$}  {description}");
+    }
+    let _ = writeln!(out, "(* = default scene)");
+    out
+}
+
+/// Resolves a built-in scene name or a scene file path.
+pub fn load_scene(name_or_path: &str) -> Result<Scene, CliError> {
+    Scene::resolve(name_or_path).map_err(CliError::from)
+}
+
+/// The scene as TOML, ready to save and edit.
+pub fn show_scene(name_or_path: &str) -> Result<String, CliError> {
+    Ok(load_scene(name_or_path)?.to_toml_string())
+}

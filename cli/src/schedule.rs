@@ -1,0 +1,92 @@
+//! Which substep each output frame falls on.
+
+use crate::error::CliError;
+
+/// Frames of a run: frame `k` is the state after `round(k * frame_dt / dt)`
+/// substeps (frame 0 is the initial state), clamped to the run's total of
+/// `round(duration / dt)` substeps; the last frame is the end of the run.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Schedule {
+    pub dt: f64,
+    pub frame_dt: f64,
+    pub total_steps: u64,
+}
+
+/// The most substeps one command will run (about 30 years of wall time at 1e3/s).
+pub const MAX_STEPS: u64 = 1_000_000_000_000;
+
+impl Schedule {
+    /// The schedule of a run of `duration` seconds with substep `dt` and frame interval `frame_dt`.
+    pub fn new(duration: f64, dt: f64, frame_dt: f64) -> Result<Self, CliError> {
+        let steps = (duration / dt).round();
+        if steps < 1.0 {
+            return Err(CliError::Usage(format!(
+                "duration {duration} s is shorter than one substep (dt = {dt} s)"
+            )));
+        }
+        if steps > MAX_STEPS as f64 {
+            return Err(CliError::Usage(format!(
+                "duration {duration} s needs {steps:.3e} substeps of {dt} s; at most {MAX_STEPS:.0e} are supported"
+            )));
+        }
+        Ok(Schedule {
+            dt,
+            frame_dt,
+            total_steps: steps as u64,
+        })
+    }
+
+    fn unclamped(&self, frame: u64) -> u64 {
+        (frame as f64 * self.frame_dt / self.dt).round() as u64
+    }
+
+    /// Substeps done at frame `frame`.
+    pub fn steps_at_frame(&self, frame: u64) -> u64 {
+        self.unclamped(frame).min(self.total_steps)
+    }
+
+    /// Index of the last frame (the number of frames after the initial one).
+    pub fn last_frame(&self) -> u64 {
+        let mut k = (self.total_steps as f64 * self.dt / self.frame_dt).floor() as u64;
+        while self.unclamped(k) < self.total_steps {
+            k += 1;
+        }
+        while k > 0 && self.unclamped(k - 1) >= self.total_steps {
+            k -= 1;
+        }
+        k
+    }
+
+    /// Simulated duration of the whole run.
+    pub fn duration(&self) -> f64 {
+        self.total_steps as f64 * self.dt
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn frames_cover_the_run() {
+        let s = Schedule::new(1.0, 4e-5, 1.0 / 60.0).unwrap();
+        assert_eq!(s.total_steps, 25_000);
+        assert_eq!(s.last_frame(), 60);
+        assert_eq!(s.steps_at_frame(0), 0);
+        assert_eq!(s.steps_at_frame(1), 417);
+        assert_eq!(s.steps_at_frame(60), 25_000);
+        // A run that ends between two frames gets a last, shorter frame.
+        let s = Schedule::new(0.025, 1e-3, 0.01).unwrap();
+        assert_eq!(s.last_frame(), 3);
+        assert_eq!(s.steps_at_frame(2), 20);
+        assert_eq!(s.steps_at_frame(3), 25);
+        for k in 1..=s.last_frame() {
+            assert!(s.steps_at_frame(k) > s.steps_at_frame(k - 1));
+        }
+    }
+
+    #[test]
+    fn rejects_durations_below_one_substep() {
+        assert!(Schedule::new(1e-6, 4e-5, 0.01).is_err());
+    }
+}

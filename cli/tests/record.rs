@@ -1,0 +1,275 @@
+//! `yarnsim record` end to end: run the binary, decode the `.rrd` with
+//! Rerun's own decoder, and check entity paths, timelines, frame count and
+//! that the logged positions are the library's state at each frame.
+
+use std::collections::{BTreeMap, BTreeSet};
+use std::io::BufReader;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use rerun::components::{Position2D, Position3D};
+use rerun::external::re_log_encoding::DecoderApp;
+use rerun::external::re_log_types::LogMsg;
+use rerun::log::Chunk;
+use rerun::{Points2D, Points3D, StoreKind, TimelineName};
+use yarnsim::massspring::{scenes, Integrator, IntegratorOptions, Simulation};
+use yarnsim::scene::Scene;
+use yarnsim::YarnSim;
+
+/// A small yarn scene: 2 yarns of 30 vertices on a 64^2 grid, a frame every
+/// 10 substeps, with walls, an obstacle and an active attractor.
+const SCENE: &str = r#"
+kind = "yarn"
+name = "record-test"
+gravity = [0.0, -9.8]
+
+[grid]
+resolution = 64
+size = 1.0
+
+[time]
+dt = 0.00004
+frame_dt = 0.0004
+
+[material]
+k = 1000.0
+gamma = 500.0
+youngs_modulus = 1000.0
+friction = 0.05
+bending = 100.0
+density = 1.0
+plasticity = true
+
+[attractor]
+position = [0.5, 0.3]
+strength = 20.0
+active = true
+
+[walls]
+mode = "sticky"
+cells = 3
+
+[[obstacles]]
+center = [0.5, 0.45]
+radius = 0.1
+friction = 0.3
+
+[[yarns]]
+start = [0.2, 0.6]
+end = [0.8, 0.65]
+vertices = 30
+count = 2
+spacing = [0.0, 0.03]
+velocity = [0.0, -1.0]
+"#;
+
+fn tmp(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_TARGET_TMPDIR")).join(name)
+}
+
+fn yarnsim(args: &[&str]) -> std::process::Output {
+    let out = Command::new(env!("CARGO_BIN_EXE_yarnsim"))
+        .args(args)
+        .output()
+        .expect("run yarnsim");
+    assert!(
+        out.status.success(),
+        "yarnsim {args:?} failed: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    out
+}
+
+/// The recording's data chunks (blueprint store left out), by entity path.
+fn decode(path: &Path) -> BTreeMap<String, Vec<Chunk>> {
+    let file = std::fs::File::open(path).expect("open rrd");
+    let mut chunks: BTreeMap<String, Vec<Chunk>> = BTreeMap::new();
+    for msg in DecoderApp::decode_eager(BufReader::new(file)).expect("rrd header") {
+        let msg = msg.expect("decodable message");
+        if let LogMsg::ArrowMsg(store, arrow) = &msg {
+            if store.kind() != StoreKind::Recording {
+                continue;
+            }
+            let chunk = Chunk::from_arrow_msg(arrow).expect("chunk");
+            chunks
+                .entry(
+                    chunk
+                        .entity_path()
+                        .to_string()
+                        .trim_start_matches('/')
+                        .to_string(),
+                )
+                .or_default()
+                .push(chunk);
+        }
+    }
+    chunks
+}
+
+/// Every `(frame, values)` of one component of an entity, sorted by frame.
+fn by_frame<C: rerun::Component + Clone>(
+    chunks: &[Chunk],
+    component: rerun::ComponentIdentifier,
+) -> Vec<(i64, Vec<C>)> {
+    let mut rows = Vec::new();
+    for c in chunks {
+        let frames = c.iter_component_indices(TimelineName::from_static_str("frame"), component);
+        for ((t, _), values) in frames.zip(c.iter_component::<C>(component)) {
+            rows.push((t.as_i64(), values.to_vec()));
+        }
+    }
+    rows.sort_by_key(|(f, _)| *f);
+    rows
+}
+
+fn timelines(chunks: &BTreeMap<String, Vec<Chunk>>) -> BTreeSet<String> {
+    chunks
+        .values()
+        .flatten()
+        .flat_map(|c| c.timelines().keys().map(|k| k.to_string()))
+        .collect()
+}
+
+#[test]
+fn yarn_recording_holds_the_library_state_at_every_frame() {
+    let scene_file = tmp("record-test.toml");
+    std::fs::write(&scene_file, SCENE).unwrap();
+    let rrd = tmp("record-test.rrd");
+    let _ = std::fs::remove_file(&rrd);
+    // 2 ms = 50 substeps of 40 us = 5 frames of 10 substeps, plus frame 0.
+    let out = yarnsim(&[
+        "record",
+        scene_file.to_str().unwrap(),
+        "--duration",
+        "2ms",
+        "-o",
+        rrd.to_str().unwrap(),
+    ]);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        stdout.contains("recorded 6 frames (50 substeps"),
+        "{stdout}"
+    );
+
+    let chunks = decode(&rrd);
+    let entities: BTreeSet<&str> = chunks.keys().map(String::as_str).collect();
+    for e in [
+        "world",
+        "world/vertices",
+        "world/quadrature",
+        "world/yarns",
+        "world/domain",
+        "world/walls",
+        "world/obstacles",
+        "world/attractor",
+        "plots/energy/kinetic",
+        "plots/energy/elastic",
+        "plots/momentum/x",
+        "plots/momentum/y",
+        "plots/angular_momentum",
+        "plots/stretch/max",
+        "timing/step_time",
+    ] {
+        assert!(
+            entities.contains(e),
+            "missing entity {e}; have {entities:?}"
+        );
+    }
+    // Reproducible: only the two simulation timelines, no wall clock.
+    let tl = timelines(&chunks);
+    assert_eq!(
+        tl,
+        BTreeSet::from(["frame".to_string(), "sim_time".to_string()])
+    );
+
+    let Scene::Yarn(y) = Scene::from_toml_str(SCENE).unwrap() else {
+        panic!("yarn scene expected")
+    };
+    let mut sim = YarnSim::new(&y).unwrap();
+    let verts = by_frame::<Position2D>(
+        &chunks["world/vertices"],
+        Points2D::descriptor_positions().component,
+    );
+    let quads = by_frame::<Position2D>(
+        &chunks["world/quadrature"],
+        Points2D::descriptor_positions().component,
+    );
+    assert_eq!(
+        verts.iter().map(|(f, _)| *f).collect::<Vec<_>>(),
+        (0..=5).collect::<Vec<_>>()
+    );
+    assert_eq!(quads.len(), 6);
+    for ((frame, v), (_, q)) in verts.iter().zip(&quads) {
+        let target = 10 * *frame as u64;
+        sim.steps_n(target - sim.steps()).unwrap();
+        let p = sim.particles();
+        assert_eq!(v.len(), p.vert.x.len());
+        assert_eq!(q.len(), p.quad.x.len());
+        for (logged, x) in v.iter().zip(&p.vert.x) {
+            assert_eq!(logged.0 .0, [x.x as f32, x.y as f32], "frame {frame}");
+        }
+        for (logged, x) in q.iter().zip(&p.quad.x) {
+            assert_eq!(logged.0 .0, [x.x as f32, x.y as f32], "frame {frame}");
+        }
+    }
+    // The bundle moved (the test would be weak on a state at rest).
+    assert_ne!(verts[0].1, verts[5].1);
+}
+
+#[test]
+fn massspring_recording_holds_the_library_state_at_every_frame() {
+    let rrd = tmp("record-wire.rrd");
+    let _ = std::fs::remove_file(&rrd);
+    // 0.15 s = 3 frames of 0.05 s.
+    yarnsim(&[
+        "record",
+        "wire",
+        "--duration",
+        "0.15",
+        "--integrator",
+        "backward-euler",
+        "-o",
+        rrd.to_str().unwrap(),
+    ]);
+    let chunks = decode(&rrd);
+    for e in [
+        "world/particles",
+        "world/springs",
+        "plots/energy/kinetic",
+        "plots/energy/gravity",
+        "plots/momentum/z",
+        "plots/angular_momentum/y",
+        "plots/strain/max",
+        "timing/step_time",
+    ] {
+        assert!(chunks.contains_key(e), "missing entity {e}");
+    }
+    assert_eq!(
+        timelines(&chunks),
+        BTreeSet::from(["frame".to_string(), "sim_time".to_string()])
+    );
+    let pos = by_frame::<Position3D>(
+        &chunks["world/particles"],
+        Points3D::descriptor_positions().component,
+    );
+    assert_eq!(pos.len(), 4);
+    let mut sim = Simulation::new(
+        &scenes::wire(),
+        Integrator::BackwardEuler,
+        IntegratorOptions::default(),
+    )
+    .unwrap();
+    for (frame, logged) in &pos {
+        while (sim.frame() as i64) < *frame {
+            sim.step_frame().unwrap();
+        }
+        let want: Vec<[f32; 3]> = sim
+            .positions()
+            .iter()
+            .map(|x| [x.x as f32, x.y as f32, x.z as f32])
+            .collect();
+        let got: Vec<[f32; 3]> = logged.iter().map(|p| p.0 .0).collect();
+        assert_eq!(got, want, "frame {frame}");
+    }
+    assert_ne!(pos[0].1, pos[3].1);
+}
