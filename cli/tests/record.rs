@@ -18,50 +18,7 @@ use yarnsim::YarnSim;
 
 /// A small yarn scene: 2 yarns of 30 vertices on a 64^2 grid, a frame every
 /// 10 substeps, with walls, an obstacle and an active attractor.
-const SCENE: &str = r#"
-kind = "yarn"
-name = "record-test"
-gravity = [0.0, -9.8]
-
-[grid]
-resolution = 64
-size = 1.0
-
-[time]
-dt = 0.00004
-frame_dt = 0.0004
-
-[material]
-k = 1000.0
-gamma = 500.0
-youngs_modulus = 1000.0
-friction = 0.05
-bending = 100.0
-density = 1.0
-plasticity = true
-
-[attractor]
-position = [0.5, 0.3]
-strength = 20.0
-active = true
-
-[walls]
-mode = "sticky"
-cells = 3
-
-[[obstacles]]
-center = [0.5, 0.45]
-radius = 0.1
-friction = 0.3
-
-[[yarns]]
-start = [0.2, 0.6]
-end = [0.8, 0.65]
-vertices = 30
-count = 2
-spacing = [0.0, 0.03]
-velocity = [0.0, -1.0]
-"#;
+const SCENE: &str = include_str!("data/small.toml");
 
 fn tmp(name: &str) -> PathBuf {
     Path::new(env!("CARGO_TARGET_TMPDIR")).join(name)
@@ -132,8 +89,7 @@ fn timelines(chunks: &BTreeMap<String, Vec<Chunk>>) -> BTreeSet<String> {
 
 #[test]
 fn yarn_recording_holds_the_library_state_at_every_frame() {
-    let scene_file = tmp("record-test.toml");
-    std::fs::write(&scene_file, SCENE).unwrap();
+    let scene_file = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/small.toml");
     let rrd = tmp("record-test.rrd");
     let _ = std::fs::remove_file(&rrd);
     // 2 ms = 50 substeps of 40 us = 5 frames of 10 substeps, plus frame 0.

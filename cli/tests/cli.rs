@@ -1,0 +1,206 @@
+//! The `yarnsim` binary as a user sees it: help texts and summary tables
+//! (insta snapshots, wall-clock figures masked), CSV output, error messages
+//! and exit codes.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn yarnsim(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_yarnsim"))
+        .args(args)
+        .env_remove("COLUMNS")
+        .output()
+        .expect("run yarnsim")
+}
+
+fn stdout(out: &Output) -> String {
+    String::from_utf8(out.stdout.clone()).expect("utf-8 stdout")
+}
+
+fn stderr(out: &Output) -> String {
+    String::from_utf8(out.stderr.clone()).expect("utf-8 stderr")
+}
+
+fn small_scene() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/small.toml")
+}
+
+fn tmp(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_TARGET_TMPDIR")).join(name)
+}
+
+/// Masks the wall-clock figures of a summary table.
+fn masked(f: impl FnOnce()) {
+    let mut settings = insta::Settings::clone_current();
+    settings.add_filter(r"(?m)^(wall time\s+).*$", "${1}[wall time]");
+    settings.add_filter(r"(?m)^(throughput\s+).*$", "${1}[throughput]");
+    settings.bind(f);
+}
+
+#[test]
+fn help_texts() {
+    for (name, args) in [
+        ("help", vec!["--help"]),
+        ("help_scenes", vec!["scenes", "--help"]),
+        ("help_scene_show", vec!["scene", "show", "--help"]),
+        ("help_run", vec!["run", "--help"]),
+        ("help_record", vec!["record", "--help"]),
+        ("help_bench", vec!["bench", "--help"]),
+    ] {
+        let out = yarnsim(&args);
+        assert!(out.status.success(), "{args:?}");
+        insta::assert_snapshot!(name, stdout(&out));
+    }
+}
+
+#[test]
+fn scenes_lists_every_builtin() {
+    let out = yarnsim(&["scenes"]);
+    assert!(out.status.success());
+    let text = stdout(&out);
+    for (name, _) in yarnsim::scene::builtin_names() {
+        assert!(text.contains(name), "{name} missing");
+    }
+    insta::assert_snapshot!("scenes", text);
+}
+
+#[test]
+fn scene_show_round_trips() {
+    for name in ["yarn-reference", "wire", "cloth"] {
+        let out = yarnsim(&["scene", "show", name]);
+        assert!(out.status.success());
+        let shown = yarnsim::Scene::from_toml_str(&stdout(&out)).expect("valid TOML scene");
+        assert_eq!(shown, yarnsim::Scene::resolve(name).unwrap(), "{name}");
+    }
+}
+
+#[test]
+fn run_summary_of_a_yarn_scene() {
+    let csv = tmp("run-small.csv");
+    let out = yarnsim(&[
+        "run",
+        small_scene().to_str().unwrap(),
+        "--duration",
+        "2ms",
+        "--csv",
+        csv.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    masked(|| insta::assert_snapshot!("run_small", stdout(&out)));
+
+    // One CSV row per frame (0..=5), endpoints of both yarns.
+    let text = std::fs::read_to_string(&csv).unwrap();
+    let lines: Vec<&str> = text.lines().collect();
+    assert_eq!(lines.len(), 1 + 6);
+    let header: Vec<&str> = lines[0].split(',').collect();
+    assert_eq!(header.len(), 14 + 2 * 4);
+    assert_eq!(header[header.len() - 1], "yarn1_right_y");
+    for (k, line) in lines[1..].iter().enumerate() {
+        let cols: Vec<&str> = line.split(',').collect();
+        assert_eq!(cols.len(), header.len());
+        assert_eq!(cols[0], k.to_string());
+        assert_eq!(cols[2], (10 * k).to_string());
+    }
+}
+
+#[test]
+fn run_summary_of_a_massspring_scene() {
+    let out = yarnsim(&[
+        "run",
+        "wire",
+        "--duration",
+        "0.25",
+        "--integrator",
+        "symplectic-euler",
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    masked(|| insta::assert_snapshot!("run_wire_symplectic", stdout(&out)));
+}
+
+#[test]
+fn bench_prints_the_throughput_line() {
+    let out = yarnsim(&[
+        "bench",
+        small_scene().to_str().unwrap(),
+        "--steps",
+        "5",
+        "--warmup",
+        "1",
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let text = stdout(&out);
+    let line = text
+        .lines()
+        .find(|l| l.ends_with(" particle-substeps/s"))
+        .expect("throughput line");
+    let rate: f64 = line.split(' ').next().unwrap().parse().unwrap();
+    assert!(rate > 0.0);
+    assert!(text.contains("P2G scatter"), "{text}");
+}
+
+fn assert_fails(args: &[&str], code: i32, message: &str) {
+    let out = yarnsim(args);
+    assert_eq!(out.status.code(), Some(code), "{args:?}: {}", stderr(&out));
+    let err = stderr(&out);
+    assert!(err.contains(message), "{args:?}: {err}");
+    assert!(stdout(&out).is_empty(), "{args:?} printed to stdout");
+}
+
+#[test]
+fn errors_have_clear_messages_and_exit_codes() {
+    let missing = tmp("no-such-scene.toml");
+    let bad = tmp("bad-scene.toml");
+    std::fs::write(&bad, "kind = \"yarn\"\n[grid]\nresolution = \"big\"\n").unwrap();
+    let small = small_scene();
+    let small = small.to_str().unwrap();
+    // Unknown scene, unreadable or invalid scene file: 3.
+    assert_fails(&["run", "no-such-scene"], 3, "no-such-scene");
+    assert_fails(
+        &["scene", "show", missing.to_str().unwrap()],
+        3,
+        "no-such-scene.toml",
+    );
+    assert_fails(&["run", bad.to_str().unwrap()], 3, "resolution");
+    // Invalid duration and other bad arguments: 2.
+    for d in ["0", "-1", "abc", "1h", "nan"] {
+        assert_fails(&["run", small, "--duration", d], 2, "duration");
+    }
+    assert_fails(&["run", small, "--duration", "1us"], 2, "duration");
+    assert_fails(
+        &["run", "wire", "--integrator", "rk4"],
+        2,
+        "unknown integrator",
+    );
+    assert_fails(&["run", "wire", "--option", "warp=9"], 2, "warp");
+    assert_fails(
+        &["run", small, "--integrator", "pbd"],
+        2,
+        "mass-spring scenes only",
+    );
+    // Unwritable output: 4.
+    let nowhere = "/nonexistent-dir/out";
+    assert_fails(
+        &[
+            "record",
+            small,
+            "-d",
+            "1ms",
+            "-o",
+            &format!("{nowhere}.rrd"),
+        ],
+        4,
+        "cannot write output file",
+    );
+    assert_fails(
+        &[
+            "run",
+            small,
+            "-d",
+            "1ms",
+            "--csv",
+            &format!("{nowhere}.csv"),
+        ],
+        4,
+        "cannot write output file",
+    );
+}
