@@ -54,9 +54,9 @@ vertices = 40
     }
     let p = sim.particles_mut();
     p.quad.refresh_frames(); // d was set by hand
-    passes::particle_forces(p, &geom, &energy, kb);
+    passes::quad_stress(&mut p.quad, &geom, &energy);
     let mut grid = Grid::new(geom);
-    passes::scatter(p, &mut grid, 1.0); // v = 0, C = 0: momentum = 1 * force
+    passes::scatter(p, &mut grid, 1.0, kb); // v = 0, C = 0: momentum = 1 * force
     let p = sim.particles();
 
     let total_energy = |node: (usize, usize), axis: usize, eps: f64| -> f64 {

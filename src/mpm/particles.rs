@@ -34,8 +34,6 @@ pub struct Vertices {
     pub bend_next: Vec<(u32, f64)>,
     /// Stencils at the start-of-step positions (scratch).
     pub stencil: Vec<Stencil>,
-    /// Total internal force on the vertex (scratch).
-    pub force: Vec<Vec2>,
 }
 
 /// Type-3 particles: one quadrature point per segment.
@@ -150,7 +148,6 @@ impl Particles {
         }
         let (nv, nq) = (p.vert.x.len(), p.quad.x.len());
         p.vert.stencil = vec![Stencil::default(); nv];
-        p.vert.force = vec![Vec2::zeros(); nv];
         p.quad.stencil = vec![Stencil::default(); nq];
         p.quad.t1 = vec![Vec2::zeros(); nq];
         p.quad.t2 = vec![Vec2::zeros(); nq];

@@ -2,13 +2,15 @@
 //! needs. [`crate::mpm::YarnSim::step`] runs them in order and skips those a
 //! scene does not need.
 //!
-//! 1. [`particle_forces`]: stencils, fiber-frame stress of every quadrature
-//!    particle, total internal force on every vertex (tangent + bending).
-//! 2. [`scatter`]: APIC particle-to-grid of mass and momentum, with the
-//!    internal forces added as `dt f` to the momentum.
-//! 3. [`grid_update`]: momentum / mass, gravity, attractor, obstacles, walls.
-//! 4. [`gather_vertices`] and [`gather_quads`]: grid-to-particle, vertex
-//!    advection, quadrature re-interpolation, `d2` update, return mapping.
+//! 1. [`scatter`]: APIC particle-to-grid of mass and momentum, with the
+//!    internal forces added as `dt f` to the momentum (vertex forces are
+//!    assembled here from the quadrature stress and the bending springs).
+//! 2. [`grid_update`]: momentum / mass, gravity, attractor, obstacles, walls.
+//! 3. [`gather_vertices`]: grid-to-particle and advection of the vertices.
+//! 4. [`gather_quads`]: quadrature re-interpolation, `d2` update, return
+//!    mapping, and the stress for the next step.
+//!
+//! [`quad_stress`] computes that stress when the state was set from outside.
 
 use rayon::prelude::*;
 
@@ -34,10 +36,12 @@ pub struct GridForces<'a> {
     pub wall_cells: usize,
 }
 
-/// Pass 1: stencils, quadrature stress and vertex forces.
-pub fn particle_forces(p: &mut Particles, geom: &GridGeom, energy: &YarnEnergy, bending: f64) {
+/// Stencils and fiber-frame stress of every quadrature particle from its
+/// cached frame. [`gather_quads`] does this for each particle as it updates
+/// it; this pass is needed only when the state was set from outside the
+/// stepper (a new simulation, a restored state, edited particles).
+pub fn quad_stress(q: &mut Quads, geom: &GridGeom, energy: &YarnEnergy) {
     let inv_dx = geom.inv_dx;
-    let q = &mut p.quad;
     (
         &mut q.stencil,
         &mut q.t1,
@@ -51,43 +55,32 @@ pub fn particle_forces(p: &mut Particles, geom: &GridGeom, energy: &YarnEnergy, 
         .with_min_len(PAR_MIN)
         .for_each(|(st, t1, t2, x, g, l0, vol)| {
             *st = Stencil::new(*x, inv_dx);
-            let (a, b) = frame_gradient_qr(energy, g, *l0, *vol);
-            *t1 = a;
-            *t2 = b;
+            (*t1, *t2) = frame_gradient_qr(energy, g, *l0, *vol);
         });
-    let t1 = &p.quad.t1;
-    let v = &mut p.vert;
-    let xs = &v.x;
-    (
-        &mut v.stencil,
-        &mut v.force,
-        xs,
-        &v.q_left,
-        &v.q_right,
-        &v.bend_prev,
-        &v.bend_next,
-    )
-        .into_par_iter()
-        .with_min_len(PAR_MIN)
-        .for_each(|(st, f, x, ql, qr_, bp, bn)| {
-            *st = Stencil::new(*x, inv_dx);
-            // E depends on d1 = x_right - x_left: the left end gets +dE/dd1, the right end -dE/dd1.
-            let mut force = Vec2::zeros();
-            if *qr_ != NONE {
-                force += t1[*qr_ as usize];
+}
+
+/// Total internal force on vertex `i`: the fiber (tangent) forces of its
+/// two segments and its bending springs.
+#[inline(always)]
+fn vertex_force(v: &Vertices, t1: &[Vec2], i: usize, bending: f64) -> Vec2 {
+    // E depends on d1 = x_right - x_left: the left end gets +dE/dd1, the right end -dE/dd1.
+    let mut force = Vec2::zeros();
+    let (ql, qr_) = (v.q_left[i], v.q_right[i]);
+    if qr_ != NONE {
+        force += t1[qr_ as usize];
+    }
+    if ql != NONE {
+        force -= t1[ql as usize];
+    }
+    if bending > 0.0 {
+        let x = v.x[i];
+        for (j, rest) in [v.bend_prev[i], v.bend_next[i]] {
+            if j != NONE {
+                force += spring_force(x, v.x[j as usize], bending / rest, rest);
             }
-            if *ql != NONE {
-                force -= t1[*ql as usize];
-            }
-            if bending > 0.0 {
-                for &(j, rest) in [bp, bn] {
-                    if j != NONE {
-                        force += spring_force(*x, xs[j as usize], bending / rest, rest);
-                    }
-                }
-            }
-            *f = force;
-        });
+        }
+    }
+    force
 }
 
 /// Force on a particle at `xi` from a spring to `xj` of stiffness `k` and rest length `rest`.
@@ -139,10 +132,25 @@ fn splat(buf: &mut ScatterBuffer, geom: &GridGeom, st: &Stencil, m: f64, p0: Vec
     }
 }
 
-/// Pass 2: particle-to-grid of mass, momentum and `dt` times internal force.
-pub fn scatter(p: &Particles, grid: &mut Grid, dt: f64) {
+/// Pass 1: particle-to-grid of mass, momentum and `dt` times internal
+/// force. Vertex stencils and forces (fiber tangent forces from the
+/// quadrature stress, bending springs) are computed here as each vertex is
+/// splatted; quadrature stencils and stress come from [`gather_quads`] (or
+/// [`quad_stress`]).
+pub fn scatter(p: &mut Particles, grid: &mut Grid, dt: f64, bending: f64) {
     let geom = grid.geom;
     let (nv, nq) = (p.vert.x.len(), p.quad.x.len());
+    let inv_dx = geom.inv_dx;
+    // Each chunk writes the stencils of its own vertex range (taken out of
+    // `p.vert` meanwhile, so the rest of it can be shared).
+    let mut vert_stencils = std::mem::take(&mut p.vert.stencil);
+    let mut stencils: Vec<&mut [Stencil]> = Vec::with_capacity(CHUNKS);
+    let mut rest = vert_stencils.as_mut_slice();
+    for k in 0..CHUNKS {
+        let (head, tail) = rest.split_at_mut(chunk_range(nv, k).len());
+        stencils.push(head);
+        rest = tail;
+    }
     let vert = &p.vert;
     let quad = &p.quad;
     let dx = geom.dx;
@@ -150,13 +158,15 @@ pub fn scatter(p: &Particles, grid: &mut Grid, dt: f64) {
     let normal_scale = -dt * 4.0 * geom.inv_dx;
     grid.buffers
         .par_iter_mut()
+        .zip(stencils)
         .enumerate()
-        .for_each(|(k, buf)| {
+        .for_each(|(k, (buf, sts))| {
             buf.clear(&geom);
-            for i in chunk_range(nv, k) {
+            for (i, st) in chunk_range(nv, k).zip(sts.iter_mut()) {
+                *st = Stencil::new(vert.x[i], inv_dx);
                 let m = vert.m[i];
-                let p0 = vert.v[i] * m + vert.force[i] * dt;
-                splat(buf, &geom, &vert.stencil[i], m, p0, &(vert.c[i] * (m * dx)));
+                let p0 = vert.v[i] * m + vertex_force(vert, &quad.t1, i, bending) * dt;
+                splat(buf, &geom, st, m, p0, &(vert.c[i] * (m * dx)));
             }
             for q in chunk_range(nq, k) {
                 let m = quad.m[q];
@@ -165,10 +175,11 @@ pub fn scatter(p: &Particles, grid: &mut Grid, dt: f64) {
                 splat(buf, &geom, &quad.stencil[q], m, quad.v[q] * m, &a);
             }
         });
+    p.vert.stencil = vert_stencils;
     grid.collect_active();
 }
 
-/// Pass 3: sums the chunk buffers on the active blocks, turns momentum into
+/// Pass 2: sums the chunk buffers on the active blocks, turns momentum into
 /// velocity and applies gravity, attractor, obstacles and walls. Work is
 /// done per active block; obstacle and wall tests only where a block is near one.
 pub fn grid_update(grid: &mut Grid, dt: f64, ext: &GridForces) {
@@ -376,7 +387,7 @@ fn project_out(o: &Obstacle, x: &mut Vec2, v: &mut Vec2) {
     }
 }
 
-/// Pass 4a: grid-to-particle for vertices and advection `x += dt v`.
+/// Pass 3: grid-to-particle for vertices and advection `x += dt v`.
 /// Returns the index of the first vertex whose state is non-finite or whose
 /// speed exceeds one cell per substep (the CFL limit), if any.
 pub fn gather_vertices(
@@ -415,17 +426,22 @@ pub fn gather_vertices(
         .min()
 }
 
-/// Pass 4b: grid-to-particle for quadrature particles: velocity and `C` from
+/// Pass 4: grid-to-particle for quadrature particles: velocity and `C` from
 /// the grid, position and `d1` from the (already moved) vertices,
-/// `d2 += dt C d2`, then the return mapping and `F = d D^-1`.
-/// Returns the first quadrature particle with a non-finite frame, if any.
+/// `d2 += dt C d2`, the return mapping (when `plastic`) and `F = d D^-1`;
+/// then, for the next step, the particle's stencil and its stress from the
+/// new frame. Returns the first quadrature particle with a non-finite
+/// frame, if any.
 pub fn gather_quads(
     quad: &mut Quads,
     vx: &[Vec2],
     grid: &Grid,
     dt: f64,
-    plastic: Option<&YarnEnergy>,
+    energy: &YarnEnergy,
+    plastic: bool,
 ) -> Option<usize> {
+    let inv_dx = grid.geom.inv_dx;
+    let stress = (&mut quad.stencil, &mut quad.t1, &mut quad.t2, &quad.vol);
     (
         &mut quad.x,
         &mut quad.v,
@@ -433,7 +449,7 @@ pub fn gather_quads(
         &mut quad.d,
         &mut quad.f,
         &mut quad.frame,
-        &quad.stencil,
+        stress,
         &quad.left,
         &quad.d_rest_inv,
         &quad.l0,
@@ -441,35 +457,39 @@ pub fn gather_quads(
         .into_par_iter()
         .with_min_len(PAR_MIN)
         .enumerate()
-        .filter_map(|(k, (x, v, c, d, f, frame, st, left, dinv, l0))| {
-            let (nv, nc) = interpolate(grid, st);
-            *v = nv;
-            *c = nc;
-            let (xl, xr) = (vx[*left as usize], vx[*left as usize + 1]);
-            *x = (xl + xr) * 0.5;
-            let d1 = xr - xl;
-            let d2o = d.column(1).into_owned();
-            let mut d2 = d2o + nc * d2o * dt;
-            let inv_l0 = 1.0 / *l0;
-            let mut r = qr(&(Mat2::from_columns(&[d1, d2]) * inv_l0));
-            if let Some(energy) = plastic {
-                let (r12, r22) = energy.return_map(r.r12, r.r22);
-                if r12 != r.r12 || r22 != r.r22 {
-                    d2 = r.rotate(Vec2::new(r12, r22)) * *l0;
-                    // refactor (rather than patch r12, r22) so that `frame` is
-                    // always bitwise qr(d / l0), as after a state restore
-                    r = qr(&(Mat2::from_columns(&[d1, d2]) * inv_l0));
+        .filter_map(
+            |(k, (x, v, c, d, f, frame, (st, t1, t2, vol), left, dinv, l0))| {
+                let (nv, nc) = interpolate(grid, st);
+                *v = nv;
+                *c = nc;
+                let (xl, xr) = (vx[*left as usize], vx[*left as usize + 1]);
+                *x = (xl + xr) * 0.5;
+                let d1 = xr - xl;
+                let d2o = d.column(1).into_owned();
+                let mut d2 = d2o + nc * d2o * dt;
+                let inv_l0 = 1.0 / *l0;
+                let mut r = qr(&(Mat2::from_columns(&[d1, d2]) * inv_l0));
+                if plastic {
+                    let (r12, r22) = energy.return_map(r.r12, r.r22);
+                    if r12 != r.r12 || r22 != r.r22 {
+                        d2 = r.rotate(Vec2::new(r12, r22)) * *l0;
+                        // refactor (rather than patch r12, r22) so that `frame` is
+                        // always bitwise qr(d / l0), as after a state restore
+                        r = qr(&(Mat2::from_columns(&[d1, d2]) * inv_l0));
+                    }
                 }
-            }
-            *frame = r;
-            *d = Mat2::from_columns(&[d1, d2]);
-            *f = *d * dinv;
-            if d.iter().all(|e| e.is_finite()) && v.x.is_finite() && v.y.is_finite() {
-                None
-            } else {
-                Some(k)
-            }
-        })
+                *frame = r;
+                *d = Mat2::from_columns(&[d1, d2]);
+                *f = *d * dinv;
+                *st = Stencil::new(*x, inv_dx);
+                (*t1, *t2) = frame_gradient_qr(energy, &r, *l0, *vol);
+                if d.iter().all(|e| e.is_finite()) && v.x.is_finite() && v.y.is_finite() {
+                    None
+                } else {
+                    Some(k)
+                }
+            },
+        )
         .min()
 }
 

@@ -57,10 +57,17 @@ pub struct Passes {
 /// Wall-clock seconds spent in each pass since the last reset.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct PassTimes {
+    /// Stencils and stress recomputed from the frames after the state was
+    /// set from outside (new simulation, restore, edited particles); zero
+    /// in steady stepping, where [`PassTimes::gather_quads`] does this work.
     pub forces: f64,
+    /// Particle-to-grid, with the vertex forces (fiber and bending).
     pub scatter: f64,
+    /// Grid velocities, gravity, attractor, obstacles, walls.
     pub grid: f64,
+    /// Grid-to-particle of the vertices, advection, obstacle projection.
     pub gather_vertices: f64,
+    /// Grid-to-particle of the quadrature particles, return mapping, stress.
     pub gather_quads: f64,
     pub substeps: u64,
 }
@@ -73,11 +80,23 @@ impl PassTimes {
     /// `(name, seconds)` of every pass, in execution order.
     pub fn entries(&self) -> [(&'static str, f64); 5] {
         [
-            ("particle forces (QR, stress, bending)", self.forces),
-            ("P2G scatter", self.scatter),
-            ("grid update (forces, obstacles, walls)", self.grid),
-            ("G2P vertices", self.gather_vertices),
-            ("G2P quadrature + return mapping", self.gather_quads),
+            (
+                "stress refresh (only after outside state changes)",
+                self.forces,
+            ),
+            ("P2G scatter + vertex forces (fiber, bending)", self.scatter),
+            (
+                "grid update (gravity, attractor, obstacles, walls)",
+                self.grid,
+            ),
+            (
+                "G2P vertices + advection + obstacle projection",
+                self.gather_vertices,
+            ),
+            (
+                "G2P quadrature + return mapping + stress",
+                self.gather_quads,
+            ),
         ]
     }
 }
@@ -138,7 +157,7 @@ impl YarnSim {
             time: 0.0,
             steps: 0,
             failed: None,
-            frames_stale: false,
+            frames_stale: true,
             timings: PassTimes::default(),
             scene: scene.clone(),
         })
@@ -282,14 +301,14 @@ impl YarnSim {
             &empty
         };
 
+        let t0 = Instant::now();
         if self.frames_stale {
             self.particles.quad.refresh_frames();
+            passes::quad_stress(&mut self.particles.quad, &self.grid.geom, &self.energy);
             self.frames_stale = false;
         }
-        let t0 = Instant::now();
-        passes::particle_forces(&mut self.particles, &self.grid.geom, &self.energy, bending);
         let t1 = Instant::now();
-        passes::scatter(&self.particles, &mut self.grid, dt);
+        passes::scatter(&mut self.particles, &mut self.grid, dt, bending);
         let t2 = Instant::now();
         let ext = GridForces {
             gravity: self.gravity,
@@ -304,13 +323,13 @@ impl YarnSim {
         let t3 = Instant::now();
         let bad_v = passes::gather_vertices(&mut self.particles.vert, &self.grid, dt, obstacles);
         let t4 = Instant::now();
-        let plastic = passes.plasticity.then_some(&self.energy);
         let bad_q = passes::gather_quads(
             &mut self.particles.quad,
             &self.particles.vert.x,
             &self.grid,
             dt,
-            plastic,
+            &self.energy,
+            passes.plasticity,
         );
         let t5 = Instant::now();
 
