@@ -229,3 +229,54 @@ fn massspring_recording_holds_the_library_state_at_every_frame() {
     }
     assert_ne!(pos[0].1, pos[3].1);
 }
+
+#[cfg(unix)]
+#[test]
+fn ctrl_c_finishes_the_recording_cleanly() {
+    let rrd = tmp("record-interrupted.rrd");
+    let _ = std::fs::remove_file(&rrd);
+    let scene_file = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/small.toml");
+    let child = Command::new(env!("CARGO_BIN_EXE_yarnsim"))
+        .args(["record", scene_file.to_str().unwrap(), "--duration", "1000"])
+        .arg("-o")
+        .arg(&rrd)
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .expect("start yarnsim");
+    // Let it record a few frames, then interrupt it like Ctrl-C does.
+    let start = std::time::Instant::now();
+    while std::fs::metadata(&rrd).map_or(0, |m| m.len()) < 20_000 {
+        assert!(start.elapsed().as_secs() < 60, "no recording after 60 s");
+        std::thread::sleep(std::time::Duration::from_millis(50));
+    }
+    let kill = Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(kill.success());
+    let out = child.wait_with_output().unwrap();
+    assert_eq!(
+        out.status.code(),
+        Some(130),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(String::from_utf8_lossy(&out.stderr).contains("interrupted"));
+    // Every message decodes, and the frames logged are 0, 1, 2, ... without gaps.
+    let chunks = decode(&rrd);
+    let frames: Vec<i64> = by_frame::<Position2D>(
+        &chunks["world/vertices"],
+        Points2D::descriptor_positions().component,
+    )
+    .iter()
+    .map(|(f, _)| *f)
+    .collect();
+    assert!(frames.len() >= 2, "{frames:?}");
+    assert_eq!(frames, (0..frames.len() as i64).collect::<Vec<_>>());
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        stdout.contains(&format!("recorded {} frames", frames.len())),
+        "{stdout}"
+    );
+}
