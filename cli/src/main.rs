@@ -77,10 +77,10 @@ enum Command {
         #[arg(default_value = DEFAULT_SCENE)]
         scene: String,
         /// Timed substeps.
-        #[arg(short, long, default_value_t = 200)]
+        #[arg(short, long, default_value_t = 1000)]
         steps: u64,
         /// Untimed substeps before timing.
-        #[arg(long, default_value_t = 20)]
+        #[arg(long, default_value_t = 100)]
         warmup: u64,
         /// Worker threads (default: all cores).
         #[arg(short = 'j', long)]
