@@ -627,3 +627,36 @@ fn log_massspring_frame(
     }
     Ok(())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use yarnsim::mpm::constitutive::YarnEnergy;
+
+    #[test]
+    fn plastic_state_follows_the_return_mapping() {
+        let e = YarnEnergy {
+            k: 1000.0,
+            gamma: 500.0,
+            normal: 1400.0,
+            friction: 0.3,
+        };
+        // Compressed, little shear: inside the yield surface.
+        assert_eq!(PlasticState::of(&e, 1e-4, 0.95), PlasticState::Elastic);
+        // Too much shear for the pressure: the return mapping puts it on the surface.
+        let (r12, r22) = e.return_map(0.5, 0.95);
+        assert!(r12 < 0.5);
+        assert_eq!(PlasticState::of(&e, r12, r22), PlasticState::Yielding);
+        assert_eq!(PlasticState::of(&e, -r12, r22), PlasticState::Yielding);
+        // Cross-section in tension: separated.
+        let (r12, r22) = e.return_map(0.1, 1.2);
+        assert_eq!(PlasticState::of(&e, r12, r22), PlasticState::Separated);
+    }
+
+    #[test]
+    fn stretch_colors_saturate() {
+        assert_eq!(stretch_color(1.0), Color::from_rgb(200, 200, 200));
+        assert_eq!(stretch_color(2.0), stretch_color(1.1));
+        assert_eq!(stretch_color(0.5), Color::from_rgb(40, 90, 255));
+    }
+}
