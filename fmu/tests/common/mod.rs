@@ -107,6 +107,7 @@ impl Fmu {
             )
         };
         if c.is_null() {
+            let _ = std::fs::remove_dir_all(&dir);
             return Err(log.lock().unwrap().clone());
         }
         Ok(Fmu {
