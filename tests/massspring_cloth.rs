@@ -87,7 +87,7 @@ fn strain_after_limiting_is_within_the_configured_limit() {
 
     // The same pass after an implicit step (seed 001's optimisation form).
     let o = IntegratorOptions {
-        strain_limit: Some(0.01),
+        strain_limit: Some(0.02),
         strain_iterations: 3000,
         strain_solver: StrainSolver::GaussSeidel,
         ..Default::default()
@@ -96,7 +96,7 @@ fn strain_after_limiting_is_within_the_configured_limit() {
     let mut active = 0;
     for _ in 0..8 {
         let st = sim.step(sim.dt()).unwrap();
-        assert!(st.strain_after_limiting <= 0.01 + 1e-9, "{st:?}");
+        assert!(st.strain_after_limiting <= 0.02 + 1e-9, "{st:?}");
         active += st.strain_passes;
     }
     assert!(active > 0);

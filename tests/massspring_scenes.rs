@@ -17,15 +17,29 @@ fn every_integrator_runs_every_scene_or_says_why_not() {
             match Simulation::new(&layout, integ, IntegratorOptions::default()) {
                 Ok(mut sim) => {
                     let e0 = sim.energies().total();
-                    for _ in 0..3 {
+                    let mut e_max = e0;
+                    for _ in 0..30 {
                         let f = sim
                             .step_frame()
                             .unwrap_or_else(|e| panic!("{name} {integ}: {e}"));
                         assert!(f.steps >= 1);
+                        e_max = e_max.max(sim.energies().total());
                     }
                     let d = sim.diagnostics();
-                    assert_eq!(d.frame, 3);
-                    assert!((d.time - 3.0 * sim.frame_time()).abs() < 1e-12);
+                    assert_eq!(d.frame, 30);
+                    assert!((d.time - 30.0 * sim.frame_time()).abs() < 1e-12);
+                    // No energy from nowhere where nothing drives the scene
+                    // (symplectic Euler's and the trapezoidal rule's
+                    // oscillation about the true value allowed for). PBD
+                    // has no spring energy: its projection with velocity
+                    // fix-up is not energy-consistent, so it is exempt.
+                    if layout.driven.is_empty() && integ != Integrator::Pbd {
+                        let slack = 0.05 * e0.abs().max(1.0);
+                        assert!(
+                            e_max <= e0 + slack,
+                            "{name} {integ}: energy {e0} -> max {e_max}"
+                        );
+                    }
                     assert!(d.energies.total().is_finite() && d.max_strain.is_finite());
                     assert!(sim
                         .positions()

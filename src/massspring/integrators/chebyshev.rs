@@ -11,7 +11,9 @@
 //! seed 001's `m/h^2 + 4k` with the actual springs at each vertex. The seed's
 //! Unity code re-declares `w = 1` inside its loop, so its weights from the
 //! third iteration on are the constant `4/(4 - rho^2)`; the recurrence here is
-//! the one of the paper.
+//! the one of the paper. The `rho` used is capped at the bound
+//! `max_i (D_i - m_i/h^2)/D_i` of the Jacobi spectral radius (valid while
+//! the springs are stretched): 0.982 on the cloth, 0.33 on the 3 particles.
 
 use super::{set_kinematics, State, StepStats};
 use crate::massspring::forces::add_elastic_forces;
@@ -69,6 +71,16 @@ pub fn step(
         diag[sp.a] += add;
         diag[sp.b] += add;
     }
+    // Cap rho at a bound of the Jacobi spectral radius: with stretched
+    // springs, |lambda(I - D^-1 A)| <= max_i (D_i - m_i/h^2) / D_i. A rho
+    // above the true radius only slows the iteration down (seed 001's 0.995
+    // leaves the 3-particle system at a 5 % residual after 32 iterations,
+    // enough to pump energy into it); below it, it diverges.
+    let bound = (0..n)
+        .filter(|&i| sys.is_free(i))
+        .map(|i| (diag[i] - sys.masses[i] / (h * h)) / diag[i])
+        .fold(0.0, f64::max);
+    let rho = rho.min(bound);
     let mut g = vec![V3::zeros(); n];
     let gradient = |x: &[V3], g: &mut [V3]| {
         for i in 0..n {

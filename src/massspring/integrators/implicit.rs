@@ -14,11 +14,12 @@
 //! `h v` on free and the prescribed displacement on kinematic particles. One
 //! solve is Baraff-Witkin's step; for backward Euler without damping it is
 //! exactly seed 004's `(M - h^2 K) v' = M v + h f`. The trapezoidal rule
-//! keeps the same matrix but evaluates the known part exactly, right-hand
-//! side `h/2 (f(x, v) + f(x + a, v + dv_k))`: linearising about `(x, v)`
-//! would make it first order wherever the Hessian clamp is active or the
-//! springs are damped (the matrix omits the position derivative of the
-//! damping force), since then `f(x + a) - f(x) + H a = O(h)`. With
+//! keeps the same (clamped, SPD) matrix but multiplies `a` by the exact
+//! position Jacobian (unclamped Hessian plus the position derivative of the
+//! damping force): with the clamped one `f(x + a) - f(x) + H a = O(h)`
+//! wherever a spring is compressed or damped, and the rule would be only
+//! first order. (Evaluating `f(x + a)` exactly instead is also second order
+//! but blows up on the stiff cloth at h = 1/30 s.) With
 //! `newton_iterations > 1`, chord-Newton corrections with the same matrix
 //! solve the nonlinear equations to `newton_tolerance`.
 
@@ -83,33 +84,52 @@ pub fn step_system(sys: &System, s: &State, h: f64, scheme: Scheme) -> StepSyste
         .collect();
     let matrix = assemble_block_system(&map, &sys.masses, &sys.springs, &blocks);
     let mut rhs = vec![0.0; map.dofs()];
+    // f(x + a, v + dv_k) ~ f - corr, corr = J a + B dv_k.
+    let mut corr = vec![V3::zeros(); n];
     match scheme {
         Scheme::BackwardEuler => {
-            // Baraff-Witkin / seed 004: f(x + a, v + dvk) ~ f - H a - B dvk.
-            let mut corr = vec![V3::zeros(); n];
+            // Baraff-Witkin / seed 004: the clamped Hessian for J.
             add_block_product(&sys.springs, &hb, &a, &mut corr);
-            add_block_product(&sys.springs, &bb, &dvk, &mut corr);
-            for (fi, &p) in map.particle.iter().enumerate() {
-                let r = f[p] * h - corr[p] * (theta * h);
-                rhs[3 * fi..3 * fi + 3].copy_from_slice(r.as_slice());
-            }
         }
         Scheme::Trapezoidal => {
-            // The known part of the end state is evaluated exactly: only the
-            // dv-dependent part is linearised, so the clamped Hessian and
-            // the omitted position derivative of the damping force cost
-            // O(h^3) per step and the rule stays second order.
-            let xp: Vec<V3> = (0..n).map(|i| s.x[i] + a[i]).collect();
-            let vp: Vec<V3> = (0..n).map(|i| s.v[i] + dvk[i]).collect();
-            let mut fp = vec![V3::zeros(); n];
-            total_forces(sys, &xp, &vp, &mut fp);
-            for (fi, &p) in map.particle.iter().enumerate() {
-                let r = (f[p] * (1.0 - theta) + fp[p] * theta) * h;
-                rhs[3 * fi..3 * fi + 3].copy_from_slice(r.as_slice());
-            }
+            // The exact position Jacobian (unclamped Hessian and the
+            // position derivative of the damping force): with the clamped
+            // one the O(h) displacement a would carry an O(h^2) error into
+            // every step and the rule would be first order.
+            let exact: Vec<Matrix3<f64>> = sys
+                .springs
+                .iter()
+                .map(|sp| hessian_block(&s.x, sp, false) + damping_position_block(&s.x, &s.v, sp))
+                .collect();
+            add_block_product(&sys.springs, &exact, &a, &mut corr);
         }
     }
+    add_block_product(&sys.springs, &bb, &dvk, &mut corr);
+    let mut rhs = vec![0.0; map.dofs()];
+    for (fi, &p) in map.particle.iter().enumerate() {
+        let r = f[p] * h - corr[p] * (theta * h);
+        rhs[3 * fi..3 * fi + 3].copy_from_slice(r.as_slice());
+    }
     StepSystem { map, matrix, rhs }
+}
+
+/// `G = -df_a/dx_a = df_a/dx_b` of the damping force
+/// `f_a = b d (d . u)`, `u = v_b - v_a`: `G = b/l [(d . u) P + d (P u)^T]`,
+/// `P = I - d d^T` (not symmetric; used only in products).
+fn damping_position_block(
+    x: &[V3],
+    v: &[V3],
+    sp: &crate::massspring::layout::Spring,
+) -> Matrix3<f64> {
+    let dx = x[sp.b] - x[sp.a];
+    let l = dx.norm();
+    if sp.damping == 0.0 || l == 0.0 {
+        return Matrix3::zeros();
+    }
+    let d = dx / l;
+    let u = v[sp.b] - v[sp.a];
+    let p = Matrix3::identity() - d * d.transpose();
+    (p * d.dot(&u) + d * (p * u).transpose()) * (sp.damping / l)
 }
 
 /// `a` (explicit part of the displacement) and the kinematic velocity change.
