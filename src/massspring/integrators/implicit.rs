@@ -83,7 +83,6 @@ pub fn step_system(sys: &System, s: &State, h: f64, scheme: Scheme) -> StepSyste
         .map(|(hs, bs)| hs * (theta * h * c) + bs * (theta * h))
         .collect();
     let matrix = assemble_block_system(&map, &sys.masses, &sys.springs, &blocks);
-    let mut rhs = vec![0.0; map.dofs()];
     // f(x + a, v + dv_k) ~ f - corr, corr = J a + B dv_k.
     let mut corr = vec![V3::zeros(); n];
     match scheme {
