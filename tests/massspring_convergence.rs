@@ -61,6 +61,8 @@ fn observed_order(layout: &Layout, integ: Integrator, h: f64, t_end: f64) -> f64
 }
 
 #[test]
+// Thousands of projection passes / Jacobi iterations: release only.
+#[cfg_attr(debug_assertions, ignore)]
 fn observed_order_is_one_for_the_euler_schemes_and_two_for_trapezoidal() {
     let layout = damped_three_particle();
     let (h, t_end) = (0.004, 1.0);
@@ -85,6 +87,8 @@ fn observed_order_is_one_for_the_euler_schemes_and_two_for_trapezoidal() {
 }
 
 #[test]
+// Thousands of projection passes / Jacobi iterations: release only.
+#[cfg_attr(debug_assertions, ignore)]
 fn observed_order_on_the_driven_damped_wire() {
     // The stiff wire (damping rate up to about 4400 1/s; forward Euler's
     // bound is 4.7e-4 s): every scheme reaches its asymptotic order once h
