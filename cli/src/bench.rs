@@ -148,9 +148,16 @@ pub fn format_bench(r: &BenchResult) -> String {
         return out;
     };
     let total = passes.total();
+    let w = passes
+        .entries()
+        .iter()
+        .map(|(name, _)| name.len())
+        .chain([20])
+        .max()
+        .unwrap_or(20);
     let _ = writeln!(
         out,
-        "{:<40} {:>10} {:>7} {:>14}",
+        "{:<w$} {:>10} {:>7} {:>14}",
         "pass", "seconds", "share", "us/substep"
     );
     let per = |s: f64| 1e6 * s / passes.substeps.max(1) as f64;
@@ -162,13 +169,13 @@ pub fn format_bench(r: &BenchResult) -> String {
         };
         let _ = writeln!(
             out,
-            "{name:<40} {secs:>10.4} {share:>6.1}% {:>14.2}",
+            "{name:<w$} {secs:>10.4} {share:>6.1}% {:>14.2}",
             per(secs)
         );
     }
     let _ = writeln!(
         out,
-        "{:<40} {total:>10.4} {:>6.1}% {:>14.2}",
+        "{:<w$} {total:>10.4} {:>6.1}% {:>14.2}",
         "total (timed passes)",
         100.0,
         per(total)
