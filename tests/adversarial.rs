@@ -398,7 +398,7 @@ fn cloth_stretched_ten_times_pbd() {
 }
 
 #[test]
-#[ignore = "massspring bug (reported): the linearised trapezoidal step at the cloth's h = 1/30 s gains energy on a 10x-stretched cloth (total energy 6.4e7 -> 5.2e9 J, max strain 9 -> 151 after 30 frames) and reports success"]
+#[ignore = "massspring (reported): trapezoidal at the cloth's h = 1/30 s gains energy on a 10x-stretched cloth (6.38e7 -> 6.90e7 J after 30 frames, +8%) and reports success; the stress study finds it stable on the cloth only up to dt ~ 0.020 s"]
 fn cloth_stretched_ten_times_trapezoidal() {
     cloth_stretched_ten_times_and_released(Integrator::Trapezoidal);
 }
