@@ -636,10 +636,11 @@ fn yes() -> bool {
 }
 
 // ---- validating field readers (the error carries the value's span) --------
-// The f64 readers of `scene::yarn` are private to that module, and this model
-// needs 3-vectors and other ranges; the line/field plumbing is shared through
-// `scene::error::from_toml_error`.
+// The common ones live in `scene::readers`; these are this model's own.
 
+use crate::scene::readers::{
+    bounded_u32, finite, finite_array, nonnegative, opt_positive, positive,
+};
 use serde::de::Error as _;
 
 fn kind_ok<'de, D: Deserializer<'de>>(d: D) -> Result<String, D::Error> {
@@ -653,35 +654,6 @@ fn kind_ok<'de, D: Deserializer<'de>>(d: D) -> Result<String, D::Error> {
     }
 }
 
-fn finite<'de, D: Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
-    let v = f64::deserialize(d)?;
-    if v.is_finite() {
-        Ok(v)
-    } else {
-        Err(D::Error::custom(format!(
-            "must be a finite number, got {v}"
-        )))
-    }
-}
-
-fn positive<'de, D: Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
-    let v = finite(d)?;
-    if v > 0.0 {
-        Ok(v)
-    } else {
-        Err(D::Error::custom(format!("must be > 0, got {v}")))
-    }
-}
-
-fn nonnegative<'de, D: Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
-    let v = finite(d)?;
-    if v >= 0.0 {
-        Ok(v)
-    } else {
-        Err(D::Error::custom(format!("must be >= 0, got {v}")))
-    }
-}
-
 fn unit_interval<'de, D: Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
     let v = finite(d)?;
     if v > 0.0 && v <= 1.0 {
@@ -689,10 +661,6 @@ fn unit_interval<'de, D: Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
     } else {
         Err(D::Error::custom(format!("must be in (0, 1], got {v}")))
     }
-}
-
-fn opt_positive<'de, D: Deserializer<'de>>(d: D) -> Result<Option<f64>, D::Error> {
-    positive(d).map(Some)
 }
 
 fn opt_strain<'de, D: Deserializer<'de>>(d: D) -> Result<Option<f64>, D::Error> {
@@ -705,25 +673,7 @@ fn opt_strain<'de, D: Deserializer<'de>>(d: D) -> Result<Option<f64>, D::Error> 
 }
 
 fn finite3<'de, D: Deserializer<'de>>(d: D) -> Result<[f64; 3], D::Error> {
-    let v = <[f64; 3]>::deserialize(d)?;
-    if v.iter().all(|x| x.is_finite()) {
-        Ok(v)
-    } else {
-        Err(D::Error::custom(format!(
-            "must be three finite numbers, got {v:?}"
-        )))
-    }
-}
-
-fn bounded_u32<'de, D: Deserializer<'de>>(d: D, lo: u32, hi: u32) -> Result<u32, D::Error> {
-    let v = i64::deserialize(d)?;
-    if (lo as i64..=hi as i64).contains(&v) {
-        Ok(v as u32)
-    } else {
-        Err(D::Error::custom(format!(
-            "must be an integer from {lo} to {hi}, got {v}"
-        )))
-    }
+    finite_array::<D, 3>(d)
 }
 
 fn frame_count<'de, D: Deserializer<'de>>(d: D) -> Result<u32, D::Error> {

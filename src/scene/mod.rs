@@ -5,6 +5,7 @@
 
 pub mod builtin;
 pub mod error;
+pub(crate) mod readers;
 pub mod yarn;
 
 pub use builtin::{builtin, builtin_names, DEFAULT_SCENE};

@@ -467,6 +467,7 @@ fn default_obstacle_friction() -> f64 {
 
 // ---- validating field readers (the error carries the value's span) --------
 
+use super::readers::{bounded_u32, finite_array, nonnegative, opt_positive, positive};
 use serde::de::Error as _;
 
 fn kind_is_yarn<'de, D: Deserializer<'de>>(d: D) -> Result<String, D::Error> {
@@ -480,63 +481,12 @@ fn kind_is_yarn<'de, D: Deserializer<'de>>(d: D) -> Result<String, D::Error> {
     }
 }
 
-fn finite<'de, D: Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
-    let v = f64::deserialize(d)?;
-    if v.is_finite() {
-        Ok(v)
-    } else {
-        Err(D::Error::custom(format!(
-            "must be a finite number, got {v}"
-        )))
-    }
-}
-
-fn positive<'de, D: Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
-    let v = finite(d)?;
-    if v > 0.0 {
-        Ok(v)
-    } else {
-        Err(D::Error::custom(format!("must be > 0, got {v}")))
-    }
-}
-
-fn nonnegative<'de, D: Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
-    let v = finite(d)?;
-    if v >= 0.0 {
-        Ok(v)
-    } else {
-        Err(D::Error::custom(format!("must be >= 0, got {v}")))
-    }
-}
-
-fn opt_positive<'de, D: Deserializer<'de>>(d: D) -> Result<Option<f64>, D::Error> {
-    positive(d).map(Some)
-}
-
 fn finite2<'de, D: Deserializer<'de>>(d: D) -> Result<[f64; 2], D::Error> {
-    let v = <[f64; 2]>::deserialize(d)?;
-    if v.iter().all(|x| x.is_finite()) {
-        Ok(v)
-    } else {
-        Err(D::Error::custom(format!(
-            "must be two finite numbers, got {v:?}"
-        )))
-    }
+    finite_array::<D, 2>(d)
 }
 
 fn opt_finite2<'de, D: Deserializer<'de>>(d: D) -> Result<Option<[f64; 2]>, D::Error> {
     finite2(d).map(Some)
-}
-
-fn bounded_u32<'de, D: Deserializer<'de>>(d: D, lo: u32, hi: u32) -> Result<u32, D::Error> {
-    let v = i64::deserialize(d)?;
-    if (lo as i64..=hi as i64).contains(&v) {
-        Ok(v as u32)
-    } else {
-        Err(D::Error::custom(format!(
-            "must be an integer from {lo} to {hi}, got {v}"
-        )))
-    }
 }
 
 fn resolution<'de, D: Deserializer<'de>>(d: D) -> Result<u32, D::Error> {

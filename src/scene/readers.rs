@@ -1,0 +1,76 @@
+//! Validating field readers for `#[serde(deserialize_with = ...)]`, shared by
+//! every scene kind. A reader's error carries the value's span, so the TOML
+//! loader reports the line and the field of a bad value.
+
+use serde::de::Error as _;
+use serde::{Deserialize, Deserializer};
+
+/// A finite `f64`.
+pub(crate) fn finite<'de, D: Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
+    let v = f64::deserialize(d)?;
+    if v.is_finite() {
+        Ok(v)
+    } else {
+        Err(D::Error::custom(format!(
+            "must be a finite number, got {v}"
+        )))
+    }
+}
+
+/// A finite `f64 > 0`.
+pub(crate) fn positive<'de, D: Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
+    let v = finite(d)?;
+    if v > 0.0 {
+        Ok(v)
+    } else {
+        Err(D::Error::custom(format!("must be > 0, got {v}")))
+    }
+}
+
+/// A finite `f64 >= 0`.
+pub(crate) fn nonnegative<'de, D: Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
+    let v = finite(d)?;
+    if v >= 0.0 {
+        Ok(v)
+    } else {
+        Err(D::Error::custom(format!("must be >= 0, got {v}")))
+    }
+}
+
+/// An optional field that, when present, is a finite `f64 > 0`.
+pub(crate) fn opt_positive<'de, D: Deserializer<'de>>(d: D) -> Result<Option<f64>, D::Error> {
+    positive(d).map(Some)
+}
+
+/// `N` finite numbers.
+pub(crate) fn finite_array<'de, D: Deserializer<'de>, const N: usize>(
+    d: D,
+) -> Result<[f64; N], D::Error> {
+    let v = Vec::<f64>::deserialize(d)?;
+    match <[f64; N]>::try_from(v.as_slice()) {
+        Ok(a) if a.iter().all(|x| x.is_finite()) => Ok(a),
+        Ok(a) => Err(D::Error::custom(format!(
+            "must be {N} finite numbers, got {a:?}"
+        ))),
+        Err(_) => Err(D::Error::custom(format!(
+            "must be {N} numbers, got {} ({v:?})",
+            v.len()
+        ))),
+    }
+}
+
+/// An integer in `lo..=hi`.
+pub(crate) fn bounded_u32<'de, D: Deserializer<'de>>(
+    d: D,
+    lo: u32,
+    hi: u32,
+) -> Result<u32, D::Error> {
+    let v = i64::deserialize(d)?;
+    if (lo as i64..=hi as i64).contains(&v) {
+        Ok(v as u32)
+    } else {
+        Err(D::Error::custom(format!(
+            "must be an integer from {lo} to {hi}, got {v}"
+        )))
+    }
+}
