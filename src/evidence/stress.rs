@@ -296,7 +296,7 @@ pub fn yarn_configs(quick: bool) -> Vec<(String, f64, YarnScene)> {
     } {
         let mut s = base.clone();
         s.gravity = [0.0, -g];
-        v.push((format!("|g| = {g}"), g, s));
+        v.push((format!("gravity {g}"), g, s));
     }
     v
 }
