@@ -439,3 +439,24 @@ fn bad_inputs_are_rejected() {
     assert!(sim.step_dt(-1.0).is_err());
     assert_eq!(sim.attractor(), a);
 }
+
+#[test]
+fn simd_and_portable_kernels_give_the_same_bits() {
+    // The reference scene's setting (obstacles, walls, plasticity, bending),
+    // smaller: the wide (AVX2) and portable kernels must agree exactly.
+    let mut scene = match yarnsim::scene::builtin("yarn-reference") {
+        Some(yarnsim::Scene::Yarn(s)) => s,
+        _ => unreachable!(),
+    };
+    scene.yarns.truncate(1);
+    scene.yarns[0].count = 3;
+    scene.attractor.active = true;
+    let run = |portable: bool| {
+        passes::set_portable_kernels(portable);
+        let mut sim = YarnSim::new(&scene).unwrap();
+        sim.steps_n(300).unwrap();
+        passes::set_portable_kernels(false);
+        sim.save_state()
+    };
+    assert!(run(true) == run(false));
+}

@@ -12,18 +12,70 @@
 //!
 //! [`quad_stress`] computes that stress when the state was set from outside.
 
+use std::sync::atomic::{AtomicBool, Ordering};
+
 use rayon::prelude::*;
 
 use super::constitutive::{frame_gradient_qr, YarnEnergy};
 use super::grid::{Grid, GridGeom, Node, ScatterBuffer, BLOCK, CHUNKS, M, X, Y};
 use super::particles::{Particles, Quads, Vertices, NONE};
 use crate::math::bspline::Stencil;
-use crate::math::qr::qr;
+use crate::math::qr::{qr, Qr2};
 use crate::math::{Mat2, Vec2};
 use crate::scene::{Obstacle, WallMode};
 
-/// Minimum particles per parallel task.
+/// Particles per parallel task in the gathers.
 const PAR_MIN: usize = 256;
+
+/// Set to run the portable kernels even where AVX2 is available.
+static PORTABLE_ONLY: AtomicBool = AtomicBool::new(false);
+
+/// Makes every simulation in the process use the portable kernels (`true`)
+/// or the AVX2 + FMA ones where the CPU has them (`false`, the default).
+/// Results are bitwise the same; this exists to test exactly that.
+pub fn set_portable_kernels(portable: bool) {
+    PORTABLE_ONLY.store(portable, Ordering::Relaxed);
+}
+
+/// Whether the CPU runs the AVX2 + FMA versions of the kernels (detected
+/// once by std, cached).
+#[inline(always)]
+fn wide_simd() -> bool {
+    #[cfg(target_arch = "x86_64")]
+    {
+        std::is_x86_feature_detected!("avx2")
+            && std::is_x86_feature_detected!("fma")
+            && !PORTABLE_ONLY.load(Ordering::Relaxed)
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        false
+    }
+}
+
+/// `fn $name(args) = $imp;` defines `$name`, which runs the `#[inline(always)]`
+/// kernel `$imp` compiled for AVX2 + FMA when the CPU has them and as built
+/// otherwise. Both give the same bits: Rust never contracts `a * b + c` into
+/// an FMA by itself, so only the register width differs.
+macro_rules! multiversion {
+    ($(#[$m:meta])* fn $name:ident($($a:ident: $t:ty),* $(,)?) $(-> $r:ty)? = $imp:ident;) => {
+        $(#[$m])*
+        fn $name($($a: $t),*) $(-> $r)? {
+            #[cfg(target_arch = "x86_64")]
+            {
+                #[target_feature(enable = "avx2,fma")]
+                unsafe fn wide($($a: $t),*) $(-> $r)? {
+                    $imp($($a),*)
+                }
+                if wide_simd() {
+                    // SAFETY: the CPU has the features `wide` is compiled for.
+                    return unsafe { wide($($a),*) };
+                }
+            }
+            $imp($($a),*)
+        }
+    };
+}
 
 /// The external-force and boundary settings used by [`grid_update`].
 #[derive(Clone, Debug)]
@@ -140,7 +192,6 @@ fn splat(buf: &mut ScatterBuffer, geom: &GridGeom, st: &Stencil, m: f64, p0: Vec
 pub fn scatter(p: &mut Particles, grid: &mut Grid, dt: f64, bending: f64) {
     let geom = grid.geom;
     let (nv, nq) = (p.vert.x.len(), p.quad.x.len());
-    let inv_dx = geom.inv_dx;
     // Each chunk writes the stencils of its own vertex range (taken out of
     // `p.vert` meanwhile, so the rest of it can be shared).
     let mut vert_stencils = std::mem::take(&mut p.vert.stencil);
@@ -151,32 +202,70 @@ pub fn scatter(p: &mut Particles, grid: &mut Grid, dt: f64, bending: f64) {
         stencils.push(head);
         rest = tail;
     }
-    let vert = &p.vert;
-    let quad = &p.quad;
-    let dx = geom.dx;
-    // the normal force per unit of (w_i (x_i - x_p) / dx . d2): -dt dE/dd2 4 / dx
-    let normal_scale = -dt * 4.0 * geom.inv_dx;
+    let ctx = ScatterCtx {
+        vert: &p.vert,
+        quad: &p.quad,
+        geom,
+        dt,
+        bending,
+    };
     grid.buffers
         .par_iter_mut()
         .zip(stencils)
         .enumerate()
         .for_each(|(k, (buf, sts))| {
-            buf.clear(&geom);
-            for (i, st) in chunk_range(nv, k).zip(sts.iter_mut()) {
-                *st = Stencil::new(vert.x[i], inv_dx);
-                let m = vert.m[i];
-                let p0 = vert.v[i] * m + vertex_force(vert, &quad.t1, i, bending) * dt;
-                splat(buf, &geom, st, m, p0, &(vert.c[i] * (m * dx)));
-            }
-            for q in chunk_range(nq, k) {
-                let m = quad.m[q];
-                let d2 = quad.d[q].column(1).into_owned();
-                let a = quad.c[q] * (m * dx) + quad.t2[q] * normal_scale * d2.transpose();
-                splat(buf, &geom, &quad.stencil[q], m, quad.v[q] * m, &a);
-            }
+            scatter_chunk(buf, sts, chunk_range(nv, k), chunk_range(nq, k), &ctx)
         });
     p.vert.stencil = vert_stencils;
     grid.collect_active();
+}
+
+/// What every scatter chunk reads.
+struct ScatterCtx<'a> {
+    vert: &'a Vertices,
+    quad: &'a Quads,
+    geom: GridGeom,
+    dt: f64,
+    bending: f64,
+}
+
+multiversion! {
+    /// Scatters vertices `vr` (writing their stencils to `sts`) and
+    /// quadrature particles `qr` into one chunk's buffer.
+    fn scatter_chunk(
+        buf: &mut ScatterBuffer,
+        sts: &mut [Stencil],
+        vr: std::ops::Range<usize>,
+        qr: std::ops::Range<usize>,
+        ctx: &ScatterCtx,
+    ) = scatter_chunk_impl;
+}
+
+#[inline(always)]
+fn scatter_chunk_impl(
+    buf: &mut ScatterBuffer,
+    sts: &mut [Stencil],
+    vr: std::ops::Range<usize>,
+    qr: std::ops::Range<usize>,
+    ctx: &ScatterCtx,
+) {
+    let (vert, quad, geom, dt) = (ctx.vert, ctx.quad, &ctx.geom, ctx.dt);
+    let dx = geom.dx;
+    // the normal force per unit of (w_i (x_i - x_p) / dx . d2): -dt dE/dd2 4 / dx
+    let normal_scale = -dt * 4.0 * geom.inv_dx;
+    buf.clear(geom);
+    for (i, st) in vr.zip(sts.iter_mut()) {
+        *st = Stencil::new(vert.x[i], geom.inv_dx);
+        let m = vert.m[i];
+        let p0 = vert.v[i] * m + vertex_force(vert, &quad.t1, i, ctx.bending) * dt;
+        splat(buf, geom, st, m, p0, &(vert.c[i] * (m * dx)));
+    }
+    for q in qr {
+        let m = quad.m[q];
+        let d2 = quad.d[q].column(1).into_owned();
+        let a = quad.c[q] * (m * dx) + quad.t2[q] * normal_scale * d2.transpose();
+        splat(buf, geom, &quad.stencil[q], m, quad.v[q] * m, &a);
+    }
 }
 
 /// Pass 2: sums the chunk buffers on the active blocks, turns momentum into
@@ -186,76 +275,100 @@ pub fn grid_update(grid: &mut Grid, dt: f64, ext: &GridForces) {
     let geom = grid.geom;
     let buffers = &grid.buffers;
     let is_active = &grid.is_active;
-    let cells = ext.wall_cells;
-    let dx = geom.dx;
     grid.node
         .par_chunks_mut(geom.stride * BLOCK)
         .enumerate()
-        .for_each(|(bi, band)| {
-            for bj in 0..geom.nb {
-                let b = bi * geom.nb + bj;
-                if !is_active[b] {
-                    continue;
-                }
-                let (i0, j0) = (bi * BLOCK, bj * BLOCK);
-                let mut srcs: [&ScatterBuffer; CHUNKS] = [&buffers[0]; CHUNKS];
-                let mut nsrc = 0;
-                for s in buffers.iter().filter(|s| s.touched[b]) {
-                    srcs[nsrc] = s;
-                    nsrc += 1;
-                }
-                let srcs = &srcs[..nsrc];
-                let lo = Vec2::new(i0 as f64, j0 as f64) * dx;
-                let hi = lo + Vec2::new((BLOCK - 1) as f64, (BLOCK - 1) as f64) * dx;
-                let near_obstacle = ext.obstacles.iter().any(|o| {
-                    let c = Vec2::from(o.center);
-                    let q = Vec2::new(c.x.clamp(lo.x, hi.x), c.y.clamp(lo.y, hi.y));
-                    (q - c).norm() < o.radius
-                });
-                let near_wall = ext.walls != WallMode::None
-                    && (i0 < cells
-                        || j0 < cells
-                        || i0 + BLOCK + cells > geom.n
-                        || j0 + BLOCK + cells > geom.n);
-                for r in 0..BLOCK {
-                    let i = i0 + r;
-                    let row = r * geom.stride + j0;
-                    let gidx = bi * BLOCK * geom.stride + row;
-                    for c in 0..BLOCK {
-                        let j = j0 + c;
-                        let mut acc: Node = [0.0; 4];
-                        for s in srcs {
-                            let n = &s.node[gidx + c];
-                            for l in 0..4 {
-                                acc[l] += n[l];
-                            }
-                        }
-                        let out = &mut band[row + c];
-                        if acc[M] <= 0.0 {
-                            *out = [0.0; 4];
-                            continue;
-                        }
-                        let mut v = Vec2::new(acc[X], acc[Y]) / acc[M] + ext.gravity * dt;
-                        if ext.attractor.is_some() || near_obstacle {
-                            let xi = Vec2::new(i as f64, j as f64) * dx;
-                            if let Some((pos, strength)) = ext.attractor {
-                                let d = pos - xi;
-                                v += d * (dt * strength / (d.norm() + 0.01));
-                            }
-                            if near_obstacle {
-                                for o in ext.obstacles {
-                                    v = obstacle_velocity(o, xi, v);
-                                }
-                            }
-                        }
-                        if near_wall {
-                            v = wall_velocity(ext.walls, cells, geom.n, i, j, v);
-                        }
-                        *out = [v.x, v.y, acc[M], 0.0];
+        .for_each(|(bi, band)| grid_band(bi, band, buffers, is_active, &geom, dt, ext));
+}
+
+multiversion! {
+    /// [`grid_update`] on the active blocks of block row `bi`.
+    fn grid_band(
+        bi: usize,
+        band: &mut [Node],
+        buffers: &[ScatterBuffer],
+        is_active: &[bool],
+        geom: &GridGeom,
+        dt: f64,
+        ext: &GridForces,
+    ) = grid_band_impl;
+}
+
+#[inline(always)]
+fn grid_band_impl(
+    bi: usize,
+    band: &mut [Node],
+    buffers: &[ScatterBuffer],
+    is_active: &[bool],
+    geom: &GridGeom,
+    dt: f64,
+    ext: &GridForces,
+) {
+    let cells = ext.wall_cells;
+    let dx = geom.dx;
+    for bj in 0..geom.nb {
+        let b = bi * geom.nb + bj;
+        if !is_active[b] {
+            continue;
+        }
+        let (i0, j0) = (bi * BLOCK, bj * BLOCK);
+        let mut srcs: [&ScatterBuffer; CHUNKS] = [&buffers[0]; CHUNKS];
+        let mut nsrc = 0;
+        for s in buffers.iter().filter(|s| s.touched[b]) {
+            srcs[nsrc] = s;
+            nsrc += 1;
+        }
+        let srcs = &srcs[..nsrc];
+        let lo = Vec2::new(i0 as f64, j0 as f64) * dx;
+        let hi = lo + Vec2::new((BLOCK - 1) as f64, (BLOCK - 1) as f64) * dx;
+        let near_obstacle = ext.obstacles.iter().any(|o| {
+            let c = Vec2::from(o.center);
+            let q = Vec2::new(c.x.clamp(lo.x, hi.x), c.y.clamp(lo.y, hi.y));
+            (q - c).norm() < o.radius
+        });
+        let near_wall = ext.walls != WallMode::None
+            && (i0 < cells
+                || j0 < cells
+                || i0 + BLOCK + cells > geom.n
+                || j0 + BLOCK + cells > geom.n);
+        for r in 0..BLOCK {
+            let i = i0 + r;
+            let row = r * geom.stride + j0;
+            let gidx = bi * BLOCK * geom.stride + row;
+            for c in 0..BLOCK {
+                let j = j0 + c;
+                let mut acc: Node = [0.0; 4];
+                for s in srcs {
+                    let n = &s.node[gidx + c];
+                    for l in 0..4 {
+                        acc[l] += n[l];
                     }
                 }
+                let out = &mut band[row + c];
+                if acc[M] <= 0.0 {
+                    *out = [0.0; 4];
+                    continue;
+                }
+                let mut v = Vec2::new(acc[X], acc[Y]) / acc[M] + ext.gravity * dt;
+                if ext.attractor.is_some() || near_obstacle {
+                    let xi = Vec2::new(i as f64, j as f64) * dx;
+                    if let Some((pos, strength)) = ext.attractor {
+                        let d = pos - xi;
+                        v += d * (dt * strength / (d.norm() + 0.01));
+                    }
+                    if near_obstacle {
+                        for o in ext.obstacles {
+                            v = obstacle_velocity(o, xi, v);
+                        }
+                    }
+                }
+                if near_wall {
+                    v = wall_velocity(ext.walls, cells, geom.n, i, j, v);
+                }
+                *out = [v.x, v.y, acc[M], 0.0];
             }
-        });
+        }
+    }
 }
 
 /// Velocity of a grid node after contact with a circular obstacle: no
@@ -396,34 +509,66 @@ pub fn gather_vertices(
     dt: f64,
     obstacles: &[Obstacle],
 ) -> Option<usize> {
-    let geom = grid.geom;
-    let (lo, hi) = (geom.dx, (geom.n as f64 - 2.0) * geom.dx);
-    (&mut vert.x, &mut vert.v, &mut vert.c, &vert.stencil)
+    (
+        vert.x.par_chunks_mut(PAR_MIN),
+        vert.v.par_chunks_mut(PAR_MIN),
+        vert.c.par_chunks_mut(PAR_MIN),
+        vert.stencil.par_chunks(PAR_MIN),
+    )
         .into_par_iter()
-        .with_min_len(PAR_MIN)
         .enumerate()
         .filter_map(|(k, (x, v, c, st))| {
-            let (nv, nc) = interpolate(grid, st);
-            *v = nv;
-            *c = nc;
-            *x += nv * dt;
-            for o in obstacles {
-                project_out(o, x, v);
-            }
-            clamp_to_grid(x, v, lo, hi);
-            // Finite, and no faster than one cell per substep (CFL): beyond
-            // that the transfer is meaningless and the run is diverging.
-            let ok = x.x.is_finite()
-                && x.y.is_finite()
-                && c.iter().all(|e| e.is_finite())
-                && nv.norm_squared() * (dt * dt) <= geom.dx * geom.dx;
-            if ok {
-                None
-            } else {
-                Some(k)
-            }
+            gather_vertex_chunk(x, v, c, st, grid, dt, obstacles).map(|i| k * PAR_MIN + i)
         })
         .min()
+}
+
+multiversion! {
+    /// [`gather_vertices`] on one chunk; returns the first bad index in it.
+    fn gather_vertex_chunk(
+        xs: &mut [Vec2],
+        vs: &mut [Vec2],
+        cs: &mut [Mat2],
+        sts: &[Stencil],
+        grid: &Grid,
+        dt: f64,
+        obstacles: &[Obstacle],
+    ) -> Option<usize> = gather_vertex_chunk_impl;
+}
+
+#[inline(always)]
+fn gather_vertex_chunk_impl(
+    xs: &mut [Vec2],
+    vs: &mut [Vec2],
+    cs: &mut [Mat2],
+    sts: &[Stencil],
+    grid: &Grid,
+    dt: f64,
+    obstacles: &[Obstacle],
+) -> Option<usize> {
+    let geom = grid.geom;
+    let (lo, hi) = (geom.dx, (geom.n as f64 - 2.0) * geom.dx);
+    let mut bad = None;
+    for (k, (((x, v), c), st)) in xs.iter_mut().zip(vs).zip(cs).zip(sts).enumerate() {
+        let (nv, nc) = interpolate(grid, st);
+        *v = nv;
+        *c = nc;
+        *x += nv * dt;
+        for o in obstacles {
+            project_out(o, x, v);
+        }
+        clamp_to_grid(x, v, lo, hi);
+        // Finite, and no faster than one cell per substep (CFL): beyond
+        // that the transfer is meaningless and the run is diverging.
+        let ok = x.x.is_finite()
+            && x.y.is_finite()
+            && c.iter().all(|e| e.is_finite())
+            && nv.norm_squared() * (dt * dt) <= geom.dx * geom.dx;
+        if !ok && bad.is_none() {
+            bad = Some(k);
+        }
+    }
+    bad
 }
 
 /// Pass 4: grid-to-particle for quadrature particles: velocity and `C` from
@@ -440,57 +585,124 @@ pub fn gather_quads(
     energy: &YarnEnergy,
     plastic: bool,
 ) -> Option<usize> {
-    let inv_dx = grid.geom.inv_dx;
-    let stress = (&mut quad.stencil, &mut quad.t1, &mut quad.t2, &quad.vol);
+    let rest = QuadRest {
+        left: &quad.left,
+        d_rest_inv: &quad.d_rest_inv,
+        l0: &quad.l0,
+        vol: &quad.vol,
+        vx,
+        dt,
+        energy,
+        plastic,
+    };
     (
-        &mut quad.x,
-        &mut quad.v,
-        &mut quad.c,
-        &mut quad.d,
-        &mut quad.f,
-        &mut quad.frame,
-        stress,
-        &quad.left,
-        &quad.d_rest_inv,
-        &quad.l0,
+        quad.x.par_chunks_mut(PAR_MIN),
+        quad.v.par_chunks_mut(PAR_MIN),
+        quad.c.par_chunks_mut(PAR_MIN),
+        quad.d.par_chunks_mut(PAR_MIN),
+        quad.f.par_chunks_mut(PAR_MIN),
+        quad.frame.par_chunks_mut(PAR_MIN),
+        quad.stencil.par_chunks_mut(PAR_MIN),
+        quad.t1.par_chunks_mut(PAR_MIN),
+        quad.t2.par_chunks_mut(PAR_MIN),
     )
         .into_par_iter()
-        .with_min_len(PAR_MIN)
         .enumerate()
-        .filter_map(
-            |(k, (x, v, c, d, f, frame, (st, t1, t2, vol), left, dinv, l0))| {
-                let (nv, nc) = interpolate(grid, st);
-                *v = nv;
-                *c = nc;
-                let (xl, xr) = (vx[*left as usize], vx[*left as usize + 1]);
-                *x = (xl + xr) * 0.5;
-                let d1 = xr - xl;
-                let d2o = d.column(1).into_owned();
-                let mut d2 = d2o + nc * d2o * dt;
-                let inv_l0 = 1.0 / *l0;
-                let mut r = qr(&(Mat2::from_columns(&[d1, d2]) * inv_l0));
-                if plastic {
-                    let (r12, r22) = energy.return_map(r.r12, r.r22);
-                    if r12 != r.r12 || r22 != r.r22 {
-                        d2 = r.rotate(Vec2::new(r12, r22)) * *l0;
-                        // refactor (rather than patch r12, r22) so that `frame` is
-                        // always bitwise qr(d / l0), as after a state restore
-                        r = qr(&(Mat2::from_columns(&[d1, d2]) * inv_l0));
-                    }
-                }
-                *frame = r;
-                *d = Mat2::from_columns(&[d1, d2]);
-                *f = *d * dinv;
-                *st = Stencil::new(*x, inv_dx);
-                (*t1, *t2) = frame_gradient_qr(energy, &r, *l0, *vol);
-                if d.iter().all(|e| e.is_finite()) && v.x.is_finite() && v.y.is_finite() {
-                    None
-                } else {
-                    Some(k)
-                }
-            },
-        )
+        .filter_map(|(k, (x, v, c, d, f, frame, st, t1, t2))| {
+            let chunk = QuadChunk {
+                x,
+                v,
+                c,
+                d,
+                f,
+                frame,
+                stencil: st,
+                t1,
+                t2,
+            };
+            gather_quad_chunk(k * PAR_MIN, chunk, grid, &rest).map(|i| k * PAR_MIN + i)
+        })
         .min()
+}
+
+/// The per-particle arrays [`gather_quads`] writes, for one chunk.
+struct QuadChunk<'a> {
+    x: &'a mut [Vec2],
+    v: &'a mut [Vec2],
+    c: &'a mut [Mat2],
+    d: &'a mut [Mat2],
+    f: &'a mut [Mat2],
+    frame: &'a mut [Qr2],
+    stencil: &'a mut [Stencil],
+    t1: &'a mut [Vec2],
+    t2: &'a mut [Vec2],
+}
+
+/// What [`gather_quads`] only reads (indexed by global particle index).
+struct QuadRest<'a> {
+    left: &'a [u32],
+    d_rest_inv: &'a [Mat2],
+    l0: &'a [f64],
+    vol: &'a [f64],
+    vx: &'a [Vec2],
+    dt: f64,
+    energy: &'a YarnEnergy,
+    plastic: bool,
+}
+
+multiversion! {
+    /// [`gather_quads`] on the chunk starting at particle `base`; returns the
+    /// first bad index in it.
+    fn gather_quad_chunk(base: usize, q: QuadChunk, grid: &Grid, r: &QuadRest) -> Option<usize>
+        = gather_quad_chunk_impl;
+}
+
+#[inline(always)]
+fn gather_quad_chunk_impl(
+    base: usize,
+    q: QuadChunk,
+    grid: &Grid,
+    rest: &QuadRest,
+) -> Option<usize> {
+    let (dt, energy) = (rest.dt, rest.energy);
+    let inv_dx = grid.geom.inv_dx;
+    let mut bad = None;
+    for k in 0..q.x.len() {
+        let g = base + k;
+        let l0 = rest.l0[g];
+        let (nv, nc) = interpolate(grid, &q.stencil[k]);
+        q.v[k] = nv;
+        q.c[k] = nc;
+        let left = rest.left[g] as usize;
+        let (xl, xr) = (rest.vx[left], rest.vx[left + 1]);
+        let x = (xl + xr) * 0.5;
+        q.x[k] = x;
+        let d1 = xr - xl;
+        let d2o = q.d[k].column(1).into_owned();
+        let mut d2 = d2o + nc * d2o * dt;
+        let inv_l0 = 1.0 / l0;
+        let mut r = qr(&(Mat2::from_columns(&[d1, d2]) * inv_l0));
+        if rest.plastic {
+            let (r12, r22) = energy.return_map(r.r12, r.r22);
+            if r12 != r.r12 || r22 != r.r22 {
+                d2 = r.rotate(Vec2::new(r12, r22)) * l0;
+                // refactor (rather than patch r12, r22) so that `frame` is
+                // always bitwise qr(d / l0), as after a state restore
+                r = qr(&(Mat2::from_columns(&[d1, d2]) * inv_l0));
+            }
+        }
+        let d = Mat2::from_columns(&[d1, d2]);
+        q.frame[k] = r;
+        q.d[k] = d;
+        q.f[k] = d * rest.d_rest_inv[g];
+        q.stencil[k] = Stencil::new(x, inv_dx);
+        (q.t1[k], q.t2[k]) = frame_gradient_qr(energy, &r, l0, rest.vol[g]);
+        let ok = d.iter().all(|e| e.is_finite()) && nv.x.is_finite() && nv.y.is_finite();
+        if !ok && bad.is_none() {
+            bad = Some(k);
+        }
+    }
+    bad
 }
 
 /// Whether `n` splits into the same chunks as the scatter uses (for tests).
