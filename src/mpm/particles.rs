@@ -49,8 +49,6 @@ pub struct Quads {
     pub d_rest: Vec<Mat2>,
     /// `D^-1`.
     pub d_rest_inv: Vec<Mat2>,
-    /// Deformation gradient `F = d D^-1` (world frame).
-    pub f: Vec<Mat2>,
     /// Rest length `|D1|`.
     pub l0: Vec<f64>,
     /// Volume (per unit depth): `l0` times unit thickness.
@@ -68,6 +66,11 @@ pub struct Quads {
 }
 
 impl Quads {
+    /// Deformation gradient `F = d D^-1` (world frame) of particle `q`.
+    pub fn deformation_gradient(&self, q: usize) -> Mat2 {
+        self.d[q] * self.d_rest_inv[q]
+    }
+
     /// Recomputes [`Quads::frame`] from `d` (after `d` was set from outside the stepper).
     pub fn refresh_frames(&mut self) {
         self.frame = self
@@ -139,7 +142,6 @@ impl Particles {
                 p.quad
                     .d_rest_inv
                     .push(dm.try_inverse().expect("segments have positive length"));
-                p.quad.f.push(Mat2::identity());
                 p.quad.l0.push(l0);
                 p.quad.vol.push(l0);
                 p.quad.left.push(l as u32);

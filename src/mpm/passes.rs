@@ -573,7 +573,7 @@ fn gather_vertex_chunk_impl(
 
 /// Pass 4: grid-to-particle for quadrature particles: velocity and `C` from
 /// the grid, position and `d1` from the (already moved) vertices,
-/// `d2 += dt C d2`, the return mapping (when `plastic`) and `F = d D^-1`;
+/// `d2 += dt C d2` and the return mapping (when `plastic`);
 /// then, for the next step, the particle's stencil and its stress from the
 /// new frame. Returns the first quadrature particle with a non-finite
 /// frame, if any.
@@ -587,7 +587,6 @@ pub fn gather_quads(
 ) -> Option<usize> {
     let rest = QuadRest {
         left: &quad.left,
-        d_rest_inv: &quad.d_rest_inv,
         l0: &quad.l0,
         vol: &quad.vol,
         vx,
@@ -600,7 +599,6 @@ pub fn gather_quads(
         quad.v.par_chunks_mut(PAR_MIN),
         quad.c.par_chunks_mut(PAR_MIN),
         quad.d.par_chunks_mut(PAR_MIN),
-        quad.f.par_chunks_mut(PAR_MIN),
         quad.frame.par_chunks_mut(PAR_MIN),
         quad.stencil.par_chunks_mut(PAR_MIN),
         quad.t1.par_chunks_mut(PAR_MIN),
@@ -608,13 +606,12 @@ pub fn gather_quads(
     )
         .into_par_iter()
         .enumerate()
-        .filter_map(|(k, (x, v, c, d, f, frame, st, t1, t2))| {
+        .filter_map(|(k, (x, v, c, d, frame, st, t1, t2))| {
             let chunk = QuadChunk {
                 x,
                 v,
                 c,
                 d,
-                f,
                 frame,
                 stencil: st,
                 t1,
@@ -631,7 +628,6 @@ struct QuadChunk<'a> {
     v: &'a mut [Vec2],
     c: &'a mut [Mat2],
     d: &'a mut [Mat2],
-    f: &'a mut [Mat2],
     frame: &'a mut [Qr2],
     stencil: &'a mut [Stencil],
     t1: &'a mut [Vec2],
@@ -641,7 +637,6 @@ struct QuadChunk<'a> {
 /// What [`gather_quads`] only reads (indexed by global particle index).
 struct QuadRest<'a> {
     left: &'a [u32],
-    d_rest_inv: &'a [Mat2],
     l0: &'a [f64],
     vol: &'a [f64],
     vx: &'a [Vec2],
@@ -694,7 +689,6 @@ fn gather_quad_chunk_impl(
         let d = Mat2::from_columns(&[d1, d2]);
         q.frame[k] = r;
         q.d[k] = d;
-        q.f[k] = d * rest.d_rest_inv[g];
         q.stencil[k] = Stencil::new(x, inv_dx);
         (q.t1[k], q.t2[k]) = frame_gradient_qr(energy, &r, l0, rest.vol[g]);
         let ok = d.iter().all(|e| e.is_finite()) && nv.x.is_finite() && nv.y.is_finite();

@@ -140,7 +140,7 @@ impl YarnSim {
             put_vec(&mut payload, &p.quad.v[q]);
             put_mat(&mut payload, &p.quad.c[q]);
             put_mat(&mut payload, &p.quad.d[q]);
-            put_mat(&mut payload, &p.quad.f[q]);
+            put_mat(&mut payload, &p.quad.deformation_gradient(q));
         }
         let mut out = Vec::with_capacity(HEADER + payload.len());
         out.extend_from_slice(MAGIC);
@@ -246,7 +246,8 @@ impl YarnSim {
         self.dt = dt;
         let p = &mut self.particles;
         (p.vert.x, p.vert.v, p.vert.c) = vert;
-        (p.quad.x, p.quad.v, p.quad.c, p.quad.d, p.quad.f) = quad;
+        // quad.4 (F) is determined by d; it is stored for readers of the format
+        (p.quad.x, p.quad.v, p.quad.c, p.quad.d) = (quad.0, quad.1, quad.2, quad.3);
         self.failed = None;
         self.frames_stale = true;
         Ok(())
