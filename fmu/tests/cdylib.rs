@@ -37,13 +37,7 @@ unsafe fn sym<T: Copy>(lib: *mut c_void, name: &str) -> T {
 
 #[test]
 fn shared_library_loads_and_runs_like_the_rlib() {
-    let exe = std::env::current_exe().unwrap();
-    let path = exe
-        .parent()
-        .unwrap()
-        .parent()
-        .unwrap()
-        .join(format!("lib{MODEL_IDENTIFIER}.so"));
+    let path = cdylib_path();
     let cpath = CString::new(path.to_str().unwrap()).unwrap();
     let scene = small_scene();
     let dir = resources(&scene);

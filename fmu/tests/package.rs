@@ -10,11 +10,8 @@ use yarnsim::scene::YarnScene;
 use YarnBundle::model::*;
 use YarnBundle::package::*;
 
-/// The cdylib cargo built next to the test executable's `deps/` folder.
 fn cdylib() -> PathBuf {
-    let exe = std::env::current_exe().unwrap();
-    let dir = exe.parent().unwrap().parent().unwrap();
-    dir.join(format!("lib{MODEL_IDENTIFIER}.so"))
+    common::cdylib_path()
 }
 
 #[test]

@@ -14,6 +14,19 @@ use YarnBundle::model::*;
 
 pub const SMALL_SCENE: &str = include_str!("../../scenes/small.toml");
 
+/// The cdylib cargo built for this test run: `deps/libYarnBundle.so` next to
+/// the test executable (`cargo test` does not copy it up to `target/<profile>/`;
+/// a `cargo build` does, which is the fallback).
+pub fn cdylib_path() -> PathBuf {
+    let exe = std::env::current_exe().unwrap();
+    let deps = exe.parent().unwrap();
+    let name = format!("lib{}.so", YarnBundle::MODEL_IDENTIFIER);
+    [deps.join(&name), deps.parent().unwrap().join(&name)]
+        .into_iter()
+        .find(|p| p.exists())
+        .unwrap_or_else(|| panic!("{name} was not built next to {}", deps.display()))
+}
+
 pub fn small_scene() -> YarnScene {
     YarnScene::from_toml_str(SMALL_SCENE).unwrap()
 }
