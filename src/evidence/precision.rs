@@ -565,3 +565,53 @@ impl PrecisionReport {
         )
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn order_fit_recovers_a_power_law() {
+        let pts: Vec<(f64, f64)> = (0..5)
+            .map(|k| {
+                let h = 0.1 / 2f64.powi(k);
+                (h, 3.0 * h * h)
+            })
+            .collect();
+        assert!((fit_order(&pts).unwrap() - 2.0).abs() < 1e-12);
+        assert_eq!(fit_order(&pts[..1]), None);
+    }
+
+    /// The study's observed orders on the wire: trapezoidal 2, the Euler
+    /// schemes 1 (the oracles of issue 5, measured through this module).
+    #[test]
+    #[cfg_attr(debug_assertions, ignore = "runs the wire ladder; release only")]
+    fn wire_orders_match_the_schemes() {
+        let r = massspring_scene("wire", &wire_system(), 0.25, 0.025, 8, &[]).unwrap();
+        assert!(r.reference_error < 1e-8, "{}", r.reference_error);
+        let trap = r.order("trapezoidal").unwrap();
+        let be = r.order("backward-euler").unwrap();
+        assert!((trap - 2.0).abs() < 0.15, "trapezoidal order {trap}");
+        assert!((be - 1.0).abs() < 0.15, "backward Euler order {be}");
+        // Forward Euler cannot run above its CFL bound: the coarse steps fail.
+        assert!(r
+            .runs
+            .iter()
+            .any(|x| x.method == "forward-euler" && x.status != "ok"));
+        // Smaller steps of a convergent scheme give smaller errors.
+        let errs: Vec<f64> = r
+            .runs
+            .iter()
+            .filter(|x| x.method == "trapezoidal")
+            .map(|x| x.error)
+            .collect();
+        assert!(errs.windows(2).all(|w| w[1] < w[0]), "{errs:?}");
+        let csv = PrecisionReport {
+            scenes: vec![r],
+            threads: 1,
+        }
+        .runs_table()
+        .to_csv();
+        assert!(csv.starts_with("scene,method,dt_s,steps,wall_s,error,status\n"));
+    }
+}

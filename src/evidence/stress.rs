@@ -482,3 +482,31 @@ impl StressReport {
         )
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn bisection_brackets_a_threshold() {
+        let (s, u, probes) = largest_stable(1e-6, 1.0, 20, |h| h <= 0.37);
+        assert!(s <= 0.37 && u > 0.37 && u / s < 1.0001, "{s} {u}");
+        assert_eq!(probes, 22);
+        assert_eq!(largest_stable(1e-6, 1.0, 5, |_| true).0, 1.0);
+        assert_eq!(largest_stable(1e-6, 1.0, 5, |_| false).0, 0.0);
+    }
+
+    /// Symplectic Euler's measured limit on the wire matches the linear
+    /// bound of `StabilityInfo` within a few per cent.
+    #[test]
+    #[cfg_attr(debug_assertions, ignore = "bisects wire runs; release only")]
+    fn symplectic_euler_limit_matches_the_theory_on_the_wire() {
+        let sys = crate::evidence::precision::wire_system();
+        let bound = analyze(&sys, &sys.positions).symplectic_euler;
+        let opt = IntegratorOptions::default();
+        let (s, u, _) = largest_stable(1e-6, 0.1, 12, |h| {
+            massspring_stable(&sys, Integrator::SymplecticEuler, &opt, h)
+        });
+        assert!(s > 0.9 * bound && u < 1.1 * bound, "{s} {u} vs {bound}");
+    }
+}
