@@ -11,8 +11,13 @@ pub struct Series {
     /// `(x, y)` points, drawn in the given order; non-finite or non-positive
     /// values (on a log axis) are skipped.
     pub points: Vec<(f64, f64)>,
-    /// Draw markers only, no connecting line.
+    /// Draw hollow markers only, no connecting line (e.g. theoretical
+    /// bounds next to measured lines).
     pub markers_only: bool,
+    /// Palette index; `None` takes the series' position in the plot.
+    pub color: Option<usize>,
+    /// Dashed line (to tell apart two series of the same colour).
+    pub dashed: bool,
 }
 
 /// A line plot with optional logarithmic axes.
@@ -32,10 +37,10 @@ const PALETTE: [&str; 10] = [
     "#7f7f7f", "#bcbd22",
 ];
 
-const W: f64 = 760.0;
+const W: f64 = 880.0;
 const H: f64 = 480.0;
 const LEFT: f64 = 80.0;
-const RIGHT: f64 = 220.0;
+const RIGHT: f64 = 300.0;
 const TOP: f64 = 40.0;
 const BOTTOM: f64 = 60.0;
 
@@ -189,7 +194,12 @@ impl LinePlot {
         );
         // Series.
         for (i, s) in self.series.iter().enumerate() {
-            let c = PALETTE[i % PALETTE.len()];
+            let c = PALETTE[s.color.unwrap_or(i) % PALETTE.len()];
+            let dash = if s.dashed {
+                r#" stroke-dasharray="6 4""#
+            } else {
+                ""
+            };
             let p = pts(s);
             if p.len() > 1 && !s.markers_only {
                 let coords: Vec<String> = p
@@ -198,24 +208,35 @@ impl LinePlot {
                     .collect();
                 let _ = writeln!(
                     out,
-                    r#"<polyline class="series" points="{}" fill="none" stroke="{c}" stroke-width="2"/>"#,
+                    r#"<polyline class="series" points="{}" fill="none" stroke="{c}" stroke-width="2"{dash}/>"#,
                     coords.join(" ")
                 );
             }
+            let marker = |x: f64, y: f64| {
+                if s.markers_only {
+                    format!(
+                        r#"<circle cx="{x:.1}" cy="{y:.1}" r="5" fill="none" stroke="{c}" stroke-width="2"/>"#
+                    )
+                } else {
+                    format!(r#"<circle cx="{x:.1}" cy="{y:.1}" r="3" fill="{c}"/>"#)
+                }
+            };
             for &(x, y) in &p {
-                let _ = writeln!(
-                    out,
-                    r#"<circle cx="{:.1}" cy="{:.1}" r="3" fill="{c}"/>"#,
-                    px(x),
-                    py(y)
-                );
+                let _ = writeln!(out, "{}", marker(px(x), py(y)));
             }
             let ly = TOP + 14.0 + 18.0 * i as f64;
             let lx = LEFT + pw + 12.0;
+            let key = if s.markers_only {
+                marker(lx + 10.0, ly)
+            } else {
+                format!(
+                    r#"<line x1="{lx}" y1="{ly}" x2="{}" y2="{ly}" stroke="{c}" stroke-width="3"{dash}/>"#,
+                    lx + 20.0
+                )
+            };
             let _ = writeln!(
                 out,
-                r#"<line x1="{lx}" y1="{ly}" x2="{}" y2="{ly}" stroke="{c}" stroke-width="3"/><text x="{}" y="{}">{}</text>"#,
-                lx + 20.0,
+                r#"{key}<text x="{}" y="{}">{}</text>"#,
                 lx + 26.0,
                 ly + 4.0,
                 esc(&s.name)
@@ -272,4 +293,74 @@ pub fn bar_chart(title: &str, x_label: &str, bars: &[(String, f64)]) -> String {
         esc(x_label)
     );
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn plot(series: Vec<Series>) -> String {
+        LinePlot {
+            title: "t <&>".into(),
+            x_label: "x".into(),
+            y_label: "y".into(),
+            log_x: true,
+            log_y: true,
+            series,
+        }
+        .to_svg()
+    }
+
+    #[test]
+    fn line_plot_draws_lines_rings_and_dashes_as_asked() {
+        let svg = plot(vec![
+            Series {
+                name: "measured".into(),
+                points: vec![(1.0, 1e-3), (10.0, 1e-4), (100.0, 1e-5)],
+                ..Series::default()
+            },
+            Series {
+                name: "dashed twin".into(),
+                points: vec![(1.0, 2e-3), (10.0, 2e-4)],
+                color: Some(0),
+                dashed: true,
+                ..Series::default()
+            },
+            Series {
+                name: "bound".into(),
+                // the non-positive and non-finite points are skipped on log axes
+                points: vec![(1.0, 5e-3), (10.0, 0.0), (f64::NAN, 1.0)],
+                markers_only: true,
+                ..Series::default()
+            },
+        ]);
+        assert!(svg.starts_with("<svg") && svg.trim_end().ends_with("</svg>"));
+        assert_eq!(
+            svg.matches("<polyline").count(),
+            2,
+            "markers-only series has no line"
+        );
+        assert_eq!(
+            svg.matches("stroke-dasharray").count(),
+            2,
+            "dashed line and its legend key"
+        );
+        // 3 + 2 filled markers, 1 ring in the plot and 1 in the legend
+        assert_eq!(svg.matches(r#"r="3""#).count(), 5);
+        assert_eq!(svg.matches(r#"r="5""#).count(), 2);
+        // the twin takes palette colour 0 like the first series
+        assert_eq!(svg.matches(PALETTE[0]).count(), 3 + 2 + 2 + 2);
+        assert!(svg.contains("t &lt;&amp;&gt;"));
+        assert!(!svg.contains("NaN") && !svg.contains("inf"));
+    }
+
+    #[test]
+    fn line_plot_without_finite_data_says_so() {
+        let svg = plot(vec![Series {
+            name: "empty".into(),
+            points: vec![(0.0, 1.0), (f64::INFINITY, 2.0)],
+            ..Series::default()
+        }]);
+        assert!(svg.contains("no finite data"));
+    }
 }

@@ -438,7 +438,7 @@ impl SceneResult {
                         Some(p) => format!("{m} (p={p:.2})"),
                         None => m,
                     },
-                    markers_only: false,
+                    ..Series::default()
                 })
                 .collect(),
         }

@@ -413,7 +413,7 @@ impl StressReport {
     pub fn plots(&self) -> Vec<(String, String)> {
         let mut out = Vec::new();
         let mut ms = LinePlot {
-            title: "largest stable dt vs spring stiffness (dashed lines: none; bound = theory)"
+            title: "largest stable dt vs stiffness (solid: wire, dashed: cloth, rings: theory)"
                 .into(),
             x_label: "spring stiffness k (N/m)".into(),
             y_label: "largest stable dt (s)".into(),
@@ -428,7 +428,16 @@ impl StressReport {
                 keys.push(k);
             }
         }
+        let mut integrators: Vec<&str> = Vec::new();
+        for (_, integ) in &keys {
+            if !integrators.contains(&integ.as_str()) {
+                integrators.push(integ);
+            }
+        }
         for (scene, integ) in &keys {
+            // One colour per integrator; the scene picks solid or dashed.
+            let color = integrators.iter().position(|i| i == integ);
+            let dashed = keys.first().is_some_and(|(first, _)| first != scene);
             let sel: Vec<&Limit> = self
                 .limits
                 .iter()
@@ -437,13 +446,17 @@ impl StressReport {
             ms.series.push(Series {
                 name: format!("{scene} {integ}"),
                 points: sel.iter().map(|l| (l.value, l.stable_dt)).collect(),
-                markers_only: false,
+                color,
+                dashed,
+                ..Series::default()
             });
             if sel.iter().any(|l| l.bound.is_finite() && l.bound > 0.0) {
                 ms.series.push(Series {
                     name: format!("{scene} {integ} bound"),
                     points: sel.iter().map(|l| (l.value, l.bound)).collect(),
                     markers_only: true,
+                    color,
+                    dashed,
                 });
             }
         }
