@@ -1,7 +1,7 @@
 //! `yarnsim record`: the full simulation state, frame by frame, as a Rerun
 //! recording (`.rrd`). All Rerun code of the project lives in this module.
 //!
-//! Layout (see docs/cli.md for the full list):
+//! Layout (see the README, "Entity paths", for the full list):
 //! * `world` carries a static mirror transform so the 2D view shows +y up;
 //!   positions below it are the library's coordinates (m), unchanged.
 //! * `world/vertices` (type-2 particles): `Points2D` coloured by stretch, with

@@ -11,7 +11,8 @@
 //!   FMU state snapshots and their serialization.
 //! * [`ffi`]: the C ABI.
 //!
-//! See `docs/fmu.md` for the variables and the build command.
+//! See the README, section "YarnBundle: the FMI 2.0 Co-Simulation FMU", for
+//! the variables and the build command.
 
 // The crate is named after the FMI modelIdentifier `YarnBundle`.
 #![allow(non_snake_case)]

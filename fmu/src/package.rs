@@ -175,7 +175,7 @@ pub fn documentation_html(scene: &YarnScene) -> String {
             xml_escape(&v.description)
         );
     }
-    h.push_str("</table>\n<p>Built by yarnsim-fmu; see docs/fmu.md in the yarnsim repository.</p>\n</body></html>\n");
+    h.push_str("</table>\n<p>Built by yarnsim-fmu; see the section on the FMU in the README of the yarnsim repository.</p>\n</body></html>\n");
     h
 }
 

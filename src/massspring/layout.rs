@@ -5,7 +5,8 @@
 //! `[[driven]]`), colliders (`[[spheres]]`), gravity and time parameters
 //! complete it. [`Layout::build`] expands it into a [`System`] that the
 //! integrators in [`super::integrators`] advance; they never look at the file
-//! form. See `docs/massspring.md` for every field with its unit and default.
+//! form. See the README, "Mass-spring scene files", for every field with its
+//! unit and default.
 
 use nalgebra::Vector3;
 use serde::{Deserialize, Deserializer, Serialize};
