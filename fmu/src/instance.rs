@@ -52,6 +52,26 @@ pub enum Phase {
     Fatal,
 }
 
+/// Every phase but `Fatal`: where the functions that an error must not lock
+/// out are allowed (debug logging, reset, the FMU-state functions).
+const NOT_FATAL: &[Phase] = &[
+    Phase::Instantiated,
+    Phase::InitializationMode,
+    Phase::StepComplete,
+    Phase::StepFailed,
+    Phase::Terminated,
+    Phase::Error,
+];
+
+/// Every phase with a consistent simulation (not `Error`, not `Fatal`).
+const LIVE: &[Phase] = &[
+    Phase::Instantiated,
+    Phase::InitializationMode,
+    Phase::StepComplete,
+    Phase::StepFailed,
+    Phase::Terminated,
+];
+
 impl Phase {
     fn code(self) -> u8 {
         self as u8
@@ -488,18 +508,7 @@ impl Instance {
     }
 
     pub fn set_debug_logging(&mut self, on: bool, cats: &[&str]) -> Res {
-        use Phase::*;
-        self.require(
-            "fmi2SetDebugLogging",
-            &[
-                Instantiated,
-                InitializationMode,
-                StepComplete,
-                StepFailed,
-                Terminated,
-                Error,
-            ],
-        )?;
+        self.require("fmi2SetDebugLogging", NOT_FATAL)?;
         let mut idx = Vec::new();
         for c in cats {
             match LOG_CATEGORIES.iter().position(|(n, _)| n == c) {
@@ -576,17 +585,7 @@ impl Instance {
     }
 
     pub fn reset(&mut self) -> Res {
-        self.require(
-            "fmi2Reset",
-            &[
-                Phase::Instantiated,
-                Phase::InitializationMode,
-                Phase::StepComplete,
-                Phase::StepFailed,
-                Phase::Terminated,
-                Phase::Error,
-            ],
-        )?;
+        self.require("fmi2Reset", NOT_FATAL)?;
         self.model = Model::new(self.bundled.clone())?;
         self.phase = Phase::Instantiated;
         self.log(Status::Ok, LOG_EVENTS, "reset to the instantiated state");
@@ -937,17 +936,7 @@ impl Instance {
     }
 
     pub fn get_fmu_state(&mut self, into: Option<&mut Snapshot>) -> Res<Option<Box<Snapshot>>> {
-        use Phase::*;
-        self.require(
-            "fmi2GetFMUstate",
-            &[
-                Instantiated,
-                InitializationMode,
-                StepComplete,
-                StepFailed,
-                Terminated,
-            ],
-        )?;
+        self.require("fmi2GetFMUstate", LIVE)?;
         // A snapshot always holds a simulation built from its parameters.
         self.model.ensure_built(self.yarns)?;
         match into {
@@ -967,18 +956,7 @@ impl Instance {
     }
 
     pub fn set_fmu_state(&mut self, s: &Snapshot) -> Res {
-        use Phase::*;
-        self.require(
-            "fmi2SetFMUstate",
-            &[
-                Instantiated,
-                InitializationMode,
-                StepComplete,
-                StepFailed,
-                Terminated,
-                Error,
-            ],
-        )?;
+        self.require("fmi2SetFMUstate", NOT_FATAL)?;
         if s.model.sim.num_yarns() != self.yarns {
             return error(
                 "fmi2SetFMUstate: the state belongs to an FMU with another number of yarns",
@@ -995,18 +973,7 @@ impl Instance {
     }
 
     fn require_state_phase(&self, func: &str) -> Res {
-        use Phase::*;
-        self.require(
-            func,
-            &[
-                Instantiated,
-                InitializationMode,
-                StepComplete,
-                StepFailed,
-                Terminated,
-                Error,
-            ],
-        )
+        self.require(func, NOT_FATAL)
     }
 
     /// The serialized bytes of a snapshot (made once, then cached).

@@ -22,6 +22,7 @@ pub mod stress;
 use std::fmt::Write;
 use std::path::Path;
 
+use crate::massspring::V3;
 use crate::scene::{
     builtin::reference_material, GridSpec, Obstacle, TimeSpec, YarnScene, YarnSpec,
 };
@@ -102,6 +103,18 @@ pub fn num(v: f64) -> String {
     } else {
         "-".into()
     }
+}
+
+/// Largest side of the bounding box of mass-spring positions (at least
+/// 1e-12): the length that makes position errors relative.
+pub fn extent(x: &[V3]) -> f64 {
+    let mut lo = V3::repeat(f64::INFINITY);
+    let mut hi = V3::repeat(f64::NEG_INFINITY);
+    for p in x {
+        lo = lo.inf(p);
+        hi = hi.sup(p);
+    }
+    (hi - lo).max().max(1e-12)
 }
 
 /// Writes `files` (name, contents) into `dir`, creating it.

@@ -26,7 +26,7 @@
 use std::time::Instant;
 
 use super::plot::{LinePlot, Series};
-use super::{num, small_yarn_scene, Table};
+use super::{extent, num, small_yarn_scene, Table};
 use crate::massspring::{scenes, Integrator, IntegratorOptions, Simulation, System, V3};
 use crate::mpm::YarnSim;
 use crate::scene::{builtin::yarn_reference, YarnScene};
@@ -84,16 +84,6 @@ fn max_diff(a: &[V3], b: &[V3]) -> f64 {
         .zip(b)
         .map(|(p, q)| (p - q).norm())
         .fold(0.0, f64::max)
-}
-
-fn extent(x: &[V3]) -> f64 {
-    let mut lo = V3::repeat(f64::INFINITY);
-    let mut hi = V3::repeat(f64::NEG_INFINITY);
-    for p in x {
-        lo = lo.inf(p);
-        hi = hi.sup(p);
-    }
-    (hi - lo).max().max(1e-12)
 }
 
 /// Runs a mass-spring system to `t_end` at step `dt`; returns the positions,

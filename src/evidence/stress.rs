@@ -21,9 +21,9 @@
 //! attractor (strength `a`) can give in the probe time `T` (Courant number 1).
 
 use super::plot::{LinePlot, Series};
-use super::{num, small_yarn_scene, Table};
+use super::{extent, num, small_yarn_scene, Table};
 use crate::massspring::integrators::stability::analyze;
-use crate::massspring::{scenes, Integrator, IntegratorOptions, Simulation, System, V3};
+use crate::massspring::{scenes, Integrator, IntegratorOptions, Simulation, System};
 use crate::math::Vec2;
 use crate::mpm::{Attractor, YarnSim};
 use crate::scene::YarnScene;
@@ -100,16 +100,6 @@ pub fn largest_stable(
     (lo, hi, probes)
 }
 
-fn ms_extent(x: &[V3]) -> f64 {
-    let mut lo = V3::repeat(f64::INFINITY);
-    let mut hi = V3::repeat(f64::NEG_INFINITY);
-    for p in x {
-        lo = lo.inf(p);
-        hi = hi.sup(p);
-    }
-    (hi - lo).max().max(1e-12)
-}
-
 /// Whether `sys` with `integrator` at step `h` survives a probe run.
 pub fn massspring_stable(
     sys: &System,
@@ -122,7 +112,7 @@ pub fn massspring_stable(
     let Ok(mut sim) = Simulation::from_system(sys.clone(), integrator, opt) else {
         return false;
     };
-    let l = ms_extent(&sys.positions);
+    let l = extent(&sys.positions);
     let g = sys.gravity.norm();
     let vmax = 10.0 * (2.0 * g * l).sqrt() + 10.0;
     let n = ((PROBE_TIME / h).ceil() as u64).clamp(MIN_PROBE_STEPS, MAX_PROBE_STEPS);

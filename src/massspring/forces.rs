@@ -26,6 +26,15 @@ pub fn direction(x: &[V3], s: &Spring) -> Option<(V3, f64)> {
     }
 }
 
+/// Unit direction of every spring at positions `x` (zero for a spring whose
+/// ends coincide).
+pub fn unit_directions(springs: &[Spring], x: &[V3]) -> Vec<V3> {
+    springs
+        .iter()
+        .map(|s| direction(x, s).map_or(V3::zeros(), |(d, _)| d))
+        .collect()
+}
+
 /// Adds the elastic spring forces at positions `x` to `f`.
 pub fn add_elastic_forces(springs: &[Spring], x: &[V3], f: &mut [V3]) {
     for s in springs {

@@ -53,26 +53,28 @@ fn wide_simd() -> bool {
     }
 }
 
-/// `fn $name(args) = $imp;` defines `$name`, which runs the `#[inline(always)]`
-/// kernel `$imp` compiled for AVX2 + FMA when the CPU has them and as built
-/// otherwise. Both give the same bits: Rust never contracts `a * b + c` into
+/// `multiversion! { fn name(args) -> R { body } }` defines `name`, whose body
+/// (an `#[inline(always)]` inner function) is compiled twice: for AVX2 + FMA,
+/// run when the CPU has them, and as built otherwise. Both give the same bits: Rust never contracts `a * b + c` into
 /// an FMA by itself, so only the register width differs.
 macro_rules! multiversion {
-    ($(#[$m:meta])* fn $name:ident($($a:ident: $t:ty),* $(,)?) $(-> $r:ty)? = $imp:ident;) => {
+    ($(#[$m:meta])* fn $name:ident($($a:ident: $t:ty),* $(,)?) $(-> $r:ty)? $body:block) => {
         $(#[$m])*
         fn $name($($a: $t),*) $(-> $r)? {
+            #[inline(always)]
+            fn imp($($a: $t),*) $(-> $r)? $body
             #[cfg(target_arch = "x86_64")]
             {
                 #[target_feature(enable = "avx2,fma")]
                 unsafe fn wide($($a: $t),*) $(-> $r)? {
-                    $imp($($a),*)
+                    imp($($a),*)
                 }
                 if wide_simd() {
                     // SAFETY: the CPU has the features `wide` is compiled for.
                     return unsafe { wide($($a),*) };
                 }
             }
-            $imp($($a),*)
+            imp($($a),*)
         }
     };
 }
@@ -238,33 +240,24 @@ multiversion! {
         vr: std::ops::Range<usize>,
         qr: std::ops::Range<usize>,
         ctx: &ScatterCtx,
-    ) = scatter_chunk_impl;
-}
-
-#[inline(always)]
-fn scatter_chunk_impl(
-    buf: &mut ScatterBuffer,
-    sts: &mut [Stencil],
-    vr: std::ops::Range<usize>,
-    qr: std::ops::Range<usize>,
-    ctx: &ScatterCtx,
-) {
-    let (vert, quad, geom, dt) = (ctx.vert, ctx.quad, &ctx.geom, ctx.dt);
-    let dx = geom.dx;
-    // the normal force per unit of (w_i (x_i - x_p) / dx . d2): -dt dE/dd2 4 / dx
-    let normal_scale = -dt * 4.0 * geom.inv_dx;
-    buf.clear(geom);
-    for (i, st) in vr.zip(sts.iter_mut()) {
-        *st = Stencil::new(vert.x[i], geom.inv_dx);
-        let m = vert.m[i];
-        let p0 = vert.v[i] * m + vertex_force(vert, &quad.t1, i, ctx.bending) * dt;
-        splat(buf, geom, st, m, p0, &(vert.c[i] * (m * dx)));
-    }
-    for q in qr {
-        let m = quad.m[q];
-        let d2 = quad.d[q].column(1).into_owned();
-        let a = quad.c[q] * (m * dx) + quad.t2[q] * normal_scale * d2.transpose();
-        splat(buf, geom, &quad.stencil[q], m, quad.v[q] * m, &a);
+    ) {
+        let (vert, quad, geom, dt) = (ctx.vert, ctx.quad, &ctx.geom, ctx.dt);
+        let dx = geom.dx;
+        // the normal force per unit of (w_i (x_i - x_p) / dx . d2): -dt dE/dd2 4 / dx
+        let normal_scale = -dt * 4.0 * geom.inv_dx;
+        buf.clear(geom);
+        for (i, st) in vr.zip(sts.iter_mut()) {
+            *st = Stencil::new(vert.x[i], geom.inv_dx);
+            let m = vert.m[i];
+            let p0 = vert.v[i] * m + vertex_force(vert, &quad.t1, i, ctx.bending) * dt;
+            splat(buf, geom, st, m, p0, &(vert.c[i] * (m * dx)));
+        }
+        for q in qr {
+            let m = quad.m[q];
+            let d2 = quad.d[q].column(1).into_owned();
+            let a = quad.c[q] * (m * dx) + quad.t2[q] * normal_scale * d2.transpose();
+            splat(buf, geom, &quad.stencil[q], m, quad.v[q] * m, &a);
+        }
     }
 }
 
@@ -291,81 +284,70 @@ multiversion! {
         geom: &GridGeom,
         dt: f64,
         ext: &GridForces,
-    ) = grid_band_impl;
-}
-
-#[inline(always)]
-fn grid_band_impl(
-    bi: usize,
-    band: &mut [Node],
-    buffers: &[ScatterBuffer],
-    is_active: &[bool],
-    geom: &GridGeom,
-    dt: f64,
-    ext: &GridForces,
-) {
-    let cells = ext.wall_cells;
-    let dx = geom.dx;
-    for bj in 0..geom.nb {
-        let b = bi * geom.nb + bj;
-        if !is_active[b] {
-            continue;
-        }
-        let (i0, j0) = (bi * BLOCK, bj * BLOCK);
-        let mut srcs: [&ScatterBuffer; CHUNKS] = [&buffers[0]; CHUNKS];
-        let mut nsrc = 0;
-        for s in buffers.iter().filter(|s| s.touched[b]) {
-            srcs[nsrc] = s;
-            nsrc += 1;
-        }
-        let srcs = &srcs[..nsrc];
-        let lo = Vec2::new(i0 as f64, j0 as f64) * dx;
-        let hi = lo + Vec2::new((BLOCK - 1) as f64, (BLOCK - 1) as f64) * dx;
-        let near_obstacle = ext.obstacles.iter().any(|o| {
-            let c = Vec2::from(o.center);
-            let q = Vec2::new(c.x.clamp(lo.x, hi.x), c.y.clamp(lo.y, hi.y));
-            (q - c).norm() < o.radius
-        });
-        let near_wall = ext.walls != WallMode::None
-            && (i0 < cells
-                || j0 < cells
-                || i0 + BLOCK + cells > geom.n
-                || j0 + BLOCK + cells > geom.n);
-        for r in 0..BLOCK {
-            let i = i0 + r;
-            let row = r * geom.stride + j0;
-            let gidx = bi * BLOCK * geom.stride + row;
-            for c in 0..BLOCK {
-                let j = j0 + c;
-                let mut acc: Node = [0.0; 4];
-                for s in srcs {
-                    let n = &s.node[gidx + c];
-                    for l in 0..4 {
-                        acc[l] += n[l];
-                    }
-                }
-                let out = &mut band[row + c];
-                if acc[M] <= 0.0 {
-                    *out = [0.0; 4];
-                    continue;
-                }
-                let mut v = Vec2::new(acc[X], acc[Y]) / acc[M] + ext.gravity * dt;
-                if ext.attractor.is_some() || near_obstacle {
-                    let xi = Vec2::new(i as f64, j as f64) * dx;
-                    if let Some((pos, strength)) = ext.attractor {
-                        let d = pos - xi;
-                        v += d * (dt * strength / (d.norm() + 0.01));
-                    }
-                    if near_obstacle {
-                        for o in ext.obstacles {
-                            v = obstacle_velocity(o, xi, v);
+    ) {
+        let cells = ext.wall_cells;
+        let dx = geom.dx;
+        for bj in 0..geom.nb {
+            let b = bi * geom.nb + bj;
+            if !is_active[b] {
+                continue;
+            }
+            let (i0, j0) = (bi * BLOCK, bj * BLOCK);
+            let mut srcs: [&ScatterBuffer; CHUNKS] = [&buffers[0]; CHUNKS];
+            let mut nsrc = 0;
+            for s in buffers.iter().filter(|s| s.touched[b]) {
+                srcs[nsrc] = s;
+                nsrc += 1;
+            }
+            let srcs = &srcs[..nsrc];
+            let lo = Vec2::new(i0 as f64, j0 as f64) * dx;
+            let hi = lo + Vec2::new((BLOCK - 1) as f64, (BLOCK - 1) as f64) * dx;
+            let near_obstacle = ext.obstacles.iter().any(|o| {
+                let c = Vec2::from(o.center);
+                let q = Vec2::new(c.x.clamp(lo.x, hi.x), c.y.clamp(lo.y, hi.y));
+                (q - c).norm() < o.radius
+            });
+            let near_wall = ext.walls != WallMode::None
+                && (i0 < cells
+                    || j0 < cells
+                    || i0 + BLOCK + cells > geom.n
+                    || j0 + BLOCK + cells > geom.n);
+            for r in 0..BLOCK {
+                let i = i0 + r;
+                let row = r * geom.stride + j0;
+                let gidx = bi * BLOCK * geom.stride + row;
+                for c in 0..BLOCK {
+                    let j = j0 + c;
+                    let mut acc: Node = [0.0; 4];
+                    for s in srcs {
+                        let n = &s.node[gidx + c];
+                        for l in 0..4 {
+                            acc[l] += n[l];
                         }
                     }
+                    let out = &mut band[row + c];
+                    if acc[M] <= 0.0 {
+                        *out = [0.0; 4];
+                        continue;
+                    }
+                    let mut v = Vec2::new(acc[X], acc[Y]) / acc[M] + ext.gravity * dt;
+                    if ext.attractor.is_some() || near_obstacle {
+                        let xi = Vec2::new(i as f64, j as f64) * dx;
+                        if let Some((pos, strength)) = ext.attractor {
+                            let d = pos - xi;
+                            v += d * (dt * strength / (d.norm() + 0.01));
+                        }
+                        if near_obstacle {
+                            for o in ext.obstacles {
+                                v = obstacle_velocity(o, xi, v);
+                            }
+                        }
+                    }
+                    if near_wall {
+                        v = wall_velocity(ext.walls, cells, geom.n, i, j, v);
+                    }
+                    *out = [v.x, v.y, acc[M], 0.0];
                 }
-                if near_wall {
-                    v = wall_velocity(ext.walls, cells, geom.n, i, j, v);
-                }
-                *out = [v.x, v.y, acc[M], 0.0];
             }
         }
     }
@@ -533,42 +515,31 @@ multiversion! {
         grid: &Grid,
         dt: f64,
         obstacles: &[Obstacle],
-    ) -> Option<usize> = gather_vertex_chunk_impl;
-}
-
-#[inline(always)]
-fn gather_vertex_chunk_impl(
-    xs: &mut [Vec2],
-    vs: &mut [Vec2],
-    cs: &mut [Mat2],
-    sts: &[Stencil],
-    grid: &Grid,
-    dt: f64,
-    obstacles: &[Obstacle],
-) -> Option<usize> {
-    let geom = grid.geom;
-    let (lo, hi) = (geom.dx, (geom.n as f64 - 2.0) * geom.dx);
-    let mut bad = None;
-    for (k, (((x, v), c), st)) in xs.iter_mut().zip(vs).zip(cs).zip(sts).enumerate() {
-        let (nv, nc) = interpolate(grid, st);
-        *v = nv;
-        *c = nc;
-        *x += nv * dt;
-        for o in obstacles {
-            project_out(o, x, v);
+    ) -> Option<usize> {
+        let geom = grid.geom;
+        let (lo, hi) = (geom.dx, (geom.n as f64 - 2.0) * geom.dx);
+        let mut bad = None;
+        for (k, (((x, v), c), st)) in xs.iter_mut().zip(vs).zip(cs).zip(sts).enumerate() {
+            let (nv, nc) = interpolate(grid, st);
+            *v = nv;
+            *c = nc;
+            *x += nv * dt;
+            for o in obstacles {
+                project_out(o, x, v);
+            }
+            clamp_to_grid(x, v, lo, hi);
+            // Finite, and no faster than one cell per substep (CFL): beyond
+            // that the transfer is meaningless and the run is diverging.
+            let ok = x.x.is_finite()
+                && x.y.is_finite()
+                && c.iter().all(|e| e.is_finite())
+                && nv.norm_squared() * (dt * dt) <= geom.dx * geom.dx;
+            if !ok && bad.is_none() {
+                bad = Some(k);
+            }
         }
-        clamp_to_grid(x, v, lo, hi);
-        // Finite, and no faster than one cell per substep (CFL): beyond
-        // that the transfer is meaningless and the run is diverging.
-        let ok = x.x.is_finite()
-            && x.y.is_finite()
-            && c.iter().all(|e| e.is_finite())
-            && nv.norm_squared() * (dt * dt) <= geom.dx * geom.dx;
-        if !ok && bad.is_none() {
-            bad = Some(k);
-        }
+        bad
     }
-    bad
 }
 
 /// Pass 4: grid-to-particle for quadrature particles: velocity and `C` from
@@ -648,55 +619,51 @@ struct QuadRest<'a> {
 multiversion! {
     /// [`gather_quads`] on the chunk starting at particle `base`; returns the
     /// first bad index in it.
-    fn gather_quad_chunk(base: usize, q: QuadChunk, grid: &Grid, r: &QuadRest) -> Option<usize>
-        = gather_quad_chunk_impl;
-}
-
-#[inline(always)]
-fn gather_quad_chunk_impl(
-    base: usize,
-    q: QuadChunk,
-    grid: &Grid,
-    rest: &QuadRest,
-) -> Option<usize> {
-    let (dt, energy) = (rest.dt, rest.energy);
-    let inv_dx = grid.geom.inv_dx;
-    let mut bad = None;
-    for k in 0..q.x.len() {
-        let g = base + k;
-        let l0 = rest.l0[g];
-        let (nv, nc) = interpolate(grid, &q.stencil[k]);
-        q.v[k] = nv;
-        q.c[k] = nc;
-        let left = rest.left[g] as usize;
-        let (xl, xr) = (rest.vx[left], rest.vx[left + 1]);
-        let x = (xl + xr) * 0.5;
-        q.x[k] = x;
-        let d1 = xr - xl;
-        let d2o = q.d[k].column(1).into_owned();
-        let mut d2 = d2o + nc * d2o * dt;
-        let inv_l0 = 1.0 / l0;
-        let mut r = qr(&(Mat2::from_columns(&[d1, d2]) * inv_l0));
-        if rest.plastic {
-            let (r12, r22) = energy.return_map(r.r12, r.r22);
-            if r12 != r.r12 || r22 != r.r22 {
-                d2 = r.rotate(Vec2::new(r12, r22)) * l0;
-                // refactor (rather than patch r12, r22) so that `frame` is
-                // always bitwise qr(d / l0), as after a state restore
-                r = qr(&(Mat2::from_columns(&[d1, d2]) * inv_l0));
+    fn gather_quad_chunk(
+        base: usize,
+        q: QuadChunk,
+        grid: &Grid,
+        rest: &QuadRest,
+    ) -> Option<usize> {
+        let (dt, energy) = (rest.dt, rest.energy);
+        let inv_dx = grid.geom.inv_dx;
+        let mut bad = None;
+        for k in 0..q.x.len() {
+            let g = base + k;
+            let l0 = rest.l0[g];
+            let (nv, nc) = interpolate(grid, &q.stencil[k]);
+            q.v[k] = nv;
+            q.c[k] = nc;
+            let left = rest.left[g] as usize;
+            let (xl, xr) = (rest.vx[left], rest.vx[left + 1]);
+            let x = (xl + xr) * 0.5;
+            q.x[k] = x;
+            let d1 = xr - xl;
+            let d2o = q.d[k].column(1).into_owned();
+            let mut d2 = d2o + nc * d2o * dt;
+            let inv_l0 = 1.0 / l0;
+            let mut r = qr(&(Mat2::from_columns(&[d1, d2]) * inv_l0));
+            if rest.plastic {
+                let (r12, r22) = energy.return_map(r.r12, r.r22);
+                if r12 != r.r12 || r22 != r.r22 {
+                    d2 = r.rotate(Vec2::new(r12, r22)) * l0;
+                    // refactor (rather than patch r12, r22) so that `frame` is
+                    // always bitwise qr(d / l0), as after a state restore
+                    r = qr(&(Mat2::from_columns(&[d1, d2]) * inv_l0));
+                }
+            }
+            let d = Mat2::from_columns(&[d1, d2]);
+            q.frame[k] = r;
+            q.d[k] = d;
+            q.stencil[k] = Stencil::new(x, inv_dx);
+            (q.t1[k], q.t2[k]) = frame_gradient_qr(energy, &r, l0, rest.vol[g]);
+            let ok = d.iter().all(|e| e.is_finite()) && nv.x.is_finite() && nv.y.is_finite();
+            if !ok && bad.is_none() {
+                bad = Some(k);
             }
         }
-        let d = Mat2::from_columns(&[d1, d2]);
-        q.frame[k] = r;
-        q.d[k] = d;
-        q.stencil[k] = Stencil::new(x, inv_dx);
-        (q.t1[k], q.t2[k]) = frame_gradient_qr(energy, &r, l0, rest.vol[g]);
-        let ok = d.iter().all(|e| e.is_finite()) && nv.x.is_finite() && nv.y.is_finite();
-        if !ok && bad.is_none() {
-            bad = Some(k);
-        }
+        bad
     }
-    bad
 }
 
 /// Whether `n` splits into the same chunks as the scatter uses (for tests).

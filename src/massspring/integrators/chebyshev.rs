@@ -16,7 +16,7 @@
 //! the springs are stretched): 0.982 on the cloth, 0.33 on the 3 particles.
 
 use super::{set_kinematics, State, StepStats};
-use crate::massspring::forces::add_elastic_forces;
+use crate::massspring::forces::{add_elastic_forces, unit_directions};
 use crate::massspring::layout::{System, V3};
 
 /// The Chebyshev weight sequence for `iterations` iterations.
@@ -52,19 +52,7 @@ pub fn step(
     set_kinematics(sys, s.t + h, &mut x, &mut v_end);
     let y: Vec<V3> = (0..n).map(|i| x0[i] + s.v[i] * h).collect();
     // Frozen spring directions for the damping term.
-    let dirs: Vec<V3> = sys
-        .springs
-        .iter()
-        .map(|sp| {
-            let d = x0[sp.b] - x0[sp.a];
-            let l = d.norm();
-            if l > 0.0 {
-                d / l
-            } else {
-                V3::zeros()
-            }
-        })
-        .collect();
+    let dirs = unit_directions(&sys.springs, &x0);
     let mut diag: Vec<f64> = sys.masses.iter().map(|m| m / (h * h)).collect();
     for sp in &sys.springs {
         let add = sp.k + sp.damping / h;

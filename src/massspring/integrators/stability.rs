@@ -25,6 +25,7 @@
 
 use nalgebra::{DMatrix, SymmetricEigen};
 
+use crate::massspring::forces::unit_directions;
 use crate::massspring::layout::{Spring, System, V3};
 use crate::massspring::linear::DofMap;
 
@@ -48,18 +49,7 @@ pub const LANCZOS_STEPS: usize = 120;
 pub fn analyze(sys: &System, x: &[V3]) -> StabilityInfo {
     let map = DofMap::new(sys.len(), |i| sys.is_free(i));
     let springs: Vec<&Spring> = sys.springs.iter().collect();
-    let dirs: Vec<V3> = springs
-        .iter()
-        .map(|s| {
-            let d = x[s.b] - x[s.a];
-            let l = d.norm();
-            if l > 0.0 {
-                d / l
-            } else {
-                V3::zeros()
-            }
-        })
-        .collect();
+    let dirs = unit_directions(&sys.springs, x);
     let inv_sqrt_m: Vec<f64> = map
         .particle
         .iter()
