@@ -233,7 +233,7 @@ pub unsafe extern "C" fn fmi2Instantiate(
         };
         if fmuType != fmi2CoSimulation {
             return Err(format!(
-                "fmuType {fmuType} is not fmi2CoSimulation: YarnBundle is a Co-Simulation FMU only"
+                "fmuType {fmuType} is not fmi2CoSimulation: this is a Co-Simulation FMU only"
             ));
         }
         let Some(guid) = string(fmuGUID) else {

@@ -1,15 +1,16 @@
-//! One FMU instance: the FMI 2.0 Co-Simulation state machine around a
-//! [`YarnSim`], independent of the C ABI (which lives in [`crate::ffi`]).
+//! One FMU instance: the FMI 2.0 Co-Simulation state machine, the time
+//! keeping and the FMU-state snapshots around a [`Physics`] (the yarn bundle
+//! of [`crate::yarn`] or the mass-spring system of [`crate::massspring`]),
+//! independent of the C ABI (which lives in [`crate::ffi`]).
 
 use std::ffi::{c_char, c_int, c_void, CString};
 use std::path::{Path, PathBuf};
 
-use yarnsim::math::Vec2;
 use yarnsim::mpm::state::fnv1a;
-use yarnsim::mpm::{Attractor, Diagnostics, SimError, YarnSim};
-use yarnsim::scene::YarnScene;
 
-use crate::model::*;
+use crate::massspring::MsModel;
+use crate::model::{FmuScene, LOG_CATEGORIES, SCENE_FILE, VR_SUBSTEPS};
+use crate::yarn::YarnModel;
 
 /// `fmi2Status` values.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
@@ -104,114 +105,100 @@ pub const LOG_ERROR: usize = 3;
 pub const LOG_FATAL: usize = 4;
 pub const LOG_ALL: usize = 6;
 
-/// Values of the inputs.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Inputs {
-    pub attractor: [f64; 2],
-    pub strength: f64,
-    pub active: bool,
-    pub gravity: [f64; 2],
-}
+/// Checks that a parameter may be set now: `(function, value reference)`.
+pub type ParamCheck<'a> = &'a dyn Fn(&str, u32) -> Res;
 
-impl Inputs {
-    fn from_scene(s: &YarnScene) -> Self {
-        Inputs {
-            attractor: s.attractor.position,
-            strength: s.attractor.strength,
-            active: s.attractor.active,
-            gravity: s.gravity,
-        }
-    }
-
-    /// Checks the inputs the way the library does, then hands them to `sim`.
-    fn apply(&self, sim: &mut YarnSim) -> Res {
-        sim.set_gravity(Vec2::from(self.gravity))
-            .and_then(|_| {
-                sim.set_attractor(Attractor {
-                    position: Vec2::from(self.attractor),
-                    strength: self.strength,
-                    active: self.active,
-                })
-            })
-            .or_else(|e| error(e.to_string()))
-    }
-}
-
-/// The parameters as set by the environment (`None`: the scene's value).
+/// A substep that failed: the message, and whether the simulation is lost
+/// (non-finite state) rather than refused an input.
 #[derive(Clone, Debug, PartialEq)]
-pub struct Config {
-    pub scene_path: String,
-    /// Overrides of [`REAL_PARAMETERS`], in that order.
-    pub reals: [Option<f64>; 7],
-    pub plasticity: Option<bool>,
+pub struct StepFailure {
+    pub terminal: bool,
+    pub msg: String,
 }
 
-impl Default for Config {
-    fn default() -> Self {
-        Config {
-            scene_path: SCENE_FILE.to_string(),
-            reals: [None; 7],
-            plasticity: None,
+/// What an FMU simulates: the same state machine drives either model.
+#[derive(Clone, Debug)]
+pub enum Physics {
+    Yarn(Box<YarnModel>),
+    MassSpring(Box<MsModel>),
+}
+
+/// Calls the same method on either model.
+macro_rules! each {
+    ($p:expr, $m:ident => $e:expr) => {
+        match $p {
+            Physics::Yarn($m) => $e,
+            Physics::MassSpring($m) => $e,
+        }
+    };
+}
+
+impl Physics {
+    fn new(scene: &FmuScene) -> Res<Physics> {
+        Ok(match scene {
+            FmuScene::Yarn(s) => Physics::Yarn(Box::new(YarnModel::new(s.clone())?)),
+            FmuScene::MassSpring(l) => Physics::MassSpring(Box::new(MsModel::new(l.clone())?)),
+        })
+    }
+
+    /// Yarns or particles: the objects the outputs describe.
+    pub fn count(&self) -> usize {
+        each!(self, m => m.count())
+    }
+
+    /// The substep size in s.
+    pub fn dt(&self) -> f64 {
+        each!(self, m => m.dt())
+    }
+
+    fn rebuild(&mut self, count: usize) -> Res {
+        each!(self, m => m.rebuild(count))
+    }
+
+    /// Substep number `k` since initialization.
+    fn substep(&mut self, k: u64) -> Result<(), StepFailure> {
+        match self {
+            Physics::Yarn(m) => m.substep(),
+            Physics::MassSpring(m) => m.substep(k),
         }
     }
-}
 
-fn real_param_index(vr: u32) -> Option<usize> {
-    REAL_PARAMETERS.iter().position(|&p| p == vr)
-}
-
-fn scene_real(scene: &YarnScene, vr: u32) -> f64 {
-    let m = &scene.material;
-    match vr {
-        VR_K => m.k,
-        VR_GAMMA => m.gamma,
-        VR_YOUNGS_MODULUS => m.youngs_modulus,
-        VR_FRICTION => m.friction,
-        VR_BENDING => m.bending,
-        VR_DENSITY => m.density,
-        VR_DT => scene.time.dt,
-        _ => unreachable!("not a real parameter: {vr}"),
+    fn outputs_finite(&self) -> bool {
+        each!(self, m => m.outputs_finite())
     }
-}
 
-fn set_scene_real(scene: &mut YarnScene, vr: u32, v: f64) {
-    let m = &mut scene.material;
-    match vr {
-        VR_K => m.k = v,
-        VR_GAMMA => m.gamma = v,
-        VR_YOUNGS_MODULUS => m.youngs_modulus = v,
-        VR_FRICTION => m.friction = v,
-        VR_BENDING => m.bending = v,
-        VR_DENSITY => m.density = v,
-        VR_DT => scene.time.dt = v,
-        _ => unreachable!("not a real parameter: {vr}"),
+    fn is_state_output(&self, vr: u32) -> bool {
+        each!(self, m => m.is_state_output(vr))
     }
-}
 
-/// The base scene with the parameter overrides applied.
-fn effective_scene(base: &YarnScene, config: &Config) -> YarnScene {
-    let mut s = base.clone();
-    for (k, &vr) in REAL_PARAMETERS.iter().enumerate() {
-        if let Some(v) = config.reals[k] {
-            set_scene_real(&mut s, vr, v);
+    fn get_real(&mut self, vr: u32) -> Option<f64> {
+        each!(self, m => m.get_real(vr))
+    }
+
+    fn get_boolean(&self, vr: u32) -> Option<c_int> {
+        each!(self, m => m.get_boolean(vr))
+    }
+
+    fn get_string(&self, vr: u32) -> Option<&str> {
+        each!(self, m => m.get_string(vr))
+    }
+
+    /// First bytes of a serialized FMU state of this model.
+    fn state_magic(&self) -> &'static [u8; 8] {
+        match self {
+            Physics::Yarn(_) => b"YBFMUST\0",
+            Physics::MassSpring(_) => b"MSFMUST\0",
         }
     }
-    if let Some(p) = config.plasticity {
-        s.material.plasticity = p;
-    }
-    s
 }
 
 /// Everything an FMU state holds: what `fmi2GetFMUstate` copies and
 /// `fmi2Reset` rebuilds.
 #[derive(Clone, Debug)]
 pub struct Model {
-    pub config: Config,
-    /// The scene file as loaded (before parameter overrides).
-    pub base: YarnScene,
-    pub sim: YarnSim,
-    pub inputs: Inputs,
-    /// The simulation must be rebuilt from `base` and `config` before use.
+    pub physics: Physics,
+    /// The simulation must be rebuilt from the scene and the parameters
+    /// before use (a parameter changed).
     pub dirty: bool,
     pub start_time: f64,
     pub stop_time: Option<f64>,
@@ -222,18 +209,12 @@ pub struct Model {
     pub substeps: u64,
     /// Set when a step diverged (`fmi2Terminated` status).
     pub terminated: bool,
-    /// Diagnostics of the current state, computed on first use.
-    pub diag: Option<Diagnostics>,
 }
 
 impl Model {
-    fn new(base: YarnScene) -> Res<Self> {
-        let sim = YarnSim::new(&base).or_else(|e| error(format!("scene: {e}")))?;
+    fn new(scene: &FmuScene) -> Res<Self> {
         Ok(Model {
-            config: Config::default(),
-            inputs: Inputs::from_scene(&base),
-            base,
-            sim,
+            physics: Physics::new(scene)?,
             dirty: false,
             start_time: 0.0,
             stop_time: None,
@@ -241,33 +222,16 @@ impl Model {
             last_successful_time: 0.0,
             substeps: 0,
             terminated: false,
-            diag: None,
         })
     }
 
     /// Rebuilds the simulation after parameter changes.
-    fn ensure_built(&mut self, yarns: usize) -> Res {
-        if !self.dirty {
-            return Ok(());
+    fn ensure_built(&mut self, count: usize) -> Res {
+        if self.dirty {
+            self.physics.rebuild(count)?;
+            self.dirty = false;
         }
-        let scene = effective_scene(&self.base, &self.config);
-        let mut sim = YarnSim::new(&scene).or_else(|e| error(format!("parameters: {e}")))?;
-        if sim.num_yarns() != yarns {
-            return error(format!(
-                "scene {:?} creates {} yarns, but this FMU has outputs for {yarns}",
-                self.config.scene_path,
-                sim.num_yarns()
-            ));
-        }
-        self.inputs.apply(&mut sim)?;
-        self.sim = sim;
-        self.diag = None;
-        self.dirty = false;
         Ok(())
-    }
-
-    fn diagnostics(&mut self) -> Diagnostics {
-        *self.diag.get_or_insert_with(|| self.sim.diagnostics())
     }
 }
 
@@ -299,8 +263,9 @@ impl Drop for Snapshot {
     }
 }
 
-/// First bytes of a serialized FMU state.
-pub const STATE_MAGIC: &[u8; 8] = b"YBFMUST\0";
+/// First bytes of a serialized FMU state: `YBFMUST\0` for a yarn bundle,
+/// `MSFMUST\0` for a mass-spring system.
+pub const STATE_MAGICS: [&[u8; 8]; 2] = [b"YBFMUST\0", b"MSFMUST\0"];
 /// Format version of the serialized FMU state.
 pub const STATE_VERSION: u32 = 1;
 const STATE_HEADER: usize = 8 + 4 + 8 + 8;
@@ -315,8 +280,9 @@ pub struct Instance {
     categories: [bool; LOG_CATEGORIES.len()],
     pub resources: PathBuf,
     /// The scene bundled in `resources/`.
-    bundled: YarnScene,
-    yarns: usize,
+    bundled: FmuScene,
+    /// Yarns or particles: the objects the outputs describe.
+    count: usize,
     pub phase: Phase,
     pub model: Model,
     /// Strings handed out by `fmi2GetString`, valid until the next call.
@@ -369,10 +335,10 @@ pub fn resource_path(uri: &str) -> Result<PathBuf, String> {
     Ok(PathBuf::from(std::ffi::OsString::from_vec(out)))
 }
 
-fn read_scene(path: &Path) -> Result<YarnScene, String> {
+fn read_scene(path: &Path) -> Result<FmuScene, String> {
     let text = std::fs::read_to_string(path)
         .map_err(|e| format!("cannot read scene file {}: {e}", path.display()))?;
-    YarnScene::from_toml_str(&text).map_err(|e| format!("scene file {}: {e}", path.display()))
+    FmuScene::from_toml_str(&text).map_err(|e| format!("scene file {}: {e}", path.display()))
 }
 
 /// Escapes a message for the printf-style logger: `%` as `%%`, `#` as `##`
@@ -415,14 +381,14 @@ impl Instance {
     ) -> Result<Box<Instance>, String> {
         let resources = resource_path(resource_uri)?;
         let bundled = read_scene(&resources.join(SCENE_FILE))?;
-        let expected = guid(&bundled);
+        let expected = bundled.guid();
         if guid_arg != expected {
             return Err(format!(
                 "GUID {guid_arg:?} does not match this FMU's {expected:?} (modelDescription.xml and binary/resources differ)"
             ));
         }
-        let model = Model::new(bundled.clone()).map_err(|f| f.msg)?;
-        let yarns = model.sim.num_yarns();
+        let model = Model::new(&bundled).map_err(|f| f.msg)?;
+        let count = model.physics.count();
         let inst = Box::new(Instance {
             magic: INSTANCE_MAGIC,
             // The instance name is an argument, not the format: no escaping.
@@ -433,7 +399,7 @@ impl Instance {
             categories: [true; LOG_CATEGORIES.len()],
             resources,
             bundled,
-            yarns,
+            count,
             phase: Phase::Instantiated,
             model,
             strings: Vec::new(),
@@ -442,8 +408,11 @@ impl Instance {
             Status::Ok,
             LOG_EVENTS,
             &format!(
-                "instantiated {name:?}: scene {:?}, {yarns} yarns, substep {} s",
-                inst.bundled.name, inst.bundled.time.dt
+                "instantiated {name:?} ({}): scene {:?}, {}, substep {} s",
+                inst.bundled.identifier(),
+                inst.bundled.name(),
+                inst.bundled.summary(),
+                inst.model.physics.dt()
             ),
         );
         Ok(inst)
@@ -463,8 +432,9 @@ impl Instance {
         self.magic = 0;
     }
 
-    pub fn yarns(&self) -> usize {
-        self.yarns
+    /// Yarns (YarnBundle) or particles (MassSpring): the objects the outputs describe.
+    pub fn count(&self) -> usize {
+        self.count
     }
 
     /// Sends a message to the logger: errors and fatal errors and discards
@@ -557,7 +527,7 @@ impl Instance {
 
     pub fn exit_initialization_mode(&mut self) -> Res {
         self.require("fmi2ExitInitializationMode", &[Phase::InitializationMode])?;
-        self.model.ensure_built(self.yarns)?;
+        self.model.ensure_built(self.count)?;
         let m = &mut self.model;
         m.time = m.start_time;
         m.last_successful_time = m.start_time;
@@ -568,10 +538,10 @@ impl Instance {
             Status::Ok,
             LOG_EVENTS,
             &format!(
-                "initialized at t = {}: {} yarns, substep {} s",
+                "initialized at t = {}: {}, substep {} s",
                 self.model.time,
-                self.yarns,
-                self.model.sim.dt()
+                self.bundled.summary(),
+                self.model.physics.dt()
             ),
         );
         Ok(())
@@ -586,7 +556,7 @@ impl Instance {
 
     pub fn reset(&mut self) -> Res {
         self.require("fmi2Reset", NOT_FATAL)?;
-        self.model = Model::new(self.bundled.clone())?;
+        self.model = Model::new(&self.bundled)?;
         self.phase = Phase::Instantiated;
         self.log(Status::Ok, LOG_EVENTS, "reset to the instantiated state");
         Ok(())
@@ -622,48 +592,40 @@ impl Instance {
         // The substep count is an integer grid from the start time: the
         // substeps done by a given time do not depend on how the master
         // partitions its interval.
-        let target = ((end - m.start_time) / m.sim.dt()).round();
+        let dt = m.physics.dt();
+        let target = ((end - m.start_time) / dt).round();
         if !(0.0..9.0e15).contains(&target) {
-            return error(format!(
-                "step to {end} needs {target} substeps of {} s",
-                m.sim.dt()
-            ));
+            return error(format!("step to {end} needs {target} substeps of {dt} s"));
         }
         let target = target as u64;
-        let n = target.saturating_sub(m.substeps);
-        for _ in 0..n {
-            if let Err(e) = m.sim.step() {
-                m.substeps = m.sim.steps();
-                m.diag = None;
+        while m.substeps < target {
+            if let Err(e) = m.physics.substep(m.substeps) {
                 m.terminated = true;
                 self.phase = Phase::StepFailed;
-                let msg = match e {
-                    SimError::NonFinite { .. } => format!(
-                        "step from t = {t} by {h} failed: {e}; the simulation is terminated (restore a state or reset)"
-                    ),
-                    SimError::BadInput(_) => format!("step from t = {t} by {h} failed: {e}"),
+                let msg = if e.terminal {
+                    format!(
+                        "step from t = {t} by {h} failed: {}; the simulation is terminated (restore a state or reset)",
+                        e.msg
+                    )
+                } else {
+                    format!("step from t = {t} by {h} failed: {}", e.msg)
                 };
                 return Err(Fail {
                     status: Status::Discard,
                     msg,
                 });
             }
+            m.substeps += 1;
         }
-        m.substeps += n;
-        m.diag = None;
-        // The library reports divergence itself; the outputs are checked
-        // too, so a step never ends OK with a non-finite output.
-        let finite = (0..self.yarns).all(|y| {
-            let (l, r) = m.sim.yarn_endpoints(y);
-            l.x.is_finite() && l.y.is_finite() && r.x.is_finite() && r.y.is_finite()
-        });
-        if !finite {
+        // The libraries report divergence themselves; the outputs are
+        // checked too, so a step never ends OK with a non-finite output.
+        if !m.physics.outputs_finite() {
             m.terminated = true;
             self.phase = Phase::StepFailed;
             return Err(Fail {
                 status: Status::Discard,
                 msg: format!(
-                    "step from t = {t} by {h} left non-finite yarn ends; the simulation is terminated (restore a state or reset)"
+                    "step from t = {t} by {h} left non-finite outputs; the simulation is terminated (restore a state or reset)"
                 ),
             });
         }
@@ -689,42 +651,19 @@ impl Instance {
                 self.model.last_successful_time
             ));
         }
-        self.model.ensure_built(self.yarns)
+        self.model.ensure_built(self.count)
     }
 
     pub fn get_real(&mut self, vrs: &[u32], out: &mut [f64]) -> Res {
         self.require_get("fmi2GetReal")?;
         for (k, &vr) in vrs.iter().enumerate() {
-            let v = match vr {
-                VR_ATTRACTOR_X => self.model.inputs.attractor[0],
-                VR_ATTRACTOR_Y => self.model.inputs.attractor[1],
-                VR_ATTRACTOR_STRENGTH => self.model.inputs.strength,
-                VR_GRAVITY_X => self.model.inputs.gravity[0],
-                VR_GRAVITY_Y => self.model.inputs.gravity[1],
-                _ if real_param_index(vr).is_some() => {
-                    let i = real_param_index(vr).unwrap();
-                    self.model.config.reals[i].unwrap_or_else(|| scene_real(&self.model.base, vr))
-                }
-                VR_KINETIC_ENERGY | VR_ELASTIC_ENERGY | VR_MAX_STRETCH => {
-                    self.require_state("fmi2GetReal")?;
-                    let d = self.model.diagnostics();
-                    match vr {
-                        VR_KINETIC_ENERGY => d.kinetic_energy,
-                        VR_ELASTIC_ENERGY => d.elastic_energy,
-                        _ => d.max_stretch,
-                    }
-                }
-                _ if vr >= VR_YARN_BASE && ((vr - VR_YARN_BASE) / 4) < self.yarns as u32 => {
-                    self.require_state("fmi2GetReal")?;
-                    let i = (vr - VR_YARN_BASE) as usize;
-                    let (l, r) = self.model.sim.yarn_endpoints(i / 4);
-                    [l.x, l.y, r.x, r.y][i % 4]
-                }
-                _ => {
-                    return error(format!(
-                        "fmi2GetReal: no Real variable has value reference {vr}"
-                    ))
-                }
+            if self.model.physics.is_state_output(vr) {
+                self.require_state("fmi2GetReal")?;
+            }
+            let Some(v) = self.model.physics.get_real(vr) else {
+                return error(format!(
+                    "fmi2GetReal: no Real variable has value reference {vr}"
+                ));
             };
             if !v.is_finite() {
                 return error(format!(
@@ -756,20 +695,12 @@ impl Instance {
     pub fn get_boolean(&mut self, vrs: &[u32], out: &mut [c_int]) -> Res {
         self.require_get("fmi2GetBoolean")?;
         for (k, &vr) in vrs.iter().enumerate() {
-            out[k] = match vr {
-                VR_ATTRACTOR_ACTIVE => self.model.inputs.active as c_int,
-                VR_PLASTICITY => {
-                    self.model
-                        .config
-                        .plasticity
-                        .unwrap_or(self.model.base.material.plasticity) as c_int
-                }
-                _ => {
-                    return error(format!(
-                        "fmi2GetBoolean: no Boolean variable has value reference {vr}"
-                    ))
-                }
+            let Some(v) = self.model.physics.get_boolean(vr) else {
+                return error(format!(
+                    "fmi2GetBoolean: no Boolean variable has value reference {vr}"
+                ));
             };
+            out[k] = v;
         }
         Ok(())
     }
@@ -779,14 +710,12 @@ impl Instance {
         self.require_get("fmi2GetString")?;
         self.strings.clear();
         for &vr in vrs {
-            match vr {
-                VR_SCENE => self.strings.push(escape_nul(&self.model.config.scene_path)),
-                _ => {
-                    return error(format!(
-                        "fmi2GetString: no String variable has value reference {vr}"
-                    ))
-                }
-            }
+            let Some(v) = self.model.physics.get_string(vr) else {
+                return error(format!(
+                    "fmi2GetString: no String variable has value reference {vr}"
+                ));
+            };
+            self.strings.push(escape_nul(v));
         }
         Ok(&self.strings)
     }
@@ -796,71 +725,20 @@ impl Instance {
         self.require(func, &[Instantiated, InitializationMode, StepComplete])
     }
 
-    fn require_set_parameter(&self, func: &str, vr: u32) -> Res {
-        use Phase::*;
-        if matches!(self.phase, Instantiated | InitializationMode) {
-            Ok(())
-        } else {
-            error(format!(
-                "{func}: value reference {vr} is a fixed parameter, settable only before fmi2ExitInitializationMode (state is {:?})",
-                phase_name(self.phase)
-            ))
-        }
-    }
-
     pub fn set_real(&mut self, vrs: &[u32], vals: &[f64]) -> Res {
         self.require_set_input("fmi2SetReal")?;
-        // Check everything first, so a rejected call changes nothing.
-        let mut inputs = self.model.inputs;
-        let mut reals = self.model.config.reals;
-        for (&vr, &v) in vrs.iter().zip(vals) {
-            if !v.is_finite() {
-                return error(format!(
-                    "fmi2SetReal: value {v} for value reference {vr} is not finite"
-                ));
-            }
-            match vr {
-                VR_ATTRACTOR_X => inputs.attractor[0] = v,
-                VR_ATTRACTOR_Y => inputs.attractor[1] = v,
-                VR_ATTRACTOR_STRENGTH => inputs.strength = v,
-                VR_GRAVITY_X => inputs.gravity[0] = v,
-                VR_GRAVITY_Y => inputs.gravity[1] = v,
-                _ if real_param_index(vr).is_some() => {
-                    self.require_set_parameter("fmi2SetReal", vr)?;
-                    let ok = match vr {
-                        VR_DENSITY | VR_DT => v > 0.0,
-                        _ => v >= 0.0,
-                    } && v <= 1e12;
-                    if !ok {
-                        return error(format!(
-                            "fmi2SetReal: parameter value reference {vr} = {v} is out of range"
-                        ));
-                    }
-                    reals[real_param_index(vr).unwrap()] = Some(v);
-                }
-                _ => {
-                    return error(format!(
-                        "fmi2SetReal: value reference {vr} is not a Real input or parameter"
-                    ))
-                }
-            }
-        }
-        if inputs.attractor.iter().any(|c| c.abs() > 1e6) {
+        if let Some((vr, v)) = vrs.iter().zip(vals).find(|(_, v)| !v.is_finite()) {
             return error(format!(
-                "fmi2SetReal: attractor position ({}, {}) is absurd (beyond 1e6 m)",
-                inputs.attractor[0], inputs.attractor[1]
+                "fmi2SetReal: value {v} for value reference {vr} is not finite"
             ));
         }
-        // The library's own limits (|g| <= 1e6, strength in [0, 1e6]).
-        check_inputs(&inputs)?;
-        if inputs != self.model.inputs {
-            self.model.inputs = inputs;
-            inputs.apply(&mut self.model.sim)?;
-        }
-        if reals != self.model.config.reals {
-            self.model.config.reals = reals;
-            self.model.dirty = true;
-        }
+        let phase = self.phase;
+        let check = |func: &str, vr: u32| parameter_settable(phase, func, vr);
+        let changed = match &mut self.model.physics {
+            Physics::Yarn(m) => m.set_real(vrs, vals, &check)?,
+            Physics::MassSpring(m) => m.set_real(vrs, vals, &check)?,
+        };
+        self.model.dirty |= changed;
         Ok(())
     }
 
@@ -876,69 +754,37 @@ impl Instance {
 
     pub fn set_boolean(&mut self, vrs: &[u32], vals: &[c_int]) -> Res {
         self.require_set_input("fmi2SetBoolean")?;
-        let mut active = self.model.inputs.active;
-        let mut plasticity = self.model.config.plasticity;
-        for (&vr, &v) in vrs.iter().zip(vals) {
-            match vr {
-                VR_ATTRACTOR_ACTIVE => active = v != 0,
-                VR_PLASTICITY => {
-                    self.require_set_parameter("fmi2SetBoolean", vr)?;
-                    plasticity = Some(v != 0);
-                }
-                _ => {
-                    return error(format!(
-                        "fmi2SetBoolean: value reference {vr} is not a Boolean input or parameter"
-                    ))
-                }
-            }
-        }
-        if active != self.model.inputs.active {
-            self.model.inputs.active = active;
-            let inputs = self.model.inputs;
-            inputs.apply(&mut self.model.sim)?;
-        }
-        if plasticity != self.model.config.plasticity {
-            self.model.config.plasticity = plasticity;
-            self.model.dirty = true;
-        }
+        let phase = self.phase;
+        let check = |func: &str, vr: u32| parameter_settable(phase, func, vr);
+        let changed = match &mut self.model.physics {
+            Physics::Yarn(m) => m.set_boolean(vrs, vals, &check)?,
+            Physics::MassSpring(m) => m.set_boolean(vrs, vals, &check)?,
+        };
+        self.model.dirty |= changed;
         Ok(())
     }
 
     pub fn set_string(&mut self, vrs: &[u32], vals: &[Option<String>]) -> Res {
         self.require_set_input("fmi2SetString")?;
-        for (&vr, v) in vrs.iter().zip(vals) {
-            if vr != VR_SCENE {
-                return error(format!(
-                    "fmi2SetString: value reference {vr} is not a String parameter"
-                ));
+        let phase = self.phase;
+        let check = |func: &str, vr: u32| parameter_settable(phase, func, vr);
+        let changed = match (&mut self.model.physics, &self.bundled) {
+            (Physics::Yarn(m), FmuScene::Yarn(bundled)) => {
+                m.set_string(vrs, vals, &check, &self.resources, bundled)?
             }
-            self.require_set_parameter("fmi2SetString", vr)?;
-            let Some(v) = v else {
-                return error("fmi2SetString: the scene file name is a null pointer");
-            };
-            let base = if v == SCENE_FILE {
-                self.bundled.clone()
-            } else {
-                read_scene(&self.resources.join(v)).or_else(error)?
-            };
-            let yarns = num_yarns(&base);
-            if yarns != self.yarns {
-                return error(format!(
-                    "fmi2SetString: scene {v:?} creates {yarns} yarns, but this FMU has outputs for {}",
-                    self.yarns
-                ));
+            (Physics::MassSpring(m), _) => m.set_string(vrs, vals, &check)?,
+            (Physics::Yarn(_), FmuScene::MassSpring(_)) => {
+                unreachable!("a yarn model from a mass-spring scene")
             }
-            self.model.config.scene_path = v.clone();
-            self.model.base = base;
-            self.model.dirty = true;
-        }
+        };
+        self.model.dirty |= changed;
         Ok(())
     }
 
     pub fn get_fmu_state(&mut self, into: Option<&mut Snapshot>) -> Res<Option<Box<Snapshot>>> {
         self.require("fmi2GetFMUstate", LIVE)?;
         // A snapshot always holds a simulation built from its parameters.
-        self.model.ensure_built(self.yarns)?;
+        self.model.ensure_built(self.count)?;
         match into {
             Some(s) => {
                 s.phase = self.phase;
@@ -957,9 +803,11 @@ impl Instance {
 
     pub fn set_fmu_state(&mut self, s: &Snapshot) -> Res {
         self.require("fmi2SetFMUstate", NOT_FATAL)?;
-        if s.model.sim.num_yarns() != self.yarns {
+        let same_kind =
+            std::mem::discriminant(&s.model.physics) == std::mem::discriminant(&self.model.physics);
+        if !same_kind || s.model.physics.count() != self.count {
             return error(
-                "fmi2SetFMUstate: the state belongs to an FMU with another number of yarns",
+                "fmi2SetFMUstate: the state belongs to another FMU (other model or number of outputs)",
             );
         }
         self.model = s.model.clone();
@@ -987,7 +835,7 @@ impl Instance {
 
     pub fn deserialize(&mut self, bytes: &[u8]) -> Res<Box<Snapshot>> {
         self.require_state_phase("fmi2DeSerializeFMUstate")?;
-        let (phase, model) = deserialize(bytes, &self.model, self.yarns)
+        let (phase, model) = deserialize(bytes, &self.model, self.count)
             .or_else(|e| error(format!("fmi2DeSerializeFMUstate: {e}")))?;
         Ok(Box::new(Snapshot {
             magic: SNAPSHOT_MAGIC,
@@ -1011,47 +859,45 @@ pub fn escape_nul(s: &str) -> CString {
     CString::new(s.replace('\0', "")).expect("NUL removed")
 }
 
-/// The library's input checks, without a simulation at hand.
-fn check_inputs(i: &Inputs) -> Res {
-    let g = Vec2::from(i.gravity);
-    if g.norm() > 1e6 {
-        return error(format!(
-            "fmi2SetReal: gravity ({}, {}) is absurd (|g| above 1e6 m/s2)",
-            g.x, g.y
-        ));
+/// Fixed parameters can be set only before `fmi2ExitInitializationMode`.
+fn parameter_settable(phase: Phase, func: &str, vr: u32) -> Res {
+    use Phase::*;
+    if matches!(phase, Instantiated | InitializationMode) {
+        Ok(())
+    } else {
+        error(format!(
+            "{func}: value reference {vr} is a fixed parameter, settable only before fmi2ExitInitializationMode (state is {:?})",
+            phase_name(phase)
+        ))
     }
-    if !(0.0..=1e6).contains(&i.strength) {
-        return error(format!(
-            "fmi2SetReal: attractor strength {} must be in [0, 1e6] m/s2",
-            i.strength
-        ));
-    }
-    Ok(())
 }
 
-struct Writer(Vec<u8>);
+/// Little-endian writer of a serialized FMU state.
+pub struct Writer(Vec<u8>);
 
 impl Writer {
-    fn u8(&mut self, v: u8) {
+    pub fn u8(&mut self, v: u8) {
         self.0.push(v);
     }
-    fn u64(&mut self, v: u64) {
+    pub fn u64(&mut self, v: u64) {
         self.0.extend_from_slice(&v.to_le_bytes());
     }
-    fn f64(&mut self, v: f64) {
+    pub fn f64(&mut self, v: f64) {
         self.0.extend_from_slice(&v.to_le_bytes());
     }
-    fn opt_f64(&mut self, v: Option<f64>) {
+    pub fn opt_f64(&mut self, v: Option<f64>) {
         self.u8(v.is_some() as u8);
         self.f64(v.unwrap_or(0.0));
     }
-    fn bytes(&mut self, b: &[u8]) {
+    pub fn bytes(&mut self, b: &[u8]) {
         self.u64(b.len() as u64);
         self.0.extend_from_slice(b);
     }
 }
 
-struct Reader<'a> {
+/// Reader of a serialized FMU state; every read is bounds-checked and
+/// non-finite numbers are refused.
+pub struct Reader<'a> {
     b: &'a [u8],
     at: usize,
 }
@@ -1068,20 +914,20 @@ impl<'a> Reader<'a> {
         self.at += n;
         Ok(s)
     }
-    fn u8(&mut self) -> Result<u8, String> {
+    pub fn u8(&mut self) -> Result<u8, String> {
         Ok(self.take(1)?[0])
     }
-    fn bool(&mut self) -> Result<bool, String> {
+    pub fn bool(&mut self) -> Result<bool, String> {
         match self.u8()? {
             0 => Ok(false),
             1 => Ok(true),
             b => Err(format!("bad flag byte {b}")),
         }
     }
-    fn u64(&mut self) -> Result<u64, String> {
+    pub fn u64(&mut self) -> Result<u64, String> {
         Ok(u64::from_le_bytes(self.take(8)?.try_into().unwrap()))
     }
-    fn f64(&mut self) -> Result<f64, String> {
+    pub fn f64(&mut self) -> Result<f64, String> {
         let v = f64::from_le_bytes(self.take(8)?.try_into().unwrap());
         if v.is_finite() {
             Ok(v)
@@ -1089,25 +935,36 @@ impl<'a> Reader<'a> {
             Err("state contains a non-finite number".into())
         }
     }
-    fn opt_f64(&mut self) -> Result<Option<f64>, String> {
+    pub fn opt_f64(&mut self) -> Result<Option<f64>, String> {
         let some = self.bool()?;
         let v = self.f64()?;
         Ok(some.then_some(v))
     }
-    fn bytes(&mut self) -> Result<&'a [u8], String> {
+    pub fn bytes(&mut self) -> Result<&'a [u8], String> {
         let n = self.u64()?;
         let n = usize::try_from(n).map_err(|_| "bad length".to_string())?;
         self.take(n)
     }
-    fn string(&mut self) -> Result<String, String> {
+    pub fn string(&mut self) -> Result<String, String> {
         String::from_utf8(self.bytes()?.to_vec()).map_err(|_| "string is not UTF-8".to_string())
+    }
+    /// Fails unless every byte was read.
+    pub fn finish(&self) -> Result<(), String> {
+        if self.at == self.b.len() {
+            Ok(())
+        } else {
+            Err(format!(
+                "state has {} unexpected trailing bytes",
+                self.b.len() - self.at
+            ))
+        }
     }
 }
 
-/// The FMU state as bytes: magic, version, body length, FNV-1a checksum of
-/// the body; the body holds the state machine state, the wrapper's time
-/// keeping, the inputs, the parameters, the scene text and the library's own
-/// state bytes (which carry their own header and checksum). No pointers.
+/// The FMU state as bytes: magic (one per model), version, body length,
+/// FNV-1a checksum of the body; the body holds the state machine state and
+/// the wrapper's time keeping, then the model's part ([`YarnModel::write`],
+/// [`MsModel::write`]). No pointers.
 pub fn serialize(phase: Phase, m: &Model) -> Vec<u8> {
     let mut w = Writer(Vec::new());
     w.u8(phase.code());
@@ -1118,23 +975,10 @@ pub fn serialize(phase: Phase, m: &Model) -> Vec<u8> {
     w.f64(m.time);
     w.f64(m.last_successful_time);
     w.u64(m.substeps);
-    w.f64(m.inputs.attractor[0]);
-    w.f64(m.inputs.attractor[1]);
-    w.f64(m.inputs.strength);
-    w.u8(m.inputs.active as u8);
-    w.f64(m.inputs.gravity[0]);
-    w.f64(m.inputs.gravity[1]);
-    w.bytes(m.config.scene_path.as_bytes());
-    for v in m.config.reals {
-        w.opt_f64(v);
-    }
-    w.u8(m.config.plasticity.is_some() as u8);
-    w.u8(m.config.plasticity.unwrap_or(false) as u8);
-    w.bytes(m.base.to_toml_string().as_bytes());
-    w.bytes(&m.sim.save_state());
+    each!(&m.physics, p => p.write(&mut w));
     let body = w.0;
     let mut out = Vec::with_capacity(STATE_HEADER + body.len());
-    out.extend_from_slice(STATE_MAGIC);
+    out.extend_from_slice(m.physics.state_magic());
     out.extend_from_slice(&STATE_VERSION.to_le_bytes());
     out.extend_from_slice(&(body.len() as u64).to_le_bytes());
     out.extend_from_slice(&fnv1a(&body).to_le_bytes());
@@ -1142,17 +986,27 @@ pub fn serialize(phase: Phase, m: &Model) -> Vec<u8> {
     out
 }
 
-/// Reads bytes written by [`serialize`]; `current` is reused when its scene
-/// and parameters match, else the simulation is rebuilt from the stored scene.
-pub fn deserialize(bytes: &[u8], current: &Model, yarns: usize) -> Result<(Phase, Model), String> {
+/// Reads bytes written by [`serialize`] for an FMU of the same model with
+/// `count` outputs objects; `current`'s simulation is reused when its scene
+/// and parameters match, else it is rebuilt from the stored scene.
+pub fn deserialize(bytes: &[u8], current: &Model, count: usize) -> Result<(Phase, Model), String> {
     if bytes.len() < STATE_HEADER {
         return Err(format!(
             "state has {} bytes, at least {STATE_HEADER} needed",
             bytes.len()
         ));
     }
-    if &bytes[..8] != STATE_MAGIC {
-        return Err("state does not start with the YarnBundle FMU state magic".into());
+    let magic = current.physics.state_magic();
+    if &bytes[..8] != magic {
+        let what = if STATE_MAGICS.iter().any(|m| &bytes[..8] == *m) {
+            "is the state of the other kind of FMU"
+        } else {
+            "does not start with a yarnsim FMU state magic"
+        };
+        return Err(format!(
+            "state {what} (expected {:?})",
+            String::from_utf8_lossy(&magic[..7])
+        ));
     }
     let version = u32::from_le_bytes(bytes[8..12].try_into().unwrap());
     if version != STATE_VERSION {
@@ -1184,58 +1038,17 @@ pub fn deserialize(bytes: &[u8], current: &Model, yarns: usize) -> Result<(Phase
     let time = r.f64()?;
     let last_successful_time = r.f64()?;
     let substeps = r.u64()?;
-    let inputs = Inputs {
-        attractor: [r.f64()?, r.f64()?],
-        strength: r.f64()?,
-        active: r.bool()?,
-        gravity: [r.f64()?, r.f64()?],
+    let built = !current.dirty;
+    let physics = match &current.physics {
+        Physics::Yarn(c) => Physics::Yarn(Box::new(YarnModel::read(&mut r, c, built, count)?)),
+        Physics::MassSpring(c) => {
+            Physics::MassSpring(Box::new(MsModel::read(&mut r, c, built, count)?))
+        }
     };
-    check_inputs(&inputs).map_err(|f| f.msg)?;
-    let scene_path = r.string()?;
-    let mut reals = [None; 7];
-    for v in &mut reals {
-        *v = r.opt_f64()?;
-    }
-    let has_p = r.bool()?;
-    let p = r.bool()?;
-    let config = Config {
-        scene_path,
-        reals,
-        plasticity: has_p.then_some(p),
-    };
-    let scene_text = r.string()?;
-    let sim_bytes = r.bytes()?;
-    if r.at != body.len() {
-        return Err(format!(
-            "state has {} unexpected trailing bytes",
-            body.len() - r.at
-        ));
-    }
-    let base = if scene_text == current.base.to_toml_string() {
-        current.base.clone()
-    } else {
-        YarnScene::from_toml_str(&scene_text).map_err(|e| format!("stored scene: {e}"))?
-    };
-    let scene = effective_scene(&base, &config);
-    let mut sim = if !current.dirty && base == current.base && config == current.config {
-        current.sim.clone()
-    } else {
-        YarnSim::new(&scene).map_err(|e| format!("stored scene: {e}"))?
-    };
-    if sim.num_yarns() != yarns {
-        return Err(format!(
-            "state has {} yarns, this FMU {yarns}",
-            sim.num_yarns()
-        ));
-    }
-    sim.load_state(sim_bytes).map_err(|e| e.to_string())?;
     Ok((
         phase,
         Model {
-            config,
-            base,
-            sim,
-            inputs,
+            physics,
             dirty,
             start_time,
             stop_time,
@@ -1243,7 +1056,6 @@ pub fn deserialize(bytes: &[u8], current: &Model, yarns: usize) -> Result<(Phase
             last_successful_time,
             substeps,
             terminated,
-            diag: None,
         },
     ))
 }

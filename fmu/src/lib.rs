@@ -1,14 +1,20 @@
-//! # YarnBundle: an FMI 2.0 Co-Simulation FMU of the yarnsim MPM yarn bundle
+//! # YarnBundle and MassSpring: FMI 2.0 Co-Simulation FMUs of yarnsim
 //!
-//! The cdylib (`libYarnBundle.so`, shipped as `binaries/linux64/YarnBundle.so`)
-//! exports the 34 `fmi2*` functions of FMI 2.0 Co-Simulation ([`ffi`]). The
-//! scene it runs travels in the FMU's `resources/scene.toml`; its number of
-//! yarns fixes the outputs, so `modelDescription.xml` is generated from the
-//! scene ([`model::model_description`]) by the `build-fmu` packager.
+//! The cdylib (`libYarnBundle.so`, shipped as `binaries/linux64/YarnBundle.so`,
+//! or as `binaries/linux64/MassSpring.so` in a mass-spring FMU) exports the 34
+//! `fmi2*` functions of FMI 2.0 Co-Simulation ([`ffi`]). The scene it runs
+//! travels in the FMU's `resources/scene.toml`: a yarn scene makes it the MPM
+//! yarn bundle (`YarnBundle`), a mass-spring layout (`wire`, `cloth`, ...) the
+//! mass-spring system (`MassSpring`). The scene fixes the outputs (yarns or
+//! particles), so `modelDescription.xml` is generated from it
+//! ([`model::FmuScene::model_description`]) by the `build-fmu` packager.
 //!
-//! * [`model`]: variables, value references, GUID, `modelDescription.xml`.
-//! * [`instance`]: the FMI state machine around a [`yarnsim::YarnSim`],
-//!   FMU state snapshots and their serialization.
+//! * [`model`]: the YarnBundle variables and value references, GUIDs, the
+//!   `modelDescription.xml` writer shared by both FMUs.
+//! * [`yarn`], [`massspring`]: each model's inputs, parameters, outputs and
+//!   its part of a serialized FMU state.
+//! * [`instance`]: the FMI state machine around either model, FMU state
+//!   snapshots and their serialization.
 //! * [`ffi`]: the C ABI.
 //!
 //! See the README, section "YarnBundle: the FMI 2.0 Co-Simulation FMU", for
@@ -19,7 +25,9 @@
 
 pub mod ffi;
 pub mod instance;
+pub mod massspring;
 pub mod model;
 pub mod package;
+pub mod yarn;
 
-pub use model::{guid, model_description, MODEL_IDENTIFIER};
+pub use model::{guid, model_description, FmuScene, MODEL_IDENTIFIER};

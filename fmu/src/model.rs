@@ -5,7 +5,7 @@
 use std::fmt::Write as _;
 
 use yarnsim::mpm::state::fnv1a;
-use yarnsim::scene::YarnScene;
+use yarnsim::scene::{Scene, YarnScene};
 
 /// The FMI model identifier: the shared library's and the C symbols' name.
 pub const MODEL_IDENTIFIER: &str = "YarnBundle";
@@ -346,10 +346,14 @@ pub fn variables(scene: &YarnScene) -> Vec<Variable> {
 /// The GUID of the FMU for this scene: a hash of the interface version and
 /// the scene's normalized TOML text.
 pub fn guid(scene: &YarnScene) -> String {
-    let text = format!(
+    guid_of(&format!(
         "{MODEL_IDENTIFIER} fmi2 interface {INTERFACE_VERSION}\n{}",
         scene.to_toml_string()
-    );
+    ))
+}
+
+/// A GUID-formatted 128-bit hash of `text`.
+pub fn guid_of(text: &str) -> String {
     let a = fnv1a(text.as_bytes());
     let b = fnv1a(format!("{text}\u{1}").as_bytes());
     format!(
@@ -396,9 +400,24 @@ pub fn default_stop_time(scene: &YarnScene) -> f64 {
 
 /// The complete `modelDescription.xml` of the FMU for this scene.
 pub fn model_description(scene: &YarnScene) -> String {
-    let vars = variables(scene);
-    let mut x = String::new();
-    let description = if scene.description.is_empty() {
+    write_model_description(&description(scene))
+}
+
+/// What `modelDescription.xml` is written from.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Description {
+    pub identifier: &'static str,
+    pub guid: String,
+    pub description: String,
+    pub variables: Vec<Variable>,
+    /// `DefaultExperiment` stop time and step size in s.
+    pub stop_time: f64,
+    pub step_size: f64,
+}
+
+/// The description of the YarnBundle FMU for this scene.
+pub fn description(scene: &YarnScene) -> Description {
+    let what = if scene.description.is_empty() {
         format!("MPM yarn bundle, scene {}", scene.name)
     } else {
         format!(
@@ -406,20 +425,38 @@ pub fn model_description(scene: &YarnScene) -> String {
             scene.name, scene.description
         )
     };
+    Description {
+        identifier: MODEL_IDENTIFIER,
+        guid: guid(scene),
+        description: what,
+        variables: variables(scene),
+        stop_time: default_stop_time(scene),
+        step_size: scene.time.frame_dt,
+    }
+}
+
+/// Writes `modelDescription.xml`; only the units the variables use are defined.
+pub fn write_model_description(d: &Description) -> String {
+    let vars = &d.variables;
+    let ident = d.identifier;
+    let mut x = String::new();
     x.push_str("<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n");
     let _ = writeln!(
         x,
-        "<fmiModelDescription fmiVersion=\"2.0\" modelName=\"{MODEL_IDENTIFIER}\" guid=\"{}\" description=\"{}\" generationTool=\"yarnsim-fmu {}\" variableNamingConvention=\"structured\" numberOfEventIndicators=\"0\">",
-        guid(scene),
-        xml_escape(&description),
+        "<fmiModelDescription fmiVersion=\"2.0\" modelName=\"{ident}\" guid=\"{}\" description=\"{}\" generationTool=\"yarnsim-fmu {}\" variableNamingConvention=\"structured\" numberOfEventIndicators=\"0\">",
+        d.guid,
+        xml_escape(&d.description),
         env!("CARGO_PKG_VERSION"),
     );
     let _ = writeln!(
         x,
-        "  <CoSimulation modelIdentifier=\"{MODEL_IDENTIFIER}\" canHandleVariableCommunicationStepSize=\"true\" canInterpolateInputs=\"false\" maxOutputDerivativeOrder=\"0\" canRunAsynchronuously=\"false\" canBeInstantiatedOnlyOncePerProcess=\"false\" canNotUseMemoryManagementFunctions=\"true\" canGetAndSetFMUstate=\"true\" canSerializeFMUstate=\"true\" providesDirectionalDerivative=\"false\"/>"
+        "  <CoSimulation modelIdentifier=\"{ident}\" canHandleVariableCommunicationStepSize=\"true\" canInterpolateInputs=\"false\" maxOutputDerivativeOrder=\"0\" canRunAsynchronuously=\"false\" canBeInstantiatedOnlyOncePerProcess=\"false\" canNotUseMemoryManagementFunctions=\"true\" canGetAndSetFMUstate=\"true\" canSerializeFMUstate=\"true\" providesDirectionalDerivative=\"false\"/>"
     );
     x.push_str("  <UnitDefinitions>\n");
-    for (name, base) in UNITS {
+    for (name, base) in UNITS
+        .iter()
+        .filter(|(u, _)| vars.iter().any(|v| v.unit == Some(*u)))
+    {
         let _ = writeln!(
             x,
             "    <Unit name=\"{}\"><BaseUnit {base}/></Unit>",
@@ -427,19 +464,19 @@ pub fn model_description(scene: &YarnScene) -> String {
         );
     }
     x.push_str("  </UnitDefinitions>\n  <LogCategories>\n");
-    for (name, d) in LOG_CATEGORIES {
+    for (name, what) in LOG_CATEGORIES {
         let _ = writeln!(
             x,
             "    <Category name=\"{name}\" description=\"{}\"/>",
-            xml_escape(d)
+            xml_escape(what)
         );
     }
     x.push_str("  </LogCategories>\n");
     let _ = writeln!(
         x,
         "  <DefaultExperiment startTime=\"0.0\" stopTime=\"{}\" stepSize=\"{}\"/>",
-        real(default_stop_time(scene)),
-        real(scene.time.frame_dt)
+        real(d.stop_time),
+        real(d.step_size)
     );
     x.push_str("  <ModelVariables>\n");
     for (i, v) in vars.iter().enumerate() {
@@ -486,4 +523,91 @@ pub fn model_description(scene: &YarnScene) -> String {
     }
     x.push_str("    </InitialUnknowns>\n  </ModelStructure>\n</fmiModelDescription>\n");
     x
+}
+
+/// The scene an FMU runs, which decides its physics and modelIdentifier:
+/// a yarn scene gives `YarnBundle`, a mass-spring layout `MassSpring`.
+#[derive(Clone, Debug, PartialEq)]
+pub enum FmuScene {
+    Yarn(YarnScene),
+    MassSpring(yarnsim::massspring::Layout),
+}
+
+impl From<Scene> for FmuScene {
+    fn from(s: Scene) -> Self {
+        match s {
+            Scene::Yarn(y) => FmuScene::Yarn(y),
+            Scene::MassSpring(l) => FmuScene::MassSpring(l),
+        }
+    }
+}
+
+impl From<YarnScene> for FmuScene {
+    fn from(s: YarnScene) -> Self {
+        FmuScene::Yarn(s)
+    }
+}
+
+impl FmuScene {
+    /// Reads a scene file's text (either kind).
+    pub fn from_toml_str(text: &str) -> Result<FmuScene, String> {
+        Scene::from_toml_str(text)
+            .map(FmuScene::from)
+            .map_err(|e| e.to_string())
+    }
+
+    /// The scene file text packed as `resources/scene.toml`.
+    pub fn to_toml_string(&self) -> String {
+        match self {
+            FmuScene::Yarn(s) => s.to_toml_string(),
+            FmuScene::MassSpring(l) => l.to_toml_string(),
+        }
+    }
+
+    /// The FMI modelIdentifier: `YarnBundle` or `MassSpring`.
+    pub fn identifier(&self) -> &'static str {
+        match self {
+            FmuScene::Yarn(_) => MODEL_IDENTIFIER,
+            FmuScene::MassSpring(_) => crate::massspring::MODEL_IDENTIFIER,
+        }
+    }
+
+    /// The scene's name.
+    pub fn name(&self) -> &str {
+        match self {
+            FmuScene::Yarn(s) => &s.name,
+            FmuScene::MassSpring(l) => &l.name,
+        }
+    }
+
+    pub fn guid(&self) -> String {
+        match self {
+            FmuScene::Yarn(s) => guid(s),
+            FmuScene::MassSpring(l) => crate::massspring::guid(l),
+        }
+    }
+
+    /// What the model description is written from; an error for a layout
+    /// that does not build.
+    pub fn description(&self) -> Result<Description, String> {
+        match self {
+            FmuScene::Yarn(s) => Ok(description(s)),
+            FmuScene::MassSpring(l) => crate::massspring::description(l),
+        }
+    }
+
+    pub fn model_description(&self) -> Result<String, String> {
+        self.description().map(|d| write_model_description(&d))
+    }
+
+    /// The outputs per object: `"12 yarns"`, `"441 particles"`.
+    pub fn summary(&self) -> String {
+        match self {
+            FmuScene::Yarn(s) => format!("{} yarns", num_yarns(s)),
+            FmuScene::MassSpring(l) => match crate::massspring::num_particles(l) {
+                Ok(n) => format!("{n} particles"),
+                Err(e) => e,
+            },
+        }
+    }
 }

@@ -297,6 +297,23 @@ impl Simulation {
         Ok(n)
     }
 
+    /// Changes gravity from the next step on (`[gx, gy, gz]` in m/s^2, finite,
+    /// |g| at most 1e6); the FMU's gravity inputs use this.
+    pub fn set_gravity(&mut self, g: V3) -> Result<(), MassSpringError> {
+        if !g.iter().all(|c| c.is_finite()) || g.norm() > 1e6 {
+            return Err(MassSpringError::Argument(format!(
+                "gravity ({}, {}, {}) must be finite with |g| at most 1e6 m/s^2",
+                g.x, g.y, g.z
+            )));
+        }
+        self.system.gravity = g;
+        Ok(())
+    }
+    /// Gravity in m/s^2.
+    pub fn gravity(&self) -> V3 {
+        self.system.gravity
+    }
+
     /// Current positions in m.
     pub fn positions(&self) -> &[V3] {
         &self.state.x

@@ -1,0 +1,462 @@
+//! The mass-spring physics behind the `MassSpring` FMU (the same shared
+//! library as `YarnBundle`, packed under the modelIdentifier `MassSpring`
+//! when the bundled scene is a mass-spring layout such as `wire` or
+//! `cloth`): its variables, GUID and model description, and the
+//! [`Simulation`] an instance drives.
+//!
+//! Inputs `gravity.x/y/z`; parameters `dt` (0: the integrator's own step)
+//! and `integrator`; outputs the energies, the largest strain, the substep
+//! count and every particle's position `particle[i].x/y/z`.
+
+use std::ffi::c_int;
+
+use yarnsim::massspring::{Integrator, IntegratorOptions, Layout, Simulation, V3};
+
+use crate::instance::{error, ParamCheck, Reader, Res, StepFailure, Writer};
+use crate::model::{real, Description, VarType, Variable};
+
+/// The FMI model identifier of a mass-spring FMU.
+pub const MODEL_IDENTIFIER: &str = "MassSpring";
+
+/// Bumped whenever the variable layout changes; part of the GUID.
+pub const INTERFACE_VERSION: u32 = 1;
+
+/// The integrator an instance uses unless the `integrator` parameter says
+/// otherwise (the CLI's default too).
+pub const DEFAULT_INTEGRATOR: Integrator = Integrator::BackwardEuler;
+
+// Value references, unique across all types.
+pub const VR_GRAVITY_X: u32 = 1;
+pub const VR_GRAVITY_Y: u32 = 2;
+pub const VR_GRAVITY_Z: u32 = 3;
+pub const VR_DT: u32 = 10;
+pub const VR_INTEGRATOR: u32 = 11; // String
+pub const VR_KINETIC_ENERGY: u32 = 100;
+pub const VR_ELASTIC_ENERGY: u32 = 101;
+pub const VR_GRAVITY_ENERGY: u32 = 102;
+pub const VR_TOTAL_ENERGY: u32 = 103;
+pub const VR_MAX_STRAIN: u32 = 104;
+pub const VR_SUBSTEPS: u32 = 200; // Integer
+/// `particle[i].x` has `VR_PARTICLE_BASE + 3 i`, then `.y`, `.z`.
+pub const VR_PARTICLE_BASE: u32 = 1000;
+
+/// Number of particles the layout creates (fixes the outputs).
+pub fn num_particles(layout: &Layout) -> Result<usize, String> {
+    layout
+        .build()
+        .map(|s| s.len())
+        .map_err(|e| format!("scene {:?}: {e}", layout.name))
+}
+
+/// Every variable of the FMU for this layout, in `ModelVariables` order.
+pub fn variables(layout: &Layout) -> Result<Vec<Variable>, String> {
+    let n = num_particles(layout)?;
+    let mut v = Vec::with_capacity(11 + 3 * n);
+    let var = |name: String,
+               vr: u32,
+               ty: VarType,
+               causality: &'static str,
+               variability: &'static str,
+               unit: Option<&'static str>,
+               start: Option<String>,
+               description: String| Variable {
+        name,
+        vr,
+        ty,
+        causality,
+        variability,
+        unit,
+        start,
+        description,
+    };
+    for (k, axis) in ["x", "y", "z"].into_iter().enumerate() {
+        v.push(var(
+            format!("gravity.{axis}"),
+            VR_GRAVITY_X + k as u32,
+            VarType::Real,
+            "input",
+            "continuous",
+            Some("m/s2"),
+            Some(real(layout.gravity[k])),
+            format!("Gravity {axis}, |g| at most 1e6"),
+        ));
+    }
+    v.push(var(
+        "dt".into(),
+        VR_DT,
+        VarType::Real,
+        "parameter",
+        "fixed",
+        Some("s"),
+        Some(real(0.0)),
+        "Substep size; 0: the integrator's own (CFL-limited for the explicit schemes, the scene's time_step otherwise). A communication step runs an integer number of substeps".into(),
+    ));
+    v.push(var(
+        "integrator".into(),
+        VR_INTEGRATOR,
+        VarType::String,
+        "parameter",
+        "fixed",
+        None,
+        Some(DEFAULT_INTEGRATOR.name().into()),
+        format!(
+            "Time integrator: one of {}",
+            Integrator::ALL.map(|i| i.name()).join(", ")
+        ),
+    ));
+    for (vr, name, unit, d) in [
+        (
+            VR_KINETIC_ENERGY,
+            "kinetic_energy",
+            Some("J"),
+            "Kinetic energy",
+        ),
+        (
+            VR_ELASTIC_ENERGY,
+            "elastic_energy",
+            Some("J"),
+            "Elastic energy of the springs",
+        ),
+        (
+            VR_GRAVITY_ENERGY,
+            "gravity_energy",
+            Some("J"),
+            "Gravitational energy -sum m g.x",
+        ),
+        (
+            VR_TOTAL_ENERGY,
+            "total_energy",
+            Some("J"),
+            "Kinetic + elastic + gravitational energy",
+        ),
+        (
+            VR_MAX_STRAIN,
+            "max_strain",
+            None,
+            "Largest spring strain |l / l0 - 1|",
+        ),
+    ] {
+        v.push(var(
+            name.into(),
+            vr,
+            VarType::Real,
+            "output",
+            "continuous",
+            unit,
+            None,
+            d.into(),
+        ));
+    }
+    v.push(var(
+        "substeps".into(),
+        VR_SUBSTEPS,
+        VarType::Integer,
+        "output",
+        "discrete",
+        None,
+        None,
+        "Substeps taken since initialization".into(),
+    ));
+    for i in 0..n {
+        for (k, axis) in ["x", "y", "z"].into_iter().enumerate() {
+            v.push(var(
+                format!("particle[{i}].{axis}"),
+                VR_PARTICLE_BASE + 3 * i as u32 + k as u32,
+                VarType::Real,
+                "output",
+                "continuous",
+                Some("m"),
+                None,
+                format!("Particle {i}, position {axis}"),
+            ));
+        }
+    }
+    Ok(v)
+}
+
+/// The GUID of the FMU for this layout: a hash of the interface version and
+/// the layout's normalized TOML text.
+pub fn guid(layout: &Layout) -> String {
+    crate::model::guid_of(&format!(
+        "{MODEL_IDENTIFIER} fmi2 interface {INTERFACE_VERSION}\n{}",
+        layout.to_toml_string()
+    ))
+}
+
+/// What `modelDescription.xml` is written from.
+pub fn description(layout: &Layout) -> Result<Description, String> {
+    let what = if layout.description.is_empty() {
+        format!("Mass-spring scene {}", layout.name)
+    } else {
+        format!("Mass-spring scene {}: {}", layout.name, layout.description)
+    };
+    Ok(Description {
+        identifier: MODEL_IDENTIFIER,
+        guid: guid(layout),
+        description: what,
+        variables: variables(layout)?,
+        stop_time: layout.time.frame_time * layout.time.frames as f64,
+        step_size: layout.time.frame_time,
+    })
+}
+
+/// The mass-spring system of one FMU instance.
+#[derive(Clone, Debug)]
+pub struct MsModel {
+    /// The bundled layout.
+    pub base: Layout,
+    /// The `dt` parameter (`None`: 0, the integrator's own step).
+    pub dt: Option<f64>,
+    pub integrator: Integrator,
+    /// The gravity inputs.
+    pub gravity: [f64; 3],
+    pub sim: Simulation,
+}
+
+fn build(base: &Layout, integrator: Integrator, dt: Option<f64>) -> Res<Simulation> {
+    let options = IntegratorOptions {
+        dt,
+        ..IntegratorOptions::default()
+    };
+    Simulation::new(base, integrator, options).or_else(|e| error(e.to_string()))
+}
+
+impl MsModel {
+    pub fn new(base: Layout) -> Res<Self> {
+        let sim = build(&base, DEFAULT_INTEGRATOR, None)?;
+        Ok(MsModel {
+            gravity: base.gravity,
+            base,
+            dt: None,
+            integrator: DEFAULT_INTEGRATOR,
+            sim,
+        })
+    }
+
+    /// Rebuilds the simulation from the layout and the parameters.
+    pub fn rebuild(&mut self, particles: usize) -> Res {
+        let mut sim = build(&self.base, self.integrator, self.dt)?;
+        if sim.positions().len() != particles {
+            return error(format!(
+                "the scene has {} particles, but this FMU has outputs for {particles}",
+                sim.positions().len()
+            ));
+        }
+        sim.set_gravity(V3::from(self.gravity))
+            .or_else(|e| error(e.to_string()))?;
+        self.sim = sim;
+        Ok(())
+    }
+
+    pub fn count(&self) -> usize {
+        self.sim.positions().len()
+    }
+
+    pub fn dt(&self) -> f64 {
+        self.sim.dt()
+    }
+
+    /// Substep number `k` (0-based since initialization): the clock is set
+    /// to `k dt` first, so the driven particles follow the substep grid.
+    pub fn substep(&mut self, k: u64) -> Result<(), StepFailure> {
+        let dt = self.sim.dt();
+        self.sim.state_mut().t = k as f64 * dt;
+        self.sim.step(dt).map(|_| ()).map_err(|e| StepFailure {
+            terminal: true,
+            msg: e.to_string(),
+        })
+    }
+
+    pub fn outputs_finite(&self) -> bool {
+        self.sim
+            .positions()
+            .iter()
+            .all(|p| p.iter().all(|c| c.is_finite()))
+    }
+
+    /// Whether the Real variable `vr` depends on the simulated state.
+    pub fn is_state_output(&self, vr: u32) -> bool {
+        (VR_KINETIC_ENERGY..=VR_MAX_STRAIN).contains(&vr)
+            || (vr >= VR_PARTICLE_BASE && ((vr - VR_PARTICLE_BASE) / 3) < self.count() as u32)
+    }
+
+    /// The value of the Real variable `vr`, `None` if there is none.
+    pub fn get_real(&self, vr: u32) -> Option<f64> {
+        Some(match vr {
+            VR_GRAVITY_X..=VR_GRAVITY_Z => self.gravity[(vr - VR_GRAVITY_X) as usize],
+            VR_DT => self.dt.unwrap_or(0.0),
+            VR_KINETIC_ENERGY => self.sim.energies().kinetic,
+            VR_ELASTIC_ENERGY => self.sim.energies().elastic,
+            VR_GRAVITY_ENERGY => self.sim.energies().gravity,
+            VR_TOTAL_ENERGY => self.sim.energies().total(),
+            VR_MAX_STRAIN => self.sim.max_strain(),
+            _ if self.is_state_output(vr) => {
+                let i = (vr - VR_PARTICLE_BASE) as usize;
+                self.sim.positions()[i / 3][i % 3]
+            }
+            _ => return None,
+        })
+    }
+
+    pub fn get_boolean(&self, _vr: u32) -> Option<c_int> {
+        None
+    }
+
+    pub fn get_string(&self, vr: u32) -> Option<&str> {
+        (vr == VR_INTEGRATOR).then_some(self.integrator.name())
+    }
+
+    /// Sets the gravity inputs and the `dt` parameter; true when the
+    /// parameter changed. A rejected call changes nothing.
+    pub fn set_real(&mut self, vrs: &[u32], vals: &[f64], param_ok: ParamCheck) -> Res<bool> {
+        let mut gravity = self.gravity;
+        let mut dt = self.dt;
+        for (&vr, &v) in vrs.iter().zip(vals) {
+            match vr {
+                VR_GRAVITY_X..=VR_GRAVITY_Z => gravity[(vr - VR_GRAVITY_X) as usize] = v,
+                VR_DT => {
+                    param_ok("fmi2SetReal", vr)?;
+                    if !(0.0..=1e3).contains(&v) {
+                        return error(format!(
+                            "fmi2SetReal: dt = {v} s is out of range (0 = automatic, else up to 1e3 s)"
+                        ));
+                    }
+                    dt = (v > 0.0).then_some(v);
+                }
+                _ => {
+                    return error(format!(
+                        "fmi2SetReal: value reference {vr} is not a Real input or parameter"
+                    ))
+                }
+            }
+        }
+        if gravity != self.gravity {
+            self.sim
+                .set_gravity(V3::from(gravity))
+                .or_else(|e| error(format!("fmi2SetReal: {e}")))?;
+            self.gravity = gravity;
+        }
+        let changed = dt != self.dt;
+        self.dt = dt;
+        Ok(changed)
+    }
+
+    pub fn set_boolean(&mut self, vrs: &[u32], _vals: &[c_int], _: ParamCheck) -> Res<bool> {
+        match vrs.first() {
+            None => Ok(false),
+            Some(vr) => error(format!(
+                "fmi2SetBoolean: value reference {vr} is not a Boolean input or parameter"
+            )),
+        }
+    }
+
+    /// Sets the `integrator` parameter; true when it changed.
+    pub fn set_string(
+        &mut self,
+        vrs: &[u32],
+        vals: &[Option<String>],
+        param_ok: ParamCheck,
+    ) -> Res<bool> {
+        let mut integrator = self.integrator;
+        for (&vr, v) in vrs.iter().zip(vals) {
+            if vr != VR_INTEGRATOR {
+                return error(format!(
+                    "fmi2SetString: value reference {vr} is not a String parameter"
+                ));
+            }
+            param_ok("fmi2SetString", vr)?;
+            let Some(v) = v else {
+                return error("fmi2SetString: the integrator name is a null pointer");
+            };
+            integrator = v
+                .parse()
+                .or_else(|e| error(format!("fmi2SetString: {e}")))?;
+        }
+        let changed = integrator != self.integrator;
+        self.integrator = integrator;
+        Ok(changed)
+    }
+
+    /// This model's part of a serialized FMU state: gravity, parameters, the
+    /// layout text, then time, positions and velocities (the state's header
+    /// checksums the whole body).
+    pub fn write(&self, w: &mut Writer) {
+        for g in self.gravity {
+            w.f64(g);
+        }
+        w.opt_f64(self.dt);
+        w.bytes(self.integrator.name().as_bytes());
+        w.bytes(self.base.to_toml_string().as_bytes());
+        let s = self.sim.state();
+        w.f64(s.t);
+        w.u64(s.x.len() as u64);
+        for p in s.x.iter().chain(&s.v) {
+            for &c in p.iter() {
+                w.f64(c);
+            }
+        }
+    }
+
+    /// Reads what [`Self::write`] wrote; `current` (with `current_built`: its
+    /// simulation matches its layout and parameters) is reused when the
+    /// stored layout and parameters match.
+    pub fn read(
+        r: &mut Reader,
+        current: &MsModel,
+        current_built: bool,
+        particles: usize,
+    ) -> Result<MsModel, String> {
+        let gravity = [r.f64()?, r.f64()?, r.f64()?];
+        let dt = r.opt_f64()?;
+        if dt.is_some_and(|d| !(d > 0.0 && d <= 1e3)) {
+            return Err("stored dt is out of range".into());
+        }
+        let integrator: Integrator = r.string()?.parse()?;
+        let text = r.string()?;
+        let base = if text == current.base.to_toml_string() {
+            current.base.clone()
+        } else {
+            Layout::from_toml_str(&text).map_err(|e| format!("stored scene: {e}"))?
+        };
+        let t = r.f64()?;
+        let n = r.u64()?;
+        if n != particles as u64 {
+            return Err(format!("state has {n} particles, this FMU {particles}"));
+        }
+        let mut numbers = Vec::with_capacity(6 * particles);
+        for _ in 0..6 * particles {
+            numbers.push(r.f64()?);
+        }
+        r.finish()?;
+        let same = current_built
+            && base == current.base
+            && dt == current.dt
+            && integrator == current.integrator;
+        let mut sim = if same {
+            current.sim.clone()
+        } else {
+            build(&base, integrator, dt).map_err(|f| f.msg)?
+        };
+        if sim.positions().len() != particles {
+            return Err(format!(
+                "stored scene has {} particles, this FMU {particles}",
+                sim.positions().len()
+            ));
+        }
+        sim.set_gravity(V3::from(gravity))
+            .map_err(|e| e.to_string())?;
+        let s = sim.state_mut();
+        s.t = t;
+        for i in 0..particles {
+            s.x[i] = V3::from_column_slice(&numbers[3 * i..3 * i + 3]);
+            s.v[i] = V3::from_column_slice(&numbers[3 * (particles + i)..3 * (particles + i) + 3]);
+        }
+        Ok(MsModel {
+            base,
+            dt,
+            integrator,
+            gravity,
+            sim,
+        })
+    }
+}

@@ -1,0 +1,447 @@
+//! The yarn-bundle physics behind the `YarnBundle` FMU: inputs, parameter
+//! overrides, the [`YarnSim`] they build, the values of its variables
+//! ([`crate::model`] lists them) and its part of a serialized FMU state.
+
+use std::ffi::c_int;
+use std::path::Path;
+
+use yarnsim::math::Vec2;
+use yarnsim::mpm::{Attractor, Diagnostics, SimError, YarnSim};
+use yarnsim::scene::YarnScene;
+
+use crate::instance::{error, ParamCheck, Reader, Res, StepFailure, Writer};
+use crate::model::*;
+
+/// Values of the inputs.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Inputs {
+    pub attractor: [f64; 2],
+    pub strength: f64,
+    pub active: bool,
+    pub gravity: [f64; 2],
+}
+
+impl Inputs {
+    fn from_scene(s: &YarnScene) -> Self {
+        Inputs {
+            attractor: s.attractor.position,
+            strength: s.attractor.strength,
+            active: s.attractor.active,
+            gravity: s.gravity,
+        }
+    }
+
+    /// Checks the inputs the way the library does, then hands them to `sim`.
+    fn apply(&self, sim: &mut YarnSim) -> Res {
+        sim.set_gravity(Vec2::from(self.gravity))
+            .and_then(|_| {
+                sim.set_attractor(Attractor {
+                    position: Vec2::from(self.attractor),
+                    strength: self.strength,
+                    active: self.active,
+                })
+            })
+            .or_else(|e| error(e.to_string()))
+    }
+
+    /// The library's input limits, without a simulation at hand.
+    fn check(&self) -> Res {
+        let g = Vec2::from(self.gravity);
+        if g.norm() > 1e6 {
+            return error(format!(
+                "fmi2SetReal: gravity ({}, {}) is absurd (|g| above 1e6 m/s2)",
+                g.x, g.y
+            ));
+        }
+        if !(0.0..=1e6).contains(&self.strength) {
+            return error(format!(
+                "fmi2SetReal: attractor strength {} must be in [0, 1e6] m/s2",
+                self.strength
+            ));
+        }
+        if self.attractor.iter().any(|c| c.abs() > 1e6) {
+            return error(format!(
+                "fmi2SetReal: attractor position ({}, {}) is absurd (beyond 1e6 m)",
+                self.attractor[0], self.attractor[1]
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// The parameters as set by the environment (`None`: the scene's value).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Config {
+    pub scene_path: String,
+    /// Overrides of [`REAL_PARAMETERS`], in that order.
+    pub reals: [Option<f64>; 7],
+    pub plasticity: Option<bool>,
+}
+
+impl Default for Config {
+    fn default() -> Self {
+        Config {
+            scene_path: SCENE_FILE.to_string(),
+            reals: [None; 7],
+            plasticity: None,
+        }
+    }
+}
+
+fn real_param_index(vr: u32) -> Option<usize> {
+    REAL_PARAMETERS.iter().position(|&p| p == vr)
+}
+
+fn scene_real(scene: &YarnScene, vr: u32) -> f64 {
+    let m = &scene.material;
+    match vr {
+        VR_K => m.k,
+        VR_GAMMA => m.gamma,
+        VR_YOUNGS_MODULUS => m.youngs_modulus,
+        VR_FRICTION => m.friction,
+        VR_BENDING => m.bending,
+        VR_DENSITY => m.density,
+        VR_DT => scene.time.dt,
+        _ => unreachable!("not a real parameter: {vr}"),
+    }
+}
+
+fn set_scene_real(scene: &mut YarnScene, vr: u32, v: f64) {
+    let m = &mut scene.material;
+    match vr {
+        VR_K => m.k = v,
+        VR_GAMMA => m.gamma = v,
+        VR_YOUNGS_MODULUS => m.youngs_modulus = v,
+        VR_FRICTION => m.friction = v,
+        VR_BENDING => m.bending = v,
+        VR_DENSITY => m.density = v,
+        VR_DT => scene.time.dt = v,
+        _ => unreachable!("not a real parameter: {vr}"),
+    }
+}
+
+/// The base scene with the parameter overrides applied.
+fn effective_scene(base: &YarnScene, config: &Config) -> YarnScene {
+    let mut s = base.clone();
+    for (k, &vr) in REAL_PARAMETERS.iter().enumerate() {
+        if let Some(v) = config.reals[k] {
+            set_scene_real(&mut s, vr, v);
+        }
+    }
+    if let Some(p) = config.plasticity {
+        s.material.plasticity = p;
+    }
+    s
+}
+
+fn read_scene(path: &Path) -> Result<YarnScene, String> {
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| format!("cannot read scene file {}: {e}", path.display()))?;
+    YarnScene::from_toml_str(&text).map_err(|e| format!("scene file {}: {e}", path.display()))
+}
+
+/// The yarn bundle of one FMU instance.
+#[derive(Clone, Debug)]
+pub struct YarnModel {
+    pub config: Config,
+    /// The scene file as loaded (before parameter overrides).
+    pub base: YarnScene,
+    pub sim: YarnSim,
+    pub inputs: Inputs,
+    /// Diagnostics of the current state, computed on first use.
+    pub diag: Option<Diagnostics>,
+}
+
+impl YarnModel {
+    pub fn new(base: YarnScene) -> Res<Self> {
+        let sim = YarnSim::new(&base).or_else(|e| error(format!("scene: {e}")))?;
+        Ok(YarnModel {
+            config: Config::default(),
+            inputs: Inputs::from_scene(&base),
+            base,
+            sim,
+            diag: None,
+        })
+    }
+
+    /// Rebuilds the simulation from the scene and the parameters.
+    pub fn rebuild(&mut self, yarns: usize) -> Res {
+        let scene = effective_scene(&self.base, &self.config);
+        let mut sim = YarnSim::new(&scene).or_else(|e| error(format!("parameters: {e}")))?;
+        if sim.num_yarns() != yarns {
+            return error(format!(
+                "scene {:?} creates {} yarns, but this FMU has outputs for {yarns}",
+                self.config.scene_path,
+                sim.num_yarns()
+            ));
+        }
+        self.inputs.apply(&mut sim)?;
+        self.sim = sim;
+        self.diag = None;
+        Ok(())
+    }
+
+    pub fn count(&self) -> usize {
+        self.sim.num_yarns()
+    }
+
+    pub fn dt(&self) -> f64 {
+        self.sim.dt()
+    }
+
+    pub fn substep(&mut self) -> Result<(), StepFailure> {
+        self.diag = None;
+        self.sim.step().map_err(|e| StepFailure {
+            terminal: matches!(e, SimError::NonFinite { .. }),
+            msg: e.to_string(),
+        })
+    }
+
+    /// Every output is finite (the library reports divergence itself; this
+    /// makes sure no step ends OK with a non-finite output).
+    pub fn outputs_finite(&self) -> bool {
+        (0..self.count()).all(|y| {
+            let (l, r) = self.sim.yarn_endpoints(y);
+            l.x.is_finite() && l.y.is_finite() && r.x.is_finite() && r.y.is_finite()
+        })
+    }
+
+    fn diagnostics(&mut self) -> Diagnostics {
+        *self.diag.get_or_insert_with(|| self.sim.diagnostics())
+    }
+
+    /// Whether the Real variable `vr` depends on the simulated state.
+    pub fn is_state_output(&self, vr: u32) -> bool {
+        matches!(vr, VR_KINETIC_ENERGY | VR_ELASTIC_ENERGY | VR_MAX_STRETCH)
+            || (vr >= VR_YARN_BASE && ((vr - VR_YARN_BASE) / 4) < self.count() as u32)
+    }
+
+    /// The value of the Real variable `vr`, `None` if there is none.
+    pub fn get_real(&mut self, vr: u32) -> Option<f64> {
+        Some(match vr {
+            VR_ATTRACTOR_X => self.inputs.attractor[0],
+            VR_ATTRACTOR_Y => self.inputs.attractor[1],
+            VR_ATTRACTOR_STRENGTH => self.inputs.strength,
+            VR_GRAVITY_X => self.inputs.gravity[0],
+            VR_GRAVITY_Y => self.inputs.gravity[1],
+            _ if real_param_index(vr).is_some() => {
+                let i = real_param_index(vr).unwrap();
+                self.config.reals[i].unwrap_or_else(|| scene_real(&self.base, vr))
+            }
+            VR_KINETIC_ENERGY => self.diagnostics().kinetic_energy,
+            VR_ELASTIC_ENERGY => self.diagnostics().elastic_energy,
+            VR_MAX_STRETCH => self.diagnostics().max_stretch,
+            _ if self.is_state_output(vr) => {
+                let i = (vr - VR_YARN_BASE) as usize;
+                let (l, r) = self.sim.yarn_endpoints(i / 4);
+                [l.x, l.y, r.x, r.y][i % 4]
+            }
+            _ => return None,
+        })
+    }
+
+    pub fn get_boolean(&self, vr: u32) -> Option<c_int> {
+        match vr {
+            VR_ATTRACTOR_ACTIVE => Some(self.inputs.active as c_int),
+            VR_PLASTICITY => Some(
+                self.config
+                    .plasticity
+                    .unwrap_or(self.base.material.plasticity) as c_int,
+            ),
+            _ => None,
+        }
+    }
+
+    pub fn get_string(&self, vr: u32) -> Option<&str> {
+        (vr == VR_SCENE).then_some(self.config.scene_path.as_str())
+    }
+
+    /// Sets Real inputs and parameters; true when a parameter changed (the
+    /// simulation must be rebuilt). A rejected call changes nothing.
+    pub fn set_real(&mut self, vrs: &[u32], vals: &[f64], param_ok: ParamCheck) -> Res<bool> {
+        let mut inputs = self.inputs;
+        let mut reals = self.config.reals;
+        for (&vr, &v) in vrs.iter().zip(vals) {
+            match vr {
+                VR_ATTRACTOR_X => inputs.attractor[0] = v,
+                VR_ATTRACTOR_Y => inputs.attractor[1] = v,
+                VR_ATTRACTOR_STRENGTH => inputs.strength = v,
+                VR_GRAVITY_X => inputs.gravity[0] = v,
+                VR_GRAVITY_Y => inputs.gravity[1] = v,
+                _ if real_param_index(vr).is_some() => {
+                    param_ok("fmi2SetReal", vr)?;
+                    let ok = match vr {
+                        VR_DENSITY | VR_DT => v > 0.0,
+                        _ => v >= 0.0,
+                    } && v <= 1e12;
+                    if !ok {
+                        return error(format!(
+                            "fmi2SetReal: parameter value reference {vr} = {v} is out of range"
+                        ));
+                    }
+                    reals[real_param_index(vr).unwrap()] = Some(v);
+                }
+                _ => {
+                    return error(format!(
+                        "fmi2SetReal: value reference {vr} is not a Real input or parameter"
+                    ))
+                }
+            }
+        }
+        inputs.check()?;
+        if inputs != self.inputs {
+            self.inputs = inputs;
+            inputs.apply(&mut self.sim)?;
+        }
+        let changed = reals != self.config.reals;
+        self.config.reals = reals;
+        Ok(changed)
+    }
+
+    /// Sets Boolean inputs and parameters; true when a parameter changed.
+    pub fn set_boolean(&mut self, vrs: &[u32], vals: &[c_int], param_ok: ParamCheck) -> Res<bool> {
+        let mut active = self.inputs.active;
+        let mut plasticity = self.config.plasticity;
+        for (&vr, &v) in vrs.iter().zip(vals) {
+            match vr {
+                VR_ATTRACTOR_ACTIVE => active = v != 0,
+                VR_PLASTICITY => {
+                    param_ok("fmi2SetBoolean", vr)?;
+                    plasticity = Some(v != 0);
+                }
+                _ => {
+                    return error(format!(
+                        "fmi2SetBoolean: value reference {vr} is not a Boolean input or parameter"
+                    ))
+                }
+            }
+        }
+        if active != self.inputs.active {
+            self.inputs.active = active;
+            let inputs = self.inputs;
+            inputs.apply(&mut self.sim)?;
+        }
+        let changed = plasticity != self.config.plasticity;
+        self.config.plasticity = plasticity;
+        Ok(changed)
+    }
+
+    /// Sets the `scene` parameter: a scene file in `resources` (or the
+    /// bundled one, `bundled`); true when it changed.
+    pub fn set_string(
+        &mut self,
+        vrs: &[u32],
+        vals: &[Option<String>],
+        param_ok: ParamCheck,
+        resources: &Path,
+        bundled: &YarnScene,
+    ) -> Res<bool> {
+        let mut changed = false;
+        for (&vr, v) in vrs.iter().zip(vals) {
+            if vr != VR_SCENE {
+                return error(format!(
+                    "fmi2SetString: value reference {vr} is not a String parameter"
+                ));
+            }
+            param_ok("fmi2SetString", vr)?;
+            let Some(v) = v else {
+                return error("fmi2SetString: the scene file name is a null pointer");
+            };
+            let base = if v == SCENE_FILE {
+                bundled.clone()
+            } else {
+                read_scene(&resources.join(v)).or_else(error)?
+            };
+            let yarns = num_yarns(&base);
+            if yarns != num_yarns(bundled) {
+                return error(format!(
+                    "fmi2SetString: scene {v:?} creates {yarns} yarns, but this FMU has outputs for {}",
+                    num_yarns(bundled)
+                ));
+            }
+            self.config.scene_path = v.clone();
+            self.base = base;
+            changed = true;
+        }
+        Ok(changed)
+    }
+
+    /// This model's part of a serialized FMU state: the inputs, the
+    /// parameters, the scene text and the library's own state bytes (which
+    /// carry their own header and checksum).
+    pub fn write(&self, w: &mut Writer) {
+        let i = &self.inputs;
+        w.f64(i.attractor[0]);
+        w.f64(i.attractor[1]);
+        w.f64(i.strength);
+        w.u8(i.active as u8);
+        w.f64(i.gravity[0]);
+        w.f64(i.gravity[1]);
+        w.bytes(self.config.scene_path.as_bytes());
+        for v in self.config.reals {
+            w.opt_f64(v);
+        }
+        w.u8(self.config.plasticity.is_some() as u8);
+        w.u8(self.config.plasticity.unwrap_or(false) as u8);
+        w.bytes(self.base.to_toml_string().as_bytes());
+        w.bytes(&self.sim.save_state());
+    }
+
+    /// Reads what [`Self::write`] wrote; `current` (with `current_built`: its
+    /// simulation matches its scene and parameters) is reused when the stored
+    /// scene and parameters match, else the simulation is rebuilt.
+    pub fn read(
+        r: &mut Reader,
+        current: &YarnModel,
+        current_built: bool,
+        yarns: usize,
+    ) -> Result<YarnModel, String> {
+        let inputs = Inputs {
+            attractor: [r.f64()?, r.f64()?],
+            strength: r.f64()?,
+            active: r.bool()?,
+            gravity: [r.f64()?, r.f64()?],
+        };
+        inputs.check().map_err(|f| f.msg)?;
+        let scene_path = r.string()?;
+        let mut reals = [None; 7];
+        for v in &mut reals {
+            *v = r.opt_f64()?;
+        }
+        let has_p = r.bool()?;
+        let p = r.bool()?;
+        let config = Config {
+            scene_path,
+            reals,
+            plasticity: has_p.then_some(p),
+        };
+        let scene_text = r.string()?;
+        let sim_bytes = r.bytes()?;
+        r.finish()?;
+        let base = if scene_text == current.base.to_toml_string() {
+            current.base.clone()
+        } else {
+            YarnScene::from_toml_str(&scene_text).map_err(|e| format!("stored scene: {e}"))?
+        };
+        let mut sim = if current_built && base == current.base && config == current.config {
+            current.sim.clone()
+        } else {
+            YarnSim::new(&effective_scene(&base, &config))
+                .map_err(|e| format!("stored scene: {e}"))?
+        };
+        if sim.num_yarns() != yarns {
+            return Err(format!(
+                "state has {} yarns, this FMU {yarns}",
+                sim.num_yarns()
+            ));
+        }
+        sim.load_state(sim_bytes).map_err(|e| e.to_string())?;
+        Ok(YarnModel {
+            config,
+            base,
+            sim,
+            inputs,
+            diag: None,
+        })
+    }
+}
