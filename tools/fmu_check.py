@@ -1,6 +1,6 @@
-"""fmpy checks of the YarnBundle FMU (run by tools/fmu_check.sh).
+"""fmpy checks of the YarnBundle and MassSpring FMUs (run by tools/fmu_check.sh).
 
-usage: fmu_check.py SMALL.fmu REFERENCE_SCENE.fmu WORKDIR REPLAY_EXE SMALL_SCENE
+usage: fmu_check.py SMALL.fmu REFERENCE_SCENE.fmu WORKDIR REPLAY_EXE SMALL_SCENE WIRE.fmu
 
 1. fmpy's validation of both FMUs (schema, structure, start values, units).
 2. fmpy.simulate_fmu of SMALL.fmu with an input signal (attractor on a
@@ -9,6 +9,9 @@ usage: fmu_check.py SMALL.fmu REFERENCE_SCENE.fmu WORKDIR REPLAY_EXE SMALL_SCENE
 3. FMU state through fmpy: get + serialize at t1, run on, deserialize +
    set, run on again: identical outputs.
 4. A short simulate_fmu of the default (reference) scene FMU.
+5. The MassSpring FMU of the wire scene: fmpy validation; simulate_fmu
+   with a gravity signal under two integrators (the `integrator` string
+   parameter), compared bit for bit with fmu-replay; an FMU state round trip.
 Exits non-zero on any problem.
 """
 import csv
@@ -21,11 +24,80 @@ from fmpy import read_model_description, simulate_fmu, extract
 from fmpy.fmi2 import FMU2Slave
 from fmpy.validation import validate_fmu
 
-small_fmu, ref_fmu, work, replay, small_scene = sys.argv[1:6]
+small_fmu, ref_fmu, work, replay, small_scene, wire_fmu = sys.argv[1:7]
 failures = []
 
+
+def write_inputs(path, cols):
+    """The input table as fmu-replay reads it."""
+    with open(path, "w") as fh:
+        fh.write(",".join(name for name, _ in cols) + "\n")
+        for row in zip(*[c for _, c in cols]):
+            fh.write(",".join(repr(float(v)) for v in row) + "\n")
+
+
+def compare(label, result, rust_csv, outputs):
+    """Every output of the fmpy run against the Rust run, bit for bit."""
+    with open(rust_csv) as fh:
+        rust = list(csv.DictReader(fh))
+    if len(rust) != len(result):
+        failures.append(f"{label}: fmpy gave {len(result)} rows, the Rust run {len(rust)}")
+    max_diff, compared = 0.0, 0
+    for k, (row, ref) in enumerate(zip(result, rust)):
+        if not math.isclose(float(ref["time"]), row["time"]):
+            failures.append(f"{label} row {k}: time {row['time']} vs {ref['time']}")
+        for name in outputs:
+            a, b = float(row[name]), float(ref[name])
+            compared += 1
+            if not math.isfinite(a):
+                failures.append(f"{label} row {k}: {name} is {a}")
+            d = abs(a - b)
+            max_diff = max(max_diff, d)
+            if d != 0.0:
+                failures.append(f"{label} row {k} (t = {row['time']}): {name}: fmpy {a!r}, Rust {b!r}")
+    print(f"{label}: simulate_fmu vs Rust: {len(result)} rows x {len(outputs)} outputs, {compared} values, max |diff| = {max_diff}")
+
+
+def state_round_trip(label, path, h, vrs):
+    """get + serialize at t1, run on, deserialize + set, run on again."""
+    md = read_model_description(path)
+    unzip = extract(path)
+    fmu = FMU2Slave(guid=md.guid, unzipDirectory=unzip, modelIdentifier=md.coSimulation.modelIdentifier, instanceName="state")
+    fmu.instantiate()
+    fmu.setupExperiment(startTime=0.0)
+    fmu.enterInitializationMode()
+    fmu.exitInitializationMode()
+    tt = 0.0
+    for _ in range(5):
+        fmu.doStep(tt, h)
+        tt += h
+    state = fmu.getFMUstate()
+    blob = fmu.serializeFMUstate(state)
+    t1 = tt
+    first = []
+    for _ in range(5):
+        fmu.doStep(tt, h)
+        tt += h
+        first.append(fmu.getReal(vrs))
+    restored = fmu.deSerializeFMUstate(blob)
+    fmu.setFMUstate(restored)
+    tt = t1
+    second = []
+    for _ in range(5):
+        fmu.doStep(tt, h)
+        tt += h
+        second.append(fmu.getReal(vrs))
+    if first != second:
+        failures.append(f"{label}: FMU state round trip through fmpy: outputs differ")
+    print(f"{label}: state round trip through fmpy: {len(bytes(blob))} bytes, {'identical' if first == second else 'DIFFERENT'} outputs")
+    fmu.freeFMUstate(state)
+    fmu.freeFMUstate(restored)
+    fmu.terminate()
+    fmu.freeInstance()
+
+
 # 1. validation
-for f in (small_fmu, ref_fmu):
+for f in (small_fmu, ref_fmu, wire_fmu):
     problems = validate_fmu(f)
     if problems:
         failures.append(f"{f}: fmpy validation: {problems}")
@@ -48,10 +120,7 @@ cols = [
 dtype = [(name, np.bool_ if name == "attractor.active" else np.double) for name, _ in cols]
 signals = np.array(list(zip(*[c for _, c in cols])), dtype=dtype)
 in_csv = f"{work}/inputs.csv"
-with open(in_csv, "w") as fh:
-    fh.write(",".join(name for name, _ in cols) + "\n")
-    for row in signals:
-        fh.write(",".join(repr(float(v)) for v in row) + "\n")
+write_inputs(in_csv, cols)
 
 md = read_model_description(small_fmu)
 outputs = [v.name for v in md.modelVariables if v.causality == "output"]
@@ -69,64 +138,14 @@ subprocess.run(
     [replay, "--scene", small_scene, "--inputs", in_csv, "--step", repr(H), "--stop", repr(STOP), "-o", out_csv],
     check=True,
 )
-with open(out_csv) as fh:
-    rust = list(csv.DictReader(fh))
-if len(rust) != len(result):
-    failures.append(f"fmpy gave {len(result)} rows, the Rust run {len(rust)}")
-max_diff = 0.0
-compared = 0
-for k, (row, ref) in enumerate(zip(result, rust)):
-    if float(ref["time"]) != row["time"] and not math.isclose(float(ref["time"]), row["time"]):
-        failures.append(f"row {k}: time {row['time']} vs {ref['time']}")
-    for name in outputs:
-        a, b = float(row[name]), float(ref[name])
-        compared += 1
-        if not math.isfinite(a):
-            failures.append(f"row {k}: {name} is {a}")
-        d = abs(a - b)
-        max_diff = max(max_diff, d)
-        if d != 0.0:
-            failures.append(f"row {k} (t = {row['time']}): {name}: fmpy {a!r}, Rust {b!r}")
-print(f"simulate_fmu vs Rust: {len(result)} rows x {len(outputs)} outputs, {compared} values, max |diff| = {max_diff}")
+compare("YarnBundle (small)", result, out_csv, outputs)
 moved = max(abs(result[-1][n] - result[0][n]) for n in outputs if n.startswith("yarn"))
 if not moved > 0.05:
     failures.append(f"the yarn ends moved only {moved} m: the inputs had no effect")
 
 # 3. FMU state through fmpy's C calls
-unzip = extract(small_fmu)
-fmu = FMU2Slave(guid=md.guid, unzipDirectory=unzip, modelIdentifier=md.coSimulation.modelIdentifier, instanceName="state")
-fmu.instantiate()
-fmu.setupExperiment(startTime=0.0)
-fmu.enterInitializationMode()
-fmu.exitInitializationMode()
 vrs = [v.valueReference for v in md.modelVariables if v.causality == "output" and v.type == "Real"]
-tt = 0.0
-for _ in range(5):
-    fmu.doStep(tt, H)
-    tt += H
-state = fmu.getFMUstate()
-blob = fmu.serializeFMUstate(state)
-t1 = tt
-first = []
-for _ in range(5):
-    fmu.doStep(tt, H)
-    tt += H
-    first.append(fmu.getReal(vrs))
-restored = fmu.deSerializeFMUstate(blob)
-fmu.setFMUstate(restored)
-tt = t1
-second = []
-for _ in range(5):
-    fmu.doStep(tt, H)
-    tt += H
-    second.append(fmu.getReal(vrs))
-if first != second:
-    failures.append("FMU state round trip through fmpy: outputs differ")
-print(f"state round trip through fmpy: {len(bytes(blob))} bytes, {'identical' if first == second else 'DIFFERENT'} outputs")
-fmu.freeFMUstate(state)
-fmu.freeFMUstate(restored)
-fmu.terminate()
-fmu.freeInstance()
+state_round_trip("YarnBundle (small)", small_fmu, H, vrs)
 
 # 4. the default scene FMU runs in fmpy
 ref = simulate_fmu(ref_fmu, stop_time=2 / 60, output_interval=1 / 60, validate=True)
@@ -134,6 +153,41 @@ ok = all(math.isfinite(ref[-1][name]) for name in ref.dtype.names)
 print(f"default scene FMU: {len(ref)} rows, {len(ref.dtype.names) - 1} outputs, finite: {ok}")
 if not ok:
     failures.append("default scene FMU gave non-finite outputs")
+
+# 5. the MassSpring FMU of the wire
+HW, STOPW = 0.05, 1.0
+n = int(round(STOPW / HW)) + 1
+t = np.array([k * HW for k in range(n)])
+cols = [
+    ("time", t),
+    ("gravity.x", 3.0 * np.sin(4.0 * t)),
+    ("gravity.y", np.full(n, -9.81)),
+    ("gravity.z", 2.0 * np.cos(3.0 * t)),
+]
+signals = np.array(list(zip(*[c for _, c in cols])), dtype=[(name, np.double) for name, _ in cols])
+in_csv = f"{work}/wire_inputs.csv"
+write_inputs(in_csv, cols)
+md = read_model_description(wire_fmu)
+outputs = [v.name for v in md.modelVariables if v.causality == "output"]
+for integrator in ("backward-euler", "symplectic-euler"):
+    result = simulate_fmu(
+        wire_fmu,
+        start_time=0.0,
+        stop_time=STOPW,
+        output_interval=HW,
+        input=signals,
+        output=outputs,
+        start_values={"integrator": integrator},
+        validate=True,
+    )
+    out_csv = f"{work}/wire_{integrator}.csv"
+    subprocess.run(
+        [replay, "--scene", "wire", "--integrator", integrator, "--inputs", in_csv, "--step", repr(HW), "--stop", repr(STOPW), "-o", out_csv],
+        check=True,
+    )
+    compare(f"MassSpring (wire, {integrator})", result, out_csv, outputs)
+vrs = [v.valueReference for v in md.modelVariables if v.causality == "output" and v.type == "Real"]
+state_round_trip("MassSpring (wire)", wire_fmu, HW, vrs)
 
 if failures:
     print(f"FMU check FAILED ({len(failures)} problems):")

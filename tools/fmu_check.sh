@@ -1,10 +1,11 @@
 #!/usr/bin/env bash
 # The FMU checks through fmpy 0.3.32 (installed into tools/.venv):
-# builds the default FMU (target/fmu/YarnBundle.fmu) and the small test
-# scene's FMU, validates both with fmpy, simulates the small one with an
-# input signal and compares its outputs bit for bit with the Rust library
-# run of the same inputs (fmu-replay), round-trips an FMU state through
-# fmpy, and runs the default FMU for two frames. Exits non-zero on failure.
+# builds the default FMU (target/fmu/YarnBundle.fmu), the small test
+# scene's FMU and the wire's MassSpring FMU, validates them with fmpy,
+# simulates the small one and the wire (two integrators) with input signals
+# and compares their outputs bit for bit with the Rust library run of the
+# same inputs (fmu-replay), round-trips FMU states through fmpy, and runs
+# the default FMU for two frames. Exits non-zero on failure.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 venv=tools/.venv
@@ -16,7 +17,8 @@ cargo build --release -p yarnsim-fmu --bins --lib
 target=$(cargo metadata --format-version 1 --no-deps | "$venv/bin/python" -c 'import json,sys; print(json.load(sys.stdin)["target_directory"])')
 "$target/release/build-fmu" --no-build
 "$target/release/build-fmu" --no-build --scene fmu/scenes/small.toml -o "$target/fmu/YarnBundle-small.fmu"
+"$target/release/build-fmu" --no-build --scene wire
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 "$venv/bin/python" tools/fmu_check.py "$target/fmu/YarnBundle-small.fmu" "$target/fmu/YarnBundle.fmu" \
-    "$work" "$target/release/fmu-replay" fmu/scenes/small.toml
+    "$work" "$target/release/fmu-replay" fmu/scenes/small.toml "$target/fmu/MassSpring-wire.fmu"

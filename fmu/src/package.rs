@@ -5,9 +5,7 @@
 
 use std::fmt::Write as _;
 
-use yarnsim::scene::YarnScene;
-
-use crate::model::{self, variables, xml_escape, MODEL_IDENTIFIER, SCENE_FILE};
+use crate::model::{xml_escape, FmuScene, SCENE_FILE};
 
 /// CRC-32 (IEEE 802.3, reflected, as zip uses it).
 pub fn crc32(data: &[u8]) -> u32 {
@@ -141,28 +139,44 @@ pub fn zip_entries(zip: &[u8]) -> Result<Vec<(String, Vec<u8>)>, String> {
 }
 
 /// `documentation/index.html`: the variables of this FMU.
-pub fn documentation_html(scene: &YarnScene) -> String {
+pub fn documentation_html(scene: &FmuScene) -> Result<String, String> {
+    let d = scene.description()?;
+    let ident = d.identifier;
+    let (what, details) = match scene {
+        FmuScene::Yarn(s) => (
+            "an MPM yarn bundle",
+            format!(
+                "{}, substep {} s, grid {}<sup>2</sup>",
+                scene.summary(),
+                s.time.dt,
+                s.grid.resolution
+            ),
+        ),
+        FmuScene::MassSpring(l) => (
+            "a mass-spring system",
+            format!(
+                "{}, frame time {} s, default integrator {}",
+                scene.summary(),
+                l.time.frame_time,
+                crate::massspring::DEFAULT_INTEGRATOR
+            ),
+        ),
+    };
     let mut h = String::new();
     let _ = writeln!(
         h,
-        "<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>{MODEL_IDENTIFIER}</title></head><body>"
+        "<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>{ident}</title></head><body>"
     );
+    let _ = writeln!(h, "<h1>{ident}: FMI 2.0 Co-Simulation FMU of {what}</h1>");
     let _ = writeln!(
         h,
-        "<h1>{MODEL_IDENTIFIER}: FMI 2.0 Co-Simulation FMU of an MPM yarn bundle</h1>"
-    );
-    let _ = writeln!(
-        h,
-        "<p>Scene <code>{}</code> ({}), {} yarns, substep {} s, grid {}<sup>2</sup>. The scene is <code>resources/{SCENE_FILE}</code>; GUID <code>{}</code>. Each communication step runs an integer number of substeps: the substeps done by time t are round((t - startTime) / dt).</p>",
-        xml_escape(&scene.name),
-        xml_escape(&scene.description),
-        model::num_yarns(scene),
-        scene.time.dt,
-        scene.grid.resolution,
-        model::guid(scene)
+        "<p>{}. Scene <code>{}</code>: {details}. The scene is <code>resources/{SCENE_FILE}</code>; GUID <code>{}</code>. Each communication step runs an integer number of substeps: the substeps done by time t are round((t - startTime) / dt).</p>",
+        xml_escape(&d.description),
+        xml_escape(scene.name()),
+        d.guid
     );
     h.push_str("<table border=\"1\"><tr><th>name</th><th>value reference</th><th>causality</th><th>variability</th><th>unit</th><th>start</th><th>description</th></tr>\n");
-    for v in variables(scene) {
+    for v in &d.variables {
         let _ = writeln!(
             h,
             "<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>",
@@ -175,19 +189,24 @@ pub fn documentation_html(scene: &YarnScene) -> String {
             xml_escape(&v.description)
         );
     }
-    h.push_str("</table>\n<p>Built by yarnsim-fmu; see the section on the FMU in the README of the yarnsim repository.</p>\n</body></html>\n");
-    h
+    h.push_str("</table>\n<p>Built by yarnsim-fmu; see the section on the FMUs in the README of the yarnsim repository.</p>\n</body></html>\n");
+    Ok(h)
 }
 
-/// The complete `.fmu` archive for `scene` around the shared library `so`.
-pub fn build_fmu(scene: &YarnScene, so: &[u8]) -> Result<Vec<u8>, String> {
+/// The complete `.fmu` archive for `scene` around the shared library `so`
+/// (packed as `binaries/linux64/<modelIdentifier>.so`).
+pub fn build_fmu(scene: &FmuScene, so: &[u8]) -> Result<Vec<u8>, String> {
     let mut z = Zip::default();
     z.add(
         "modelDescription.xml",
-        model::model_description(scene).as_bytes(),
+        scene.model_description()?.as_bytes(),
         false,
     )?;
-    z.add(&format!("binaries/linux64/{MODEL_IDENTIFIER}.so"), so, true)?;
+    z.add(
+        &format!("binaries/linux64/{}.so", scene.identifier()),
+        so,
+        true,
+    )?;
     z.add(
         &format!("resources/{SCENE_FILE}"),
         scene.to_toml_string().as_bytes(),
@@ -195,7 +214,7 @@ pub fn build_fmu(scene: &YarnScene, so: &[u8]) -> Result<Vec<u8>, String> {
     )?;
     z.add(
         "documentation/index.html",
-        documentation_html(scene).as_bytes(),
+        documentation_html(scene)?.as_bytes(),
         false,
     )?;
     Ok(z.finish())

@@ -125,7 +125,7 @@ fn guid_follows_the_scene_and_survives_the_scene_file() {
 fn fmu_archive_layout_and_contents() {
     let scene = common::small_scene();
     let so = b"\x7fELF not really".to_vec();
-    let zip = build_fmu(&scene, &so).unwrap();
+    let zip = build_fmu(&scene.clone().into(), &so).unwrap();
     let entries = zip_entries(&zip).unwrap();
     let names: Vec<&str> = entries.iter().map(|(n, _)| n.as_str()).collect();
     assert_eq!(
@@ -142,7 +142,7 @@ fn fmu_archive_layout_and_contents() {
     let packed = YarnScene::from_toml_str(std::str::from_utf8(&entries[2].1).unwrap()).unwrap();
     assert_eq!(guid(&packed), guid(&scene));
     // Reproducible: the same inputs give the same bytes.
-    assert_eq!(build_fmu(&scene, &so).unwrap(), zip);
+    assert_eq!(build_fmu(&scene.clone().into(), &so).unwrap(), zip);
     // A corrupted archive is detected.
     let mut bad = zip.clone();
     let at = zip.windows(4).position(|w| w == b"kind").unwrap();

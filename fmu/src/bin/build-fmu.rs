@@ -1,4 +1,4 @@
-//! Packs the YarnBundle FMU.
+//! Packs the YarnBundle FMU, or a MassSpring FMU for a mass-spring scene.
 //!
 //! ```text
 //! cargo run --release -p yarnsim-fmu --bin build-fmu -- [--scene NAME_OR_FILE] [-o OUT.fmu]
@@ -7,7 +7,8 @@
 //!
 //! Without `--scene` it packs the default scene (`yarn-reference`) into
 //! `<target>/fmu/YarnBundle.fmu`; another scene goes to
-//! `<target>/fmu/YarnBundle-<scene name>.fmu` unless `-o` says otherwise.
+//! `<target>/fmu/<modelIdentifier>-<scene name>.fmu` unless `-o` says
+//! otherwise (`wire` gives `MassSpring-wire.fmu`).
 //! The packager first builds the cdylib (`cargo build -p yarnsim-fmu --lib`,
 //! same profile) unless `--lib` names one or `--no-build` is given.
 //! `--model-description FILE` only writes the generated modelDescription.xml
@@ -18,7 +19,7 @@ use std::process::ExitCode;
 
 use yarnsim::scene::{Scene, DEFAULT_SCENE};
 use YarnBundle::package::{build_fmu, check_library, zip_entries};
-use YarnBundle::{model_description, MODEL_IDENTIFIER};
+use YarnBundle::{FmuScene, MODEL_IDENTIFIER};
 
 const USAGE: &str = "usage: build-fmu [--scene NAME_OR_FILE] [-o OUT.fmu] [--lib libYarnBundle.so | --no-build] [--model-description FILE]";
 
@@ -45,18 +46,20 @@ fn run() -> Result<(), String> {
         }
     }
     let name = scene_arg.as_deref().unwrap_or(DEFAULT_SCENE);
-    let scene = match Scene::resolve(name).map_err(|e| e.to_string())? {
-        Scene::Yarn(s) => s,
-        Scene::MassSpring(_) => {
-            return Err(format!(
-                "{name}: a mass-spring scene; the YarnBundle FMU runs yarn scenes only"
-            ))
-        }
-    };
-    yarnsim::mpm::YarnSim::new(&scene).map_err(|e| format!("{name}: {e}"))?;
+    let scene = FmuScene::from(Scene::resolve(name).map_err(|e| e.to_string())?);
+    // The scene must run as the FMU will run it.
+    match &scene {
+        FmuScene::Yarn(s) => yarnsim::mpm::YarnSim::new(s)
+            .map(|_| ())
+            .map_err(|e| e.to_string()),
+        FmuScene::MassSpring(l) => YarnBundle::massspring::MsModel::new(l.clone())
+            .map(|_| ())
+            .map_err(|f| f.msg),
+    }
+    .map_err(|e| format!("{name}: {e}"))?;
+    let xml = scene.model_description()?;
     if let Some(path) = xml_only {
-        std::fs::write(&path, model_description(&scene))
-            .map_err(|e| format!("cannot write {}: {e}", path.display()))?;
+        std::fs::write(&path, xml).map_err(|e| format!("cannot write {}: {e}", path.display()))?;
         println!("wrote {}", path.display());
         return Ok(());
     }
@@ -85,7 +88,7 @@ fn run() -> Result<(), String> {
             dir.join(format!("{MODEL_IDENTIFIER}.fmu"))
         } else {
             let tag: String = scene
-                .name
+                .name()
                 .chars()
                 .map(|c| {
                     if c.is_ascii_alphanumeric() || c == '-' {
@@ -100,7 +103,7 @@ fn run() -> Result<(), String> {
             } else {
                 tag
             };
-            dir.join(format!("{MODEL_IDENTIFIER}-{tag}.fmu"))
+            dir.join(format!("{}-{tag}.fmu", scene.identifier()))
         }
     });
     let zip = build_fmu(&scene, &so)?;
@@ -111,12 +114,13 @@ fn run() -> Result<(), String> {
     }
     std::fs::write(&out, &zip).map_err(|e| format!("cannot write {}: {e}", out.display()))?;
     println!(
-        "wrote {} ({} bytes): scene {:?}, {} yarns, GUID {}, library needs {}",
+        "wrote {} ({} bytes): {} FMU, scene {:?}, {}, GUID {}, library needs {}",
         out.display(),
         zip.len(),
-        scene.name,
-        YarnBundle::model::num_yarns(&scene),
-        YarnBundle::guid(&scene),
+        scene.identifier(),
+        scene.name(),
+        scene.summary(),
+        scene.guid(),
         info.needed.join(" ")
     );
     Ok(())

@@ -3,26 +3,70 @@
 //! steps the FMU, and writes the outputs as CSV.
 //!
 //! ```text
-//! fmu-replay --scene FILE --inputs in.csv --step H --stop T -o out.csv
+//! fmu-replay --scene FILE --inputs in.csv --step H --stop T -o out.csv [--integrator NAME]
 //! ```
 //!
-//! `in.csv`: header `time,attractor.x,attractor.y,attractor.strength,
-//! attractor.active,gravity.x,gravity.y`, one row per communication point
-//! k h (k = 0, 1, ...); row k is applied before the step from k h.
-//! `out.csv`: `time`, the yarn ends `yarn[i].left.x` ... `yarn[i].right.y`,
-//! `kinetic_energy`, `elastic_energy`, `max_stretch`, `substeps`, one row at
-//! t = 0 and one after every step. Numbers are written so they read back to
-//! the same bits.
+//! Yarn scenes (the YarnBundle FMU): `in.csv` has the header
+//! `time,attractor.x,attractor.y,attractor.strength,attractor.active,
+//! gravity.x,gravity.y`; `out.csv` holds `time`, the yarn ends
+//! `yarn[i].left.x` ... `yarn[i].right.y`, `kinetic_energy`,
+//! `elastic_energy`, `max_stretch`, `substeps`.
+//!
+//! Mass-spring scenes (the MassSpring FMU, `--integrator` as its parameter,
+//! default backward-euler): `in.csv` has `time,gravity.x,gravity.y,gravity.z`;
+//! `out.csv` holds `time`, `kinetic_energy`, `elastic_energy`,
+//! `gravity_energy`, `total_energy`, `max_strain`, `substeps`,
+//! `particle[i].x` ... `particle[i].z`.
+//!
+//! One input row per communication point k h (k = 0, 1, ...); row k is
+//! applied before the step from k h. One output row at t = 0 and one after
+//! every step. Numbers are written so they read back to the same bits.
 
 use std::fmt::Write as _;
 use std::process::ExitCode;
 
+use yarnsim::massspring::{Integrator, IntegratorOptions, Layout, Simulation, V3};
 use yarnsim::math::Vec2;
 use yarnsim::mpm::{Attractor, YarnSim};
-use yarnsim::scene::Scene;
+use yarnsim::scene::{Scene, YarnScene};
+
+/// The master's communication points as fmpy computes them: k h up to `stop`.
+fn communication_points(h: f64, stop: f64) -> Vec<f64> {
+    let mut t = 0.0;
+    let mut k = 0usize;
+    let mut out = Vec::new();
+    while !(t > stop || (t - stop).abs() <= 1e-9 * stop.abs().max(1e-300)) {
+        k += 1;
+        t = k as f64 * h;
+        out.push(t);
+    }
+    out
+}
+
+/// The input rows (after the header), each with `cols` numbers.
+fn read_rows(path: &str, cols: usize) -> Result<Vec<Vec<f64>>, String> {
+    let text = std::fs::read_to_string(path).map_err(|e| format!("{path}: {e}"))?;
+    let mut rows = Vec::new();
+    for (i, line) in text.lines().enumerate().skip(1) {
+        let v: Vec<f64> = line
+            .split(',')
+            .map(|s| s.trim().parse::<f64>())
+            .collect::<Result<_, _>>()
+            .map_err(|e| format!("{path}:{}: {e}", i + 1))?;
+        if v.len() != cols {
+            return Err(format!("{path}:{}: {cols} columns expected", i + 1));
+        }
+        rows.push(v);
+    }
+    if rows.is_empty() {
+        return Err(format!("{path}: the input table is empty"));
+    }
+    Ok(rows)
+}
 
 fn run() -> Result<(), String> {
     let (mut scene, mut inputs, mut step, mut stop, mut out) = (None, None, None, None, None);
+    let mut integrator: Option<String> = None;
     let mut args = std::env::args().skip(1);
     while let Some(a) = args.next() {
         let v = args.next().ok_or(format!("{a} needs a value"))?;
@@ -32,32 +76,37 @@ fn run() -> Result<(), String> {
             "--step" => step = Some(v.parse::<f64>().map_err(|e| format!("--step: {e}"))?),
             "--stop" => stop = Some(v.parse::<f64>().map_err(|e| format!("--stop: {e}"))?),
             "-o" => out = Some(v),
+            "--integrator" => integrator = Some(v),
             _ => return Err(format!("unknown argument {a}")),
         }
     }
-    let usage = "usage: fmu-replay --scene FILE --inputs in.csv --step H --stop T -o out.csv";
+    let usage = "usage: fmu-replay --scene FILE --inputs in.csv --step H --stop T -o out.csv [--integrator NAME]";
     let (Some(scene), Some(inputs), Some(h), Some(stop), Some(out)) =
         (scene, inputs, step, stop, out)
     else {
         return Err(usage.into());
     };
-    let Scene::Yarn(scene) = Scene::resolve(&scene).map_err(|e| e.to_string())? else {
-        return Err("not a yarn scene".into());
-    };
-    let text = std::fs::read_to_string(&inputs).map_err(|e| format!("{inputs}: {e}"))?;
-    let mut rows = Vec::new();
-    for (i, line) in text.lines().enumerate().skip(1) {
-        let v: Vec<f64> = line
-            .split(',')
-            .map(|s| s.trim().parse::<f64>())
-            .collect::<Result<_, _>>()
-            .map_err(|e| format!("{inputs}:{}: {e}", i + 1))?;
-        if v.len() != 7 {
-            return Err(format!("{inputs}:{}: 7 columns expected", i + 1));
+    let csv = match Scene::resolve(&scene).map_err(|e| e.to_string())? {
+        Scene::Yarn(s) => {
+            if integrator.is_some() {
+                return Err("--integrator applies to mass-spring scenes only".into());
+            }
+            replay_yarn(&s, &read_rows(&inputs, 7)?, h, stop)?
         }
-        rows.push(v);
-    }
-    let mut sim = YarnSim::new(&scene).map_err(|e| e.to_string())?;
+        Scene::MassSpring(l) => {
+            let integrator = match integrator {
+                Some(name) => name.parse()?,
+                None => YarnBundle::massspring::DEFAULT_INTEGRATOR,
+            };
+            replay_mass_spring(&l, integrator, &read_rows(&inputs, 4)?, h, stop)?
+        }
+    };
+    std::fs::write(&out, csv).map_err(|e| format!("{out}: {e}"))?;
+    Ok(())
+}
+
+fn replay_yarn(scene: &YarnScene, rows: &[Vec<f64>], h: f64, stop: f64) -> Result<String, String> {
+    let mut sim = YarnSim::new(scene).map_err(|e| e.to_string())?;
     let yarns = sim.num_yarns();
     let mut csv = String::from("time");
     for i in 0..yarns {
@@ -83,15 +132,8 @@ fn run() -> Result<(), String> {
         );
     };
     record(&mut csv, 0.0, &sim);
-    let mut t = 0.0;
-    let mut k = 0usize;
-    while !(t > stop || (t - stop).abs() <= 1e-9 * stop.abs().max(1e-300)) {
-        // The master's communication points, as fmpy computes them.
-        let next = (k + 1) as f64 * h;
-        let row = rows
-            .get(k)
-            .or(rows.last())
-            .ok_or("the input table is empty")?;
+    for (k, &next) in communication_points(h, stop).iter().enumerate() {
+        let row = rows.get(k).unwrap_or(&rows[rows.len() - 1]);
         sim.set_gravity(Vec2::new(row[5], row[6]))
             .map_err(|e| e.to_string())?;
         sim.set_attractor(Attractor {
@@ -101,16 +143,70 @@ fn run() -> Result<(), String> {
         })
         .map_err(|e| e.to_string())?;
         // The FMU's rule: substeps done by time t are round((t - t0) / dt).
-        let end = t + (next - t);
-        let target = (end / sim.dt()).round() as u64;
+        let target = (next / sim.dt()).round() as u64;
         sim.steps_n(target - sim.steps())
             .map_err(|e| e.to_string())?;
-        t = next;
-        k += 1;
-        record(&mut csv, t, &sim);
+        record(&mut csv, next, &sim);
     }
-    std::fs::write(&out, csv).map_err(|e| format!("{out}: {e}"))?;
-    Ok(())
+    Ok(csv)
+}
+
+fn replay_mass_spring(
+    layout: &Layout,
+    integrator: Integrator,
+    rows: &[Vec<f64>],
+    h: f64,
+    stop: f64,
+) -> Result<String, String> {
+    let mut sim = Simulation::new(layout, integrator, IntegratorOptions::default())
+        .map_err(|e| e.to_string())?;
+    let n = sim.positions().len();
+    let mut csv = String::from(
+        "time,kinetic_energy,elastic_energy,gravity_energy,total_energy,max_strain,substeps",
+    );
+    for i in 0..n {
+        for c in ["x", "y", "z"] {
+            let _ = write!(csv, ",particle[{i}].{c}");
+        }
+    }
+    csv.push('\n');
+    let record = |csv: &mut String, t: f64, sim: &Simulation, steps: u64| {
+        let e = sim.energies();
+        let _ = write!(
+            csv,
+            "{t:?},{:?},{:?},{:?},{:?},{:?},{steps}",
+            e.kinetic,
+            e.elastic,
+            e.gravity,
+            e.total(),
+            sim.max_strain()
+        );
+        for p in sim.positions() {
+            let _ = write!(csv, ",{:?},{:?},{:?}", p.x, p.y, p.z);
+        }
+        csv.push('\n');
+    };
+    // fmpy sets the inputs of t = 0 in initialization mode, before it reads
+    // the first outputs (the gravitational energy depends on them).
+    sim.set_gravity(V3::new(rows[0][1], rows[0][2], rows[0][3]))
+        .map_err(|e| e.to_string())?;
+    record(&mut csv, 0.0, &sim, 0);
+    let dt = sim.dt();
+    let mut steps = 0u64;
+    for (k, &next) in communication_points(h, stop).iter().enumerate() {
+        let row = rows.get(k).unwrap_or(&rows[rows.len() - 1]);
+        sim.set_gravity(V3::new(row[1], row[2], row[3]))
+            .map_err(|e| e.to_string())?;
+        // The FMU's rule: substep k starts at k dt; round((t - t0) / dt) by t.
+        let target = (next / dt).round() as u64;
+        while steps < target {
+            sim.state_mut().t = steps as f64 * dt;
+            sim.step(dt).map_err(|e| e.to_string())?;
+            steps += 1;
+        }
+        record(&mut csv, next, &sim, steps);
+    }
+    Ok(csv)
 }
 
 fn main() -> ExitCode {

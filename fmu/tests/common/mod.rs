@@ -34,6 +34,11 @@ pub fn small_scene() -> YarnScene {
 /// A fresh resources folder holding `scene` as `scene.toml`, as the
 /// packager writes it.
 pub fn resources(scene: &YarnScene) -> PathBuf {
+    resources_with(&scene.to_toml_string())
+}
+
+/// A fresh resources folder holding `text` as `scene.toml`.
+pub fn resources_with(text: &str) -> PathBuf {
     static N: AtomicUsize = AtomicUsize::new(0);
     let dir = std::env::temp_dir().join(format!(
         "yarnbundle-test-{}-{}",
@@ -41,7 +46,7 @@ pub fn resources(scene: &YarnScene) -> PathBuf {
         N.fetch_add(1, Ordering::Relaxed)
     ));
     std::fs::create_dir_all(&dir).unwrap();
-    std::fs::write(dir.join(SCENE_FILE), scene.to_toml_string()).unwrap();
+    std::fs::write(dir.join(SCENE_FILE), text).unwrap();
     dir
 }
 
@@ -82,6 +87,7 @@ pub fn logger_fn() -> Logger {
 pub struct Fmu {
     pub c: fmi2Component,
     pub log: Box<Mutex<Vec<Line>>>,
+    /// Yarns (YarnBundle) or particles (MassSpring).
     pub yarns: usize,
     pub dir: PathBuf,
 }
@@ -96,7 +102,20 @@ impl Fmu {
     }
 
     pub fn try_new(scene: &YarnScene, guid: &str, name: &str) -> Result<Fmu, Vec<Line>> {
-        let dir = resources(scene);
+        Self::try_with(&scene.to_toml_string(), num_yarns(scene), guid, name)
+    }
+
+    /// Instantiates the mass-spring FMU for `layout`.
+    pub fn mass_spring(layout: &yarnsim::massspring::Layout) -> Fmu {
+        let n = YarnBundle::massspring::num_particles(layout).unwrap();
+        let guid = YarnBundle::massspring::guid(layout);
+        Self::try_with(&layout.to_toml_string(), n, &guid, "test").expect("fmi2Instantiate failed")
+    }
+
+    /// Instantiates the FMU for the scene file `text` with `count` yarns
+    /// or particles.
+    pub fn try_with(text: &str, count: usize, guid: &str, name: &str) -> Result<Fmu, Vec<Line>> {
+        let dir = resources_with(text);
         let log: Box<Mutex<Vec<Line>>> = Box::default();
         let cb = fmi2CallbackFunctions {
             logger: Some(logger_fn()),
@@ -126,7 +145,7 @@ impl Fmu {
         Ok(Fmu {
             c,
             log,
-            yarns: num_yarns(scene),
+            yarns: count,
             dir,
         })
     }
