@@ -8,20 +8,46 @@
 //! 1. `fmi2DoStep` with h = 1e-9 dt: the substep grid is not reached, so no
 //!    substep runs and the call is pure overhead (pointer and state checks,
 //!    catch_unwind, time and substep bookkeeping).
-//! 2. The fmpy-like cycle: `fmi2SetReal` of 4 inputs + that `fmi2DoStep` +
-//!    `fmi2GetReal` of 4 yarn-end outputs.
-//! 3. For scale: `fmi2DoStep` with h = dt (one substep) against
-//!    `YarnSim::step` called directly, interleaved, alternating which goes
+//! 2. The fmpy-like cycle: `fmi2SetReal` of the inputs + that `fmi2DoStep` +
+//!    `fmi2GetReal` of as many outputs (YarnBundle: attractor and gravity,
+//!    4 yarn-end coordinates; MassSpring: gravity x/y/z, the last particle).
+//! 3. For scale: `fmi2DoStep` with h = dt (one substep) against the
+//!    library's step called directly, interleaved, alternating which goes
 //!    first (each evicts the other's data from the caches).
+//!
+//! SCENE is a yarn scene (default `fmu/scenes/small.toml`) or a mass-spring
+//! one (`wire`, `cloth`, a file), which measures the MassSpring FMU.
 
 use std::ffi::CString;
 use std::hint::black_box;
 use std::time::Instant;
 
+use yarnsim::massspring::Simulation;
 use yarnsim::mpm::YarnSim;
 use yarnsim::scene::Scene;
 use YarnBundle::ffi::*;
+use YarnBundle::massspring::{self as ms, MsModel};
 use YarnBundle::model::*;
+
+/// The library's own stepper, for the comparison in part 3.
+enum Library {
+    Yarn(Box<YarnSim>),
+    MassSpring(Box<Simulation>),
+}
+
+impl Library {
+    /// Substep `k`, as the FMU runs it.
+    fn step(&mut self, k: u64) {
+        match self {
+            Library::Yarn(sim) => sim.step().unwrap(),
+            Library::MassSpring(sim) => {
+                let dt = sim.dt();
+                sim.state_mut().t = k as f64 * dt;
+                sim.step(dt).unwrap();
+            }
+        }
+    }
+}
 
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
@@ -30,14 +56,12 @@ fn main() {
         .cloned()
         .unwrap_or_else(|| concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/small.toml").to_string());
     let calls: usize = args.get(1).map(|s| s.parse().unwrap()).unwrap_or(2_000_000);
-    let Scene::Yarn(scene) = Scene::resolve(&scene_arg).unwrap() else {
-        panic!("not a yarn scene")
-    };
+    let scene = FmuScene::from(Scene::resolve(&scene_arg).unwrap());
     let dir = std::env::temp_dir().join(format!("yarnbundle-bench-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     std::fs::write(dir.join(SCENE_FILE), scene.to_toml_string()).unwrap();
     let uri = CString::new(format!("file://{}", dir.display())).unwrap();
-    let guid = CString::new(guid(&scene)).unwrap();
+    let guid = CString::new(scene.guid()).unwrap();
     let name = CString::new("bench").unwrap();
     let cb = fmi2CallbackFunctions {
         logger: None,
@@ -46,7 +70,39 @@ fn main() {
         stepFinished: None,
         componentEnvironment: std::ptr::null_mut(),
     };
-    let dt = scene.time.dt;
+    let new_library = || match &scene {
+        FmuScene::Yarn(s) => Library::Yarn(Box::new(YarnSim::new(s).unwrap())),
+        FmuScene::MassSpring(l) => {
+            Library::MassSpring(Box::new(MsModel::new(l.clone()).unwrap().sim))
+        }
+    };
+    let dt = match new_library() {
+        Library::Yarn(sim) => sim.dt(),
+        Library::MassSpring(sim) => sim.dt(),
+    };
+    // Inputs to set and outputs to get in part 2, and the input values.
+    let (in_vr, out_vr): (Vec<u32>, Vec<u32>) = match &scene {
+        FmuScene::Yarn(_) => (
+            vec![VR_ATTRACTOR_X, VR_ATTRACTOR_Y, VR_GRAVITY_X, VR_GRAVITY_Y],
+            (VR_YARN_BASE..VR_YARN_BASE + 4).collect(),
+        ),
+        FmuScene::MassSpring(l) => {
+            let last = ms::num_particles(l).unwrap() as u32 - 1;
+            let first = ms::VR_PARTICLE_BASE + 3 * last;
+            (
+                vec![ms::VR_GRAVITY_X, ms::VR_GRAVITY_Y, ms::VR_GRAVITY_Z],
+                (first..first + 3).collect(),
+            )
+        }
+    };
+    let inputs = |k: usize| -> Vec<f64> {
+        let wobble = 1e-3 * (k & 7) as f64;
+        match &scene {
+            FmuScene::Yarn(_) => vec![0.5, 0.5 + wobble, 0.0, -9.8],
+            FmuScene::MassSpring(_) => vec![0.0, -9.81 + wobble, 0.0],
+        }
+    };
+    let ports = in_vr.len();
     unsafe {
         let c = fmi2Instantiate(
             name.as_ptr(),
@@ -85,35 +141,31 @@ fn main() {
             best * 1e9
         );
 
-        // 2. set 4 inputs + DoStep + get 4 outputs.
-        let in_vr = [VR_ATTRACTOR_X, VR_ATTRACTOR_Y, VR_GRAVITY_X, VR_GRAVITY_Y];
-        let out_vr = [
-            VR_YARN_BASE,
-            VR_YARN_BASE + 1,
-            VR_YARN_BASE + 2,
-            VR_YARN_BASE + 3,
-        ];
-        let mut out = [0.0; 4];
+        // 2. set n inputs + DoStep + get n outputs.
+        let mut out = vec![0.0; ports];
         let mut best = f64::INFINITY;
         for _round in 0..5 {
             let t0 = Instant::now();
             for k in 0..calls {
-                let v = [0.5, 0.5 + 1e-3 * (k & 7) as f64, 0.0, -9.8];
-                assert_eq!(fmi2SetReal(c, in_vr.as_ptr(), 4, v.as_ptr()), fmi2OK);
+                let v = inputs(k);
+                assert_eq!(fmi2SetReal(c, in_vr.as_ptr(), ports, v.as_ptr()), fmi2OK);
                 assert_eq!(fmi2DoStep(c, t, h, 1), fmi2OK);
-                assert_eq!(fmi2GetReal(c, out_vr.as_ptr(), 4, out.as_mut_ptr()), fmi2OK);
+                assert_eq!(
+                    fmi2GetReal(c, out_vr.as_ptr(), ports, out.as_mut_ptr()),
+                    fmi2OK
+                );
                 black_box(&out);
                 t += h;
             }
             best = best.min(t0.elapsed().as_secs_f64() / calls as f64);
         }
         println!(
-            "SetReal(4) + DoStep + GetReal(4):       {:.1} ns per cycle",
+            "SetReal({ports}) + DoStep + GetReal({ports}):       {:.1} ns per cycle",
             best * 1e9
         );
         fmi2FreeInstance(c);
 
-        // 3. One substep per DoStep against YarnSim::step, interleaved.
+        // 3. One substep per DoStep against the library's step, interleaved.
         let c = fmi2Instantiate(
             name.as_ptr(),
             fmi2CoSimulation,
@@ -126,7 +178,7 @@ fn main() {
         assert_eq!(fmi2SetupExperiment(c, 0, 0.0, 0.0, 0, 0.0), fmi2OK);
         assert_eq!(fmi2EnterInitializationMode(c), fmi2OK);
         assert_eq!(fmi2ExitInitializationMode(c), fmi2OK);
-        let mut sim = YarnSim::new(&scene).unwrap();
+        let mut sim = new_library();
         let steps = 2000.min(calls);
         let (mut fmu_s, mut lib_s) = (0.0, 0.0);
         for k in 0..steps {
@@ -136,13 +188,13 @@ fn main() {
                     assert_eq!(fmi2DoStep(c, k as f64 * dt, dt, 1), fmi2OK);
                     fmu_s += t0.elapsed().as_secs_f64();
                 } else {
-                    sim.step().unwrap();
+                    sim.step(k as u64);
                     lib_s += t0.elapsed().as_secs_f64();
                 }
             }
         }
         println!(
-            "one substep: fmi2DoStep {:.2} us, YarnSim::step {:.2} us (mean of {steps})",
+            "one substep: fmi2DoStep {:.2} us, library step {:.2} us (mean of {steps})",
             fmu_s / steps as f64 * 1e6,
             lib_s / steps as f64 * 1e6
         );
