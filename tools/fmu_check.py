@@ -67,26 +67,23 @@ def state_round_trip(label, path, h, vrs):
     fmu.setupExperiment(startTime=0.0)
     fmu.enterInitializationMode()
     fmu.exitInitializationMode()
-    tt = 0.0
-    for _ in range(5):
-        fmu.doStep(tt, h)
-        tt += h
+
+    def run(t, steps):
+        """`steps` communication steps from t: the end time, the outputs after each."""
+        out = []
+        for _ in range(steps):
+            fmu.doStep(t, h)
+            t += h
+            out.append(fmu.getReal(vrs))
+        return t, out
+
+    t1, _ = run(0.0, 5)
     state = fmu.getFMUstate()
     blob = fmu.serializeFMUstate(state)
-    t1 = tt
-    first = []
-    for _ in range(5):
-        fmu.doStep(tt, h)
-        tt += h
-        first.append(fmu.getReal(vrs))
+    _, first = run(t1, 5)
     restored = fmu.deSerializeFMUstate(blob)
     fmu.setFMUstate(restored)
-    tt = t1
-    second = []
-    for _ in range(5):
-        fmu.doStep(tt, h)
-        tt += h
-        second.append(fmu.getReal(vrs))
+    _, second = run(t1, 5)
     if first != second:
         failures.append(f"{label}: FMU state round trip through fmpy: outputs differ")
     print(f"{label}: state round trip through fmpy: {len(bytes(blob))} bytes, {'identical' if first == second else 'DIFFERENT'} outputs")

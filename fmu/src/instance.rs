@@ -186,8 +186,8 @@ impl Physics {
     /// First bytes of a serialized FMU state of this model.
     fn state_magic(&self) -> &'static [u8; 8] {
         match self {
-            Physics::Yarn(_) => b"YBFMUST\0",
-            Physics::MassSpring(_) => b"MSFMUST\0",
+            Physics::Yarn(_) => YARN_STATE_MAGIC,
+            Physics::MassSpring(_) => MASS_SPRING_STATE_MAGIC,
         }
     }
 }
@@ -263,9 +263,12 @@ impl Drop for Snapshot {
     }
 }
 
-/// First bytes of a serialized FMU state: `YBFMUST\0` for a yarn bundle,
-/// `MSFMUST\0` for a mass-spring system.
-pub const STATE_MAGICS: [&[u8; 8]; 2] = [b"YBFMUST\0", b"MSFMUST\0"];
+/// First bytes of a serialized FMU state of a yarn bundle.
+pub const YARN_STATE_MAGIC: &[u8; 8] = b"YBFMUST\0";
+/// First bytes of a serialized FMU state of a mass-spring system.
+pub const MASS_SPRING_STATE_MAGIC: &[u8; 8] = b"MSFMUST\0";
+/// Every state magic this library writes.
+pub const STATE_MAGICS: [&[u8; 8]; 2] = [YARN_STATE_MAGIC, MASS_SPRING_STATE_MAGIC];
 /// Format version of the serialized FMU state.
 pub const STATE_VERSION: u32 = 1;
 const STATE_HEADER: usize = 8 + 4 + 8 + 8;
@@ -408,10 +411,10 @@ impl Instance {
             Status::Ok,
             LOG_EVENTS,
             &format!(
-                "instantiated {name:?} ({}): scene {:?}, {}, substep {} s",
+                "instantiated {name:?} ({}): scene {:?}, {count} {}, substep {} s",
                 inst.bundled.identifier(),
                 inst.bundled.name(),
-                inst.bundled.summary(),
+                inst.bundled.objects(),
                 inst.model.physics.dt()
             ),
         );
@@ -538,9 +541,10 @@ impl Instance {
             Status::Ok,
             LOG_EVENTS,
             &format!(
-                "initialized at t = {}: {}, substep {} s",
+                "initialized at t = {}: {} {}, substep {} s",
                 self.model.time,
-                self.bundled.summary(),
+                self.count,
+                self.bundled.objects(),
                 self.model.physics.dt()
             ),
         );
@@ -725,21 +729,36 @@ impl Instance {
         self.require(func, &[Instantiated, InitializationMode, StepComplete])
     }
 
-    pub fn set_real(&mut self, vrs: &[u32], vals: &[f64]) -> Res {
-        self.require_set_input("fmi2SetReal")?;
-        if let Some((vr, v)) = vrs.iter().zip(vals).find(|(_, v)| !v.is_finite()) {
-            return error(format!(
-                "fmi2SetReal: value {v} for value reference {vr} is not finite"
-            ));
-        }
+    /// Runs one of the model's setters where inputs may be set; it may set
+    /// parameters only while [`parameter_settable`], and a changed parameter
+    /// marks the simulation for rebuilding.
+    fn set_values(
+        &mut self,
+        func: &str,
+        set: impl FnOnce(&mut Physics, ParamCheck, &Path, &FmuScene) -> Res<bool>,
+    ) -> Res {
+        self.require_set_input(func)?;
         let phase = self.phase;
         let check = |func: &str, vr: u32| parameter_settable(phase, func, vr);
-        let changed = match &mut self.model.physics {
-            Physics::Yarn(m) => m.set_real(vrs, vals, &check)?,
-            Physics::MassSpring(m) => m.set_real(vrs, vals, &check)?,
-        };
+        let changed = set(
+            &mut self.model.physics,
+            &check,
+            &self.resources,
+            &self.bundled,
+        )?;
         self.model.dirty |= changed;
         Ok(())
+    }
+
+    pub fn set_real(&mut self, vrs: &[u32], vals: &[f64]) -> Res {
+        self.set_values("fmi2SetReal", |physics, check, _, _| {
+            if let Some((vr, v)) = vrs.iter().zip(vals).find(|(_, v)| !v.is_finite()) {
+                return error(format!(
+                    "fmi2SetReal: value {v} for value reference {vr} is not finite"
+                ));
+            }
+            each!(physics, m => m.set_real(vrs, vals, check))
+        })
     }
 
     pub fn set_integer(&mut self, vrs: &[u32], _vals: &[c_int]) -> Res {
@@ -753,32 +772,25 @@ impl Instance {
     }
 
     pub fn set_boolean(&mut self, vrs: &[u32], vals: &[c_int]) -> Res {
-        self.require_set_input("fmi2SetBoolean")?;
-        let phase = self.phase;
-        let check = |func: &str, vr: u32| parameter_settable(phase, func, vr);
-        let changed = match &mut self.model.physics {
-            Physics::Yarn(m) => m.set_boolean(vrs, vals, &check)?,
-            Physics::MassSpring(m) => m.set_boolean(vrs, vals, &check)?,
-        };
-        self.model.dirty |= changed;
-        Ok(())
+        self.set_values(
+            "fmi2SetBoolean",
+            |physics, check, _, _| each!(physics, m => m.set_boolean(vrs, vals, check)),
+        )
     }
 
     pub fn set_string(&mut self, vrs: &[u32], vals: &[Option<String>]) -> Res {
-        self.require_set_input("fmi2SetString")?;
-        let phase = self.phase;
-        let check = |func: &str, vr: u32| parameter_settable(phase, func, vr);
-        let changed = match (&mut self.model.physics, &self.bundled) {
-            (Physics::Yarn(m), FmuScene::Yarn(bundled)) => {
-                m.set_string(vrs, vals, &check, &self.resources, bundled)?
-            }
-            (Physics::MassSpring(m), _) => m.set_string(vrs, vals, &check)?,
-            (Physics::Yarn(_), FmuScene::MassSpring(_)) => {
-                unreachable!("a yarn model from a mass-spring scene")
-            }
-        };
-        self.model.dirty |= changed;
-        Ok(())
+        self.set_values(
+            "fmi2SetString",
+            |physics, check, resources, bundled| match (physics, bundled) {
+                (Physics::Yarn(m), FmuScene::Yarn(bundled)) => {
+                    m.set_string(vrs, vals, check, resources, bundled)
+                }
+                (Physics::MassSpring(m), _) => m.set_string(vrs, vals, check),
+                (Physics::Yarn(_), FmuScene::MassSpring(_)) => {
+                    unreachable!("a yarn model from a mass-spring scene")
+                }
+            },
+        )
     }
 
     pub fn get_fmu_state(&mut self, into: Option<&mut Snapshot>) -> Res<Option<Box<Snapshot>>> {

@@ -600,12 +600,21 @@ impl FmuScene {
         self.description().map(|d| write_model_description(&d))
     }
 
-    /// The outputs per object: `"12 yarns"`, `"441 particles"`.
+    /// What the outputs describe: `"yarns"` or `"particles"`.
+    pub fn objects(&self) -> &'static str {
+        match self {
+            FmuScene::Yarn(_) => "yarns",
+            FmuScene::MassSpring(_) => "particles",
+        }
+    }
+
+    /// How many of them: `"12 yarns"`, `"441 particles"` (a mass-spring
+    /// layout is expanded to count them).
     pub fn summary(&self) -> String {
         match self {
-            FmuScene::Yarn(s) => format!("{} yarns", num_yarns(s)),
+            FmuScene::Yarn(s) => format!("{} {}", num_yarns(s), self.objects()),
             FmuScene::MassSpring(l) => match crate::massspring::num_particles(l) {
-                Ok(n) => format!("{n} particles"),
+                Ok(n) => format!("{n} {}", self.objects()),
                 Err(e) => e,
             },
         }
