@@ -6,8 +6,7 @@ mod common;
 use common::{bare_scene, Rng};
 use yarnsim::math::{perp, Mat2, Vec2};
 use yarnsim::mpm::grid::{self, Grid};
-use yarnsim::mpm::particles::NONE;
-use yarnsim::mpm::passes;
+use yarnsim::mpm::{grid_to_particle, particle_to_grid, simd, vertex_forces};
 use yarnsim::scene::YarnScene;
 use yarnsim::YarnSim;
 
@@ -54,9 +53,9 @@ vertices = 40
     }
     let p = sim.particles_mut();
     p.quad.refresh_frames(); // d was set by hand
-    passes::quad_stress(&mut p.quad, &geom, &energy);
+    grid_to_particle::quad_stress(&mut p.quad, &geom, &energy);
     let mut grid = Grid::new(geom);
-    passes::scatter(p, &mut grid, 1.0, kb); // v = 0, C = 0: momentum = 1 * force
+    particle_to_grid::scatter(p, &mut grid, 1.0, kb, &[], false); // v = 0, C = 0: momentum = 1 * force
     let p = sim.particles();
 
     let total_energy = |node: (usize, usize), axis: usize, eps: f64| -> f64 {
@@ -78,13 +77,9 @@ vertices = 40
             let d = Mat2::from_columns(&[x[l + 1] - x[l], d2n]);
             e += p.quad.vol[q] * energy.psi(&(d / p.quad.l0[q]));
         }
-        for (i, &(j, rest)) in p.vert.bend_next.iter().enumerate() {
-            if j != NONE {
-                let len = (x[j as usize] - x[i]).norm();
-                e += 0.5 * kb / rest * (len - rest) * (len - rest);
-            }
-        }
-        e
+        let mut moved = p.vert.clone();
+        moved.x = x;
+        e + vertex_forces::bending_energy(&moved, kb)
     };
 
     let mut max_f: f64 = 0.0;
@@ -96,7 +91,7 @@ vertices = 40
             let f: Vec2 = grid
                 .buffers
                 .iter()
-                .map(|buf| Vec2::new(buf.node[idx][grid::X], buf.node[idx][grid::Y]))
+                .map(|buf| Vec2::new(buf.node[idx][grid::PX], buf.node[idx][grid::PY]))
                 .sum();
             let m: f64 = grid.buffers.iter().map(|buf| buf.node[idx][grid::M]).sum();
             if m > 0.0 {
@@ -174,16 +169,32 @@ vertices = 80
 "#,
     );
     let mut sim = YarnSim::new(&scene).unwrap();
-    // spin the bundle about its centre of mass, and add a drift
+    // spin the bundle rigidly about its centre of mass (velocity gradient
+    // C = omega [[0, -1], [1, 0]]), and add a drift
     let c = com(&sim);
     let omega = 4.0;
+    let spin = Mat2::new(0.0, -omega, omega, 0.0);
     {
         let p = sim.particles_mut();
-        for (x, v) in p.vert.x.iter().zip(p.vert.v.iter_mut()) {
+        for ((x, v), cm) in p
+            .vert
+            .x
+            .iter()
+            .zip(p.vert.v.iter_mut())
+            .zip(p.vert.c.iter_mut())
+        {
             *v = perp(x - c) * omega + Vec2::new(0.3, -0.2);
+            *cm = spin;
         }
-        for (x, v) in p.quad.x.iter().zip(p.quad.v.iter_mut()) {
+        for ((x, v), cm) in p
+            .quad
+            .x
+            .iter()
+            .zip(p.quad.v.iter_mut())
+            .zip(p.quad.c.iter_mut())
+        {
             *v = perp(x - c) * omega + Vec2::new(0.3, -0.2);
+            *cm = spin;
         }
     }
     let d0 = sim.diagnostics();
@@ -452,10 +463,10 @@ fn simd_and_portable_kernels_give_the_same_bits() {
     scene.yarns[0].count = 3;
     scene.attractor.active = true;
     let run = |portable: bool| {
-        passes::set_portable_kernels(portable);
+        simd::set_portable_kernels(portable);
         let mut sim = YarnSim::new(&scene).unwrap();
         sim.steps_n(300).unwrap();
-        passes::set_portable_kernels(false);
+        simd::set_portable_kernels(false);
         sim.save_state()
     };
     assert!(run(true) == run(false));

@@ -157,6 +157,8 @@ pub fn small_yarn_scene(yarns: u32, vertices: u32, resolution: u32) -> YarnScene
             radius: 0.1,
             friction: 0.3,
         }],
+        transfer: Default::default(),
+        pins: Vec::new(),
         yarns: vec![YarnSpec {
             start: Some([0.1, 0.75]),
             direction: Some([1.0, 0.0]),

@@ -13,16 +13,37 @@ const BLOCK_SHIFT: usize = 3;
 /// Number of scatter chunks (fixed for determinism).
 pub const CHUNKS: usize = 4;
 
-/// One grid node: `[px, py, m, 0]` in a scatter buffer (momentum, mass),
-/// `[vx, vy, m, 0]` on the summed grid. Four lanes so that a node is one
-/// SIMD register (or two) and the momentum pair is 16-byte aligned.
-pub type Node = [f64; 4];
-/// Lane of the x component (momentum or velocity).
-pub const X: usize = 0;
-/// Lane of the y component.
-pub const Y: usize = 1;
+/// One node of a scatter buffer: momentum including the impulse of the
+/// internal forces `[PX, PY]`, mass `M`, the mass of particles touching an
+/// obstacle `MC`, and the impulse alone `[FX, FY]` (filled only by the FLIP
+/// transfer, which needs the grid velocity before the forces).
+pub type P2gNode = [f64; 6];
+/// Lane of the x momentum in a [`P2gNode`].
+pub const PX: usize = 0;
+/// Lane of the y momentum.
+pub const PY: usize = 1;
 /// Lane of the mass.
 pub const M: usize = 2;
+/// Lane of the mass of particles in contact with an obstacle.
+pub const MC: usize = 3;
+/// Lane of the x impulse `dt f`.
+pub const FX: usize = 4;
+/// Lane of the y impulse.
+pub const FY: usize = 5;
+
+/// One node of the summed grid after the grid update: the new velocity
+/// `[VX, VY]` and its change over the substep `[DVX, DVY]` (forces, gravity,
+/// attractor, contact; read by the FLIP transfer). Four lanes, one SIMD
+/// register (or two).
+pub type Node = [f64; 4];
+/// Lane of the new x velocity in a [`Node`].
+pub const VX: usize = 0;
+/// Lane of the new y velocity.
+pub const VY: usize = 1;
+/// Lane of the x velocity change.
+pub const DVX: usize = 2;
+/// Lane of the y velocity change.
+pub const DVY: usize = 3;
 
 /// Grid geometry: `n x n` nodes at `(i dx, j dx)`, stored with row stride
 /// `stride` (`n` rounded up to whole blocks): node `(i, j)` is at `i * stride + j`.
@@ -88,10 +109,10 @@ impl GridGeom {
 }
 
 /// One chunk's scatter target: momentum and mass per node,
-/// plus the blocks it touched (see [`Node`]).
+/// plus the blocks it touched (see [`P2gNode`]).
 #[derive(Clone, Debug)]
 pub struct ScatterBuffer {
-    pub node: Vec<Node>,
+    pub node: Vec<P2gNode>,
     pub touched: Vec<bool>,
     pub touched_list: Vec<u32>,
 }
@@ -99,7 +120,7 @@ pub struct ScatterBuffer {
 impl ScatterBuffer {
     pub fn new(geom: &GridGeom) -> Self {
         ScatterBuffer {
-            node: vec![[0.0; 4]; geom.storage()],
+            node: vec![[0.0; 6]; geom.storage()],
             touched: vec![false; geom.blocks()],
             touched_list: Vec::new(),
         }
@@ -111,7 +132,7 @@ impl ScatterBuffer {
             let (bi, bj) = (b as usize / geom.nb, b as usize % geom.nb);
             for r in 0..BLOCK {
                 let start = ((bi << BLOCK_SHIFT) + r) * geom.stride + (bj << BLOCK_SHIFT);
-                self.node[start..start + BLOCK].fill([0.0; 4]);
+                self.node[start..start + BLOCK].fill([0.0; 6]);
             }
             self.touched[b as usize] = false;
         }
@@ -150,7 +171,7 @@ impl ScatterBuffer {
     }
 }
 
-/// The summed grid: `[vx, vy, m, 0]` per node on the active blocks.
+/// The summed grid: a [`Node`] per node on the active blocks.
 #[derive(Clone, Debug)]
 pub struct Grid {
     pub geom: GridGeom,

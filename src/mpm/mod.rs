@@ -1,18 +1,37 @@
 //! The Material Point Method solver for 2D yarn bundles (seed 000, after
-//! Jiang, Gast, Teran 2017).
+//! Jiang, Gast, Teran 2017), one file per stage of a substep:
 //!
 //! * [`constitutive`]: the anisotropic energy, its stress and the return mapping.
 //! * [`particles`]: type-2 vertices and type-3 quadrature particles.
+//! * [`vertex_forces`]: fiber and bending forces on the vertices (a plain
+//!   function of the positions, usable without the grid).
 //! * [`grid`]: the block-sparse background grid.
-//! * [`passes`]: the passes of one substep.
+//! * [`particle_to_grid`]: pass 1, P2G of mass, momentum and force impulses.
+//! * [`grid_update`]: pass 2, velocities, gravity, attractor, contact, walls.
+//! * [`contact`]: the obstacle (Coulomb), wall and grid-edge laws.
+//! * [`grid_to_particle`]: passes 3 and 4, G2P of vertices and quadrature particles.
+//! * [`transfer`]: the G2P velocity update (APIC or FLIP blend).
+//! * [`pins`]: pinned and driven vertices and their reaction forces.
+//! * [`spin`]: the per-yarn angular momentum balance of the FLIP transfer.
+//! * [`simd`]: AVX2 + FMA / portable kernel dispatch and the fixed chunking.
 //! * [`sim`]: [`YarnSim`], which runs the passes a scene needs.
 //! * [`state`]: byte serialization of the dynamic state.
 
 pub mod constitutive;
+pub mod contact;
 pub mod grid;
+pub mod grid_to_particle;
+pub mod grid_update;
+pub mod particle_to_grid;
 pub mod particles;
-pub mod passes;
+pub mod pins;
 pub mod sim;
+pub mod simd;
+pub mod spin;
 pub mod state;
+pub mod transfer;
+pub mod vertex_forces;
 
+pub use pins::{Pin, PinMotion};
 pub use sim::{Attractor, Diagnostics, PassTimes, Passes, SimError, YarnSim};
+pub use transfer::Transfer;

@@ -8,6 +8,7 @@
 //! (APIC), so linear momentum is conserved exactly; quadrature particle
 //! positions are re-interpolated from the vertices each step.
 
+use super::vertex_forces::{rest_of_curve, BendRest};
 use crate::math::bspline::Stencil;
 use crate::math::qr::{qr, Qr2};
 use crate::math::{perp, Mat2, Vec2};
@@ -21,19 +22,23 @@ pub const NONE: u32 = u32::MAX;
 pub struct Vertices {
     pub x: Vec<Vec2>,
     pub v: Vec<Vec2>,
-    /// APIC affine velocity matrix.
+    /// Affine velocity matrix (APIC `C`).
     pub c: Vec<Mat2>,
     pub m: Vec<f64>,
     /// Quadrature particle of the segment to the left (this vertex is its right end), or [`NONE`].
     pub q_left: Vec<u32>,
     /// Quadrature particle of the segment to the right, or [`NONE`].
     pub q_right: Vec<u32>,
-    /// Bending partner two vertices back, or [`NONE`], and its rest distance.
-    pub bend_prev: Vec<(u32, f64)>,
-    /// Bending partner two vertices ahead, or [`NONE`], and its rest distance.
-    pub bend_next: Vec<(u32, f64)>,
+    /// Rest curvature and Voronoi length of the bending energy (see
+    /// [`crate::mpm::vertex_forces`]); none at yarn ends.
+    pub bend: Vec<BendRest>,
     /// Stencils at the start-of-step positions (scratch).
     pub stencil: Vec<Stencil>,
+    /// Internal force of the current substep (scratch).
+    pub f: Vec<Vec2>,
+    /// `(x_new - x_old) x v_new` of the current substep without the mass
+    /// (scratch of the FLIP angular momentum balance, [`crate::mpm::spin`]).
+    pub spin: Vec<f64>,
 }
 
 /// Type-3 particles: one quadrature point per segment.
@@ -63,6 +68,8 @@ pub struct Quads {
     pub t1: Vec<Vec2>,
     /// `dE/dd2` (scratch).
     pub t2: Vec<Vec2>,
+    /// See [`Vertices::spin`] (scratch).
+    pub spin: Vec<f64>,
 }
 
 impl Quads {
@@ -102,26 +109,15 @@ impl Particles {
         for (curve, vel) in curves.iter().zip(vels) {
             let base = p.vert.x.len();
             let n = curve.len();
-            for (i, &x) in curve.iter().enumerate() {
+            for &x in curve.iter() {
                 p.vert.x.push(x);
                 p.vert.v.push(vel);
                 p.vert.c.push(Mat2::zeros());
                 p.vert.m.push(0.0);
                 p.vert.q_left.push(NONE);
                 p.vert.q_right.push(NONE);
-                let prev = if i >= 2 {
-                    ((base + i - 2) as u32, (x - curve[i - 2]).norm())
-                } else {
-                    (NONE, 0.0)
-                };
-                let next = if i + 2 < n {
-                    ((base + i + 2) as u32, (curve[i + 2] - x).norm())
-                } else {
-                    (NONE, 0.0)
-                };
-                p.vert.bend_prev.push(prev);
-                p.vert.bend_next.push(next);
             }
+            p.vert.bend.extend(rest_of_curve(curve));
             for i in 0..n - 1 {
                 let (l, r) = (base + i, base + i + 1);
                 let d1 = curve[i + 1] - curve[i];
@@ -150,6 +146,9 @@ impl Particles {
         }
         let (nv, nq) = (p.vert.x.len(), p.quad.x.len());
         p.vert.stencil = vec![Stencil::default(); nv];
+        p.vert.f = vec![Vec2::zeros(); nv];
+        p.vert.spin = vec![0.0; nv];
+        p.quad.spin = vec![0.0; nq];
         p.quad.stencil = vec![Stencil::default(); nq];
         p.quad.t1 = vec![Vec2::zeros(); nq];
         p.quad.t2 = vec![Vec2::zeros(); nq];

@@ -4,10 +4,16 @@ use std::time::Instant;
 
 use super::constitutive::YarnEnergy;
 use super::grid::{Grid, GridGeom};
+use super::grid_to_particle::{self, VertexGather};
+use super::grid_update::{self, GridForces};
+use super::particle_to_grid;
 use super::particles::Particles;
-use super::passes::{self, GridForces};
+use super::pins::{self, Pin};
+use super::spin;
+use super::transfer::Transfer;
+use super::vertex_forces;
 use crate::math::Vec2;
-use crate::scene::{Obstacle, SceneError, WallMode, YarnScene};
+use crate::scene::{Obstacle, SceneError, TransferScheme, TransferSpec, WallMode, YarnScene};
 
 /// Why a step failed.
 #[derive(Clone, Debug, PartialEq)]
@@ -136,6 +142,22 @@ pub struct YarnSim {
     /// `particles.quad.frame` must be recomputed from `d` before the next step.
     pub(crate) frames_stale: bool,
     timings: PassTimes,
+    transfer: Transfer,
+    pins: Vec<Pin>,
+    /// Force of each pin on the yarn over the last substep.
+    pin_reactions: Vec<Vec2>,
+    /// Whether each vertex is held by a pin.
+    pinned: Vec<bool>,
+}
+
+/// The transfer scheme a scene asks for.
+pub fn transfer_of(spec: &TransferSpec) -> Transfer {
+    match spec.scheme {
+        TransferScheme::Apic => Transfer::Apic,
+        TransferScheme::Flip => Transfer::Flip {
+            ratio: spec.flip_ratio,
+        },
+    }
 }
 
 impl YarnSim {
@@ -143,8 +165,21 @@ impl YarnSim {
     pub fn new(scene: &YarnScene) -> Result<Self, SceneError> {
         scene.validate()?;
         let geom = GridGeom::new(scene.grid.resolution as usize, scene.grid.size);
+        let mut particles = Particles::from_scene(scene);
+        let pins = pins::pins_of_scene(scene, &particles)?;
+        pins::place(&pins, &mut particles.vert, 0.0);
+        let mut pinned = vec![false; particles.vert.x.len()];
+        for pin in &pins {
+            for &i in &pin.vertices {
+                pinned[i] = true;
+            }
+        }
         Ok(YarnSim {
-            particles: Particles::from_scene(scene),
+            pinned,
+            transfer: transfer_of(&scene.transfer),
+            pin_reactions: vec![Vec2::zeros(); pins.len()],
+            pins,
+            particles,
             grid: Grid::new(geom),
             energy: YarnEnergy::from_material(&scene.material),
             dt: scene.time.dt,
@@ -207,6 +242,20 @@ impl YarnSim {
     }
     pub fn num_yarns(&self) -> usize {
         self.particles.num_yarns()
+    }
+    /// The transfer scheme.
+    pub fn transfer(&self) -> Transfer {
+        self.transfer
+    }
+    /// The pins of the scene, in `[[pins]]` order.
+    pub fn pins(&self) -> &[Pin] {
+        &self.pins
+    }
+    /// Force (N per m of depth) each pin exerted on its yarn over the last
+    /// substep, in `[[pins]]` order: the yarn pulls on the pin with the
+    /// opposite force. Zero before the first substep.
+    pub fn pin_reactions(&self) -> &[Vec2] {
+        &self.pin_reactions
     }
 
     /// Sets gravity; rejects non-finite or absurd values (|g| > 1e6 m/s^2).
@@ -301,14 +350,23 @@ impl YarnSim {
             &empty
         };
 
+        let transfer = self.transfer;
+        let flip = transfer.needs_delta();
         let t0 = Instant::now();
         if self.frames_stale {
             self.particles.quad.refresh_frames();
-            passes::quad_stress(&mut self.particles.quad, &self.grid.geom, &self.energy);
+            grid_to_particle::quad_stress(&mut self.particles.quad, &self.grid.geom, &self.energy);
             self.frames_stale = false;
         }
         let t1 = Instant::now();
-        passes::scatter(&mut self.particles, &mut self.grid, dt, bending);
+        particle_to_grid::scatter(
+            &mut self.particles,
+            &mut self.grid,
+            dt,
+            bending,
+            obstacles,
+            flip,
+        );
         let t2 = Instant::now();
         let ext = GridForces {
             gravity: self.gravity,
@@ -319,18 +377,37 @@ impl YarnSim {
             walls: self.scene.walls.mode,
             wall_cells: self.scene.walls.cells as usize,
         };
-        passes::grid_update(&mut self.grid, dt, &ext);
+        grid_update::grid_update(&mut self.grid, dt, &ext, flip);
         let t3 = Instant::now();
-        let bad_v = passes::gather_vertices(&mut self.particles.vert, &self.grid, dt, obstacles);
+        let gather = VertexGather {
+            grid: &self.grid,
+            dt,
+            obstacles,
+            transfer,
+        };
+        let bad_v = grid_to_particle::gather_vertices(&mut self.particles.vert, &gather);
+        if !self.pins.is_empty() {
+            pins::apply(
+                &self.pins,
+                &mut self.particles.vert,
+                self.time + dt,
+                dt,
+                &mut self.pin_reactions,
+            );
+        }
         let t4 = Instant::now();
-        let bad_q = passes::gather_quads(
+        let bad_q = grid_to_particle::gather_quads(
             &mut self.particles.quad,
             &self.particles.vert.x,
             &self.grid,
             dt,
             &self.energy,
             passes.plasticity,
+            transfer,
         );
+        if flip {
+            spin::balance(&mut self.particles, &self.pinned);
+        }
         let t5 = Instant::now();
 
         let tm = &mut self.timings;
@@ -344,17 +421,19 @@ impl YarnSim {
         self.steps += 1;
         self.time += dt;
         let what = match (bad_v, bad_q) {
-            (Some(i), _) => {
-                let v = self.particles.vert.v[i];
-                Some(if v.x.is_finite() && v.y.is_finite() {
-                    format!(
+            (Some(b), _) => {
+                let (i, v) = (b.index, b.grid_velocity);
+                Some(
+                    if v.x.is_finite() && v.y.is_finite() && v.norm() * dt > self.grid.geom.dx {
+                        format!(
                         "vertex {i} moves {:.3} m/s, more than one cell per substep (CFL limit {:.3} m/s)",
                         v.norm(),
                         self.grid.geom.dx / dt
                     )
-                } else {
-                    format!("the state of vertex {i} is not finite")
-                })
+                    } else {
+                        format!("the state of vertex {i} is not finite")
+                    },
+                )
             }
             (None, Some(q)) => Some(format!(
                 "the frame of quadrature particle {q} is not finite"
@@ -393,23 +472,15 @@ impl YarnSim {
             .collect()
     }
 
-    /// Total elastic energy (yarn energy of every quadrature particle plus bending springs).
+    /// Total elastic energy: the yarn energy of every quadrature particle
+    /// plus the bending energy.
     pub fn elastic_energy(&self) -> f64 {
         let p = &self.particles;
         let mut e = 0.0;
         for q in 0..p.quad.x.len() {
             e += p.quad.vol[q] * self.energy.psi(&(p.quad.d[q] / p.quad.l0[q]));
         }
-        let kb = self.scene.material.bending;
-        if kb > 0.0 {
-            for (i, &(j, rest)) in p.vert.bend_next.iter().enumerate() {
-                if j != super::particles::NONE {
-                    let len = (p.vert.x[j as usize] - p.vert.x[i]).norm();
-                    e += 0.5 * kb / rest * (len - rest) * (len - rest);
-                }
-            }
-        }
-        e
+        e + vertex_forces::bending_energy(&p.vert, self.scene.material.bending)
     }
 
     /// Energies, momenta, stretch and centre of mass.

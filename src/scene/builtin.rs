@@ -49,7 +49,7 @@ pub fn reference_material() -> Material {
         gamma: 500.0,
         youngs_modulus: 1000.0,
         friction: 0.05,
-        bending: 100.0,
+        bending: 1e-3,
         density: 1.0,
         plasticity: true,
     }
@@ -86,6 +86,8 @@ pub fn yarn_reference() -> YarnScene {
         attractor: AttractorSpec::default(),
         walls: Walls::default(),
         obstacles: reference_obstacles(),
+        transfer: Default::default(),
+        pins: Vec::new(),
         yarns: vec![YarnSpec {
             start: Some([0.1, 0.75]),
             direction: Some([1.0, 0.0]),

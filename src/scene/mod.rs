@@ -11,7 +11,8 @@ pub mod yarn;
 pub use builtin::{builtin, builtin_names, DEFAULT_SCENE};
 pub use error::SceneError;
 pub use yarn::{
-    AttractorSpec, GridSpec, Material, Obstacle, TimeSpec, WallMode, Walls, YarnScene, YarnSpec,
+    AttractorSpec, GridSpec, Material, Obstacle, PinMotionKind, PinSpec, TimeSpec, TransferScheme,
+    TransferSpec, WallMode, Walls, YarnEnd, YarnScene, YarnSpec,
 };
 
 /// Any scene this crate can simulate.

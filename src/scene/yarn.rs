@@ -33,7 +33,113 @@ pub struct YarnScene {
     pub walls: Walls,
     #[serde(default)]
     pub obstacles: Vec<Obstacle>,
+    /// How particles take their velocity back from the grid.
+    #[serde(default)]
+    pub transfer: TransferSpec,
     pub yarns: Vec<YarnSpec>,
+    /// Pinned or driven yarn vertices.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub pins: Vec<PinSpec>,
+}
+
+/// The grid-to-particle velocity update (`[transfer]`); see
+/// [`crate::mpm::transfer`].
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TransferSpec {
+    /// `"flip"` (default) or `"apic"`.
+    #[serde(default)]
+    pub scheme: TransferScheme,
+    /// FLIP ratio in `[0, 1]` for `"flip"` (default 1: pure FLIP, no
+    /// per-transfer dissipation); `r < 1` blends in APIC's damping.
+    #[serde(default = "one", deserialize_with = "unit_interval")]
+    pub flip_ratio: f64,
+}
+
+impl Default for TransferSpec {
+    fn default() -> Self {
+        TransferSpec {
+            scheme: TransferScheme::default(),
+            flip_ratio: 1.0,
+        }
+    }
+}
+
+/// Name of a transfer scheme.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "lowercase")]
+pub enum TransferScheme {
+    /// The particle keeps its velocity and adds the grid's change (blended
+    /// with APIC by `flip_ratio`).
+    #[default]
+    Flip,
+    /// APIC (the seed's): velocity and affine matrix replaced by the grid's.
+    Apic,
+}
+
+/// Which end of a yarn a pin starts from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum YarnEnd {
+    /// The first vertex (index 0).
+    Start,
+    /// The last vertex.
+    End,
+}
+
+/// How pinned vertices move.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "lowercase")]
+pub enum PinMotionKind {
+    /// Held at the start position.
+    #[default]
+    Fixed,
+    /// Moved at constant `velocity`.
+    Line,
+    /// Turned rigidly about `center` at `angular_velocity`.
+    Circle,
+}
+
+/// Pinned or driven vertices of one yarn (`[[pins]]`): `count` consecutive
+/// vertices from `end` inward, or from index `vertex` onward.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PinSpec {
+    /// Yarn index, counting every copy (`count`) of every `[[yarns]]` entry in order.
+    pub yarn: u32,
+    /// `"start"` or `"end"` of the yarn.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub end: Option<YarnEnd>,
+    /// First vertex index within the yarn (instead of `end`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub vertex: Option<u32>,
+    /// How many consecutive vertices (default 1).
+    #[serde(default = "one_u32", deserialize_with = "copy_count")]
+    pub count: u32,
+    /// `"fixed"` (default), `"line"` or `"circle"`.
+    #[serde(default)]
+    pub motion: PinMotionKind,
+    /// Velocity `[vx, vy]` in m/s of a `"line"` motion.
+    #[serde(
+        default,
+        skip_serializing_if = "Option::is_none",
+        deserialize_with = "opt_finite2"
+    )]
+    pub velocity: Option<[f64; 2]>,
+    /// Centre `[x, y]` in m of a `"circle"` motion.
+    #[serde(
+        default,
+        skip_serializing_if = "Option::is_none",
+        deserialize_with = "opt_finite2"
+    )]
+    pub center: Option<[f64; 2]>,
+    /// Angular velocity in rad/s of a `"circle"` motion (counter-clockwise positive).
+    #[serde(
+        default,
+        skip_serializing_if = "Option::is_none",
+        deserialize_with = "opt_finite"
+    )]
+    pub angular_velocity: Option<f64>,
 }
 
 /// The background grid: a square domain `[0, size]^2` of `resolution^2` cells.
@@ -76,8 +182,9 @@ pub struct Material {
     /// Mohr-Coulomb friction coefficient `c_f` (dimensionless).
     #[serde(deserialize_with = "nonnegative")]
     pub friction: f64,
-    /// Bending modulus of the springs between every second vertex (Pa); a
-    /// spring of rest length `L` gets stiffness `bending / L`. 0 disables bending.
+    /// Bending stiffness `B` of the rod in N m^2 per m of depth (N m): the
+    /// energy is `int B / 2 kappa^2 ds` (discrete elastic rods, see
+    /// [`crate::mpm::vertex_forces`]). 0 disables bending.
     #[serde(default, deserialize_with = "nonnegative")]
     pub bending: f64,
     /// Line density in kg/m (per unit depth).
@@ -318,6 +425,7 @@ impl YarnScene {
                 message: format!("{total} vertices in all is more than the 20 million supported"),
             });
         }
+        self.validate_pins(text)?;
         if self.time.frame_dt < self.time.dt {
             return Err(SceneError::Invalid {
                 field: "time.frame_dt".into(),
@@ -327,6 +435,90 @@ impl YarnScene {
                     self.time.frame_dt, self.time.dt
                 ),
             });
+        }
+        Ok(())
+    }
+
+    /// The vertex ranges (within its yarn) of every pin, checked: the yarn
+    /// exists, the range lies inside it, the motion has its fields, and no
+    /// vertex is pinned twice.
+    pub fn pin_ranges(&self) -> Result<Vec<(usize, std::ops::Range<usize>)>, SceneError> {
+        self.validate_pins(None)?;
+        Ok(self
+            .pins
+            .iter()
+            .map(|p| self.pin_range(p).expect("validated"))
+            .collect())
+    }
+
+    fn pin_range(&self, p: &PinSpec) -> Result<(usize, std::ops::Range<usize>), String> {
+        let counts: Vec<usize> = self
+            .yarns
+            .iter()
+            .flat_map(|y| std::iter::repeat_n(y.vertices as usize, y.count as usize))
+            .collect();
+        let y = p.yarn as usize;
+        let Some(&n) = counts.get(y) else {
+            return Err(format!(
+                "yarn {y} does not exist: the scene has {} yarns (0 to {})",
+                counts.len(),
+                counts.len().saturating_sub(1)
+            ));
+        };
+        let c = p.count as usize;
+        let start = match (p.end, p.vertex) {
+            (Some(YarnEnd::Start), None) => 0,
+            (Some(YarnEnd::End), None) => n.saturating_sub(c),
+            (None, Some(v)) => v as usize,
+            _ => {
+                return Err("give exactly one of `end` (\"start\" or \"end\") and `vertex`".into())
+            }
+        };
+        if c > n || start + c > n {
+            return Err(format!(
+                "vertices {start}..{} are outside yarn {y}, which has {n} vertices",
+                start + c
+            ));
+        }
+        match p.motion {
+            PinMotionKind::Fixed => {}
+            PinMotionKind::Line if p.velocity.is_none() => {
+                return Err("motion \"line\" needs `velocity`".into())
+            }
+            PinMotionKind::Circle if p.center.is_none() || p.angular_velocity.is_none() => {
+                return Err("motion \"circle\" needs `center` and `angular_velocity`".into())
+            }
+            _ => {}
+        }
+        Ok((y, start..start + c))
+    }
+
+    fn validate_pins(&self, text: Option<&str>) -> Result<(), SceneError> {
+        let pin_line = |i: usize| {
+            text.and_then(|t| {
+                t.match_indices("[[pins]]")
+                    .nth(i)
+                    .map(|(p, _)| line_of(t, p))
+            })
+        };
+        let mut seen: Vec<(usize, std::ops::Range<usize>)> = Vec::new();
+        for (i, p) in self.pins.iter().enumerate() {
+            let (y, r) = self.pin_range(p).map_err(|message| SceneError::Invalid {
+                field: format!("pins[{i}]"),
+                line: pin_line(i),
+                message,
+            })?;
+            if let Some(k) = seen
+                .iter()
+                .position(|(y2, r2)| *y2 == y && r.start < r2.end && r2.start < r.end)
+            {
+                return Err(SceneError::Invalid {
+                    field: format!("pins[{i}]"),
+                    line: pin_line(i),
+                    message: format!("its vertices overlap those of pins[{k}] on yarn {y}"),
+                });
+            }
+            seen.push((y, r));
         }
         Ok(())
     }
@@ -483,6 +675,21 @@ fn kind_is_yarn<'de, D: Deserializer<'de>>(d: D) -> Result<String, D::Error> {
 
 fn finite2<'de, D: Deserializer<'de>>(d: D) -> Result<[f64; 2], D::Error> {
     finite_array::<D, 2>(d)
+}
+
+fn opt_finite<'de, D: Deserializer<'de>>(d: D) -> Result<Option<f64>, D::Error> {
+    super::readers::finite(d).map(Some)
+}
+
+fn unit_interval<'de, D: Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
+    let v = super::readers::finite(d)?;
+    if (0.0..=1.0).contains(&v) {
+        Ok(v)
+    } else {
+        Err(D::Error::custom(format!(
+            "must be between 0 and 1, got {v}"
+        )))
+    }
 }
 
 fn opt_finite2<'de, D: Deserializer<'de>>(d: D) -> Result<Option<[f64; 2]>, D::Error> {

@@ -44,7 +44,7 @@ k = 1000.0
 gamma = 500.0
 youngs_modulus = 1000.0
 friction = 0.05
-bending = 100.0
+bending = 1e-4
 plasticity = false
 [walls]
 mode = "none"

@@ -1,0 +1,340 @@
+//! Passes 3 and 4 of a substep, grid-to-particle: the vertices take their
+//! velocity from the grid by the scene's [`Transfer`] scheme and move with
+//! the grid velocity; then the quadrature particles follow their vertices,
+//! update their cross-section direction with the grid's velocity gradient,
+//! return-map, and compute the stress for the next substep.
+//! [`quad_stress`] computes that stress when the state was set from outside.
+
+use rayon::prelude::*;
+
+use super::constitutive::{frame_gradient_qr, YarnEnergy};
+use super::contact::{clamp_to_grid, project_out};
+use super::grid::{Grid, DVX, DVY, VX, VY};
+use super::particles::Quads;
+use super::simd::{multiversion, PAR_MIN};
+use super::transfer::{blend, Transfer};
+use crate::math::bspline::Stencil;
+use crate::math::qr::{qr, Qr2};
+use crate::math::{cross, Mat2, Vec2};
+use crate::mpm::grid::GridGeom;
+use crate::scene::Obstacle;
+
+/// Stencils and fiber-frame stress of every quadrature particle from its
+/// cached frame. [`gather_quads`] does this for each particle as it updates
+/// it; this pass is needed only when the state was set from outside the
+/// stepper (a new simulation, a restored state, edited particles).
+pub fn quad_stress(q: &mut Quads, geom: &GridGeom, energy: &YarnEnergy) {
+    let inv_dx = geom.inv_dx;
+    (
+        &mut q.stencil,
+        &mut q.t1,
+        &mut q.t2,
+        &q.x,
+        &q.frame,
+        &q.l0,
+        &q.vol,
+    )
+        .into_par_iter()
+        .with_min_len(PAR_MIN)
+        .for_each(|(st, t1, t2, x, g, l0, vol)| {
+            *st = Stencil::new(*x, inv_dx);
+            (*t1, *t2) = frame_gradient_qr(energy, g, *l0, *vol);
+        });
+}
+
+/// Grid velocity and affine matrix at a stencil, `v = sum w v_i`,
+/// `C = 4 / dx sum w v_i (i - fx)^T`, and with `DELTA` the same of the
+/// grid's velocity change (zero otherwise).
+#[inline(always)]
+fn interpolate<const DELTA: bool>(grid: &Grid, st: &Stencil) -> (Vec2, Mat2, Vec2, Mat2) {
+    let geom = &grid.geom;
+    let (bi, bj) = (st.base[0] as usize, st.base[1] as usize);
+    let oy = [-st.fx[1], 1.0 - st.fx[1], 2.0 - st.fx[1]];
+    // lanes: v.x, v.y, dv.x, dv.y; sums of w and of w * offset
+    let lanes = if DELTA { 4 } else { 2 };
+    let mut s0 = [0.0; 4];
+    let mut sx = [0.0; 4];
+    let mut sy = [0.0; 4];
+    for i in 0..3 {
+        let start = geom.index(bi + i, bj);
+        let row = &grid.node[start..start + 3];
+        let mut r0 = [0.0; 4];
+        let mut ry = [0.0; 4];
+        for j in 0..3 {
+            let w = st.w[1][j];
+            for l in 0..lanes {
+                let wl = w * row[j][l];
+                r0[l] += wl;
+                ry[l] += wl * oy[j];
+            }
+        }
+        let wi = st.w[0][i];
+        let ox = i as f64 - st.fx[0];
+        for l in 0..lanes {
+            s0[l] += wi * r0[l];
+            sx[l] += wi * r0[l] * ox;
+            sy[l] += wi * ry[l];
+        }
+    }
+    let s = 4.0 * geom.inv_dx;
+    let v = Vec2::new(s0[VX], s0[VY]);
+    let c = Mat2::new(sx[VX] * s, sy[VX] * s, sx[VY] * s, sy[VY] * s);
+    if DELTA {
+        let dv = Vec2::new(s0[DVX], s0[DVY]);
+        let dc = Mat2::new(sx[DVX] * s, sy[DVX] * s, sx[DVY] * s, sy[DVY] * s);
+        (v, c, dv, dc)
+    } else {
+        (v, c, Vec2::zeros(), Mat2::zeros())
+    }
+}
+
+/// New `(v, C)` of a particle by the transfer scheme, and the grid velocity
+/// at it (which moves it).
+#[inline(always)]
+fn transfer<const FLIP: bool>(
+    grid: &Grid,
+    st: &Stencil,
+    ratio: f64,
+    v: &mut Vec2,
+    c: &mut Mat2,
+) -> (Vec2, Mat2) {
+    let (vn, cn, dv, dc) = interpolate::<FLIP>(grid, st);
+    if FLIP {
+        blend(ratio, v, c, vn, cn, dv, dc);
+    } else {
+        *v = vn;
+        *c = cn;
+    }
+    (vn, cn)
+}
+
+/// What the vertex gather reads.
+pub struct VertexGather<'a> {
+    pub grid: &'a Grid,
+    pub dt: f64,
+    pub obstacles: &'a [Obstacle],
+    pub transfer: Transfer,
+}
+
+/// A vertex that failed the gather's checks, with the velocity that failed them.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BadVertex {
+    pub index: usize,
+    /// Grid velocity at the vertex (what moved it).
+    pub grid_velocity: Vec2,
+}
+
+/// Pass 3: grid-to-particle for vertices and advection `x += dt v_grid`.
+/// Returns the first vertex whose state is non-finite or whose grid
+/// velocity exceeds one cell per substep (the CFL limit), if any.
+pub fn gather_vertices(
+    vert: &mut super::particles::Vertices,
+    g: &VertexGather,
+) -> Option<BadVertex> {
+    (
+        vert.x.par_chunks_mut(PAR_MIN),
+        vert.v.par_chunks_mut(PAR_MIN),
+        vert.c.par_chunks_mut(PAR_MIN),
+        vert.stencil.par_chunks(PAR_MIN),
+        vert.spin.par_chunks_mut(PAR_MIN),
+    )
+        .into_par_iter()
+        .enumerate()
+        .filter_map(|(k, (x, v, c, st, sp))| {
+            let bad = if g.transfer.needs_delta() {
+                gather_vertex_chunk::<true>(x, v, c, st, sp, g)
+            } else {
+                gather_vertex_chunk::<false>(x, v, c, st, sp, g)
+            };
+            bad.map(|b| BadVertex {
+                index: k * PAR_MIN + b.index,
+                ..b
+            })
+        })
+        .min_by_key(|b| b.index)
+}
+
+multiversion! {
+    /// [`gather_vertices`] on one chunk; returns the first bad vertex in it
+    /// (index within the chunk).
+    fn gather_vertex_chunk<const FLIP: bool>(
+        xs: &mut [Vec2],
+        vs: &mut [Vec2],
+        cs: &mut [Mat2],
+        sts: &[Stencil],
+        spins: &mut [f64],
+        g: &VertexGather,
+    ) -> Option<BadVertex> {
+        let geom = g.grid.geom;
+        let (dt, ratio) = (g.dt, g.transfer.flip_ratio());
+        let (lo, hi) = (geom.dx, (geom.n as f64 - 2.0) * geom.dx);
+        let mut bad = None;
+        let it = xs.iter_mut().zip(vs).zip(cs).zip(sts).zip(spins);
+        for (k, ((((x, v), c), st), spin)) in it.enumerate() {
+            let (nv, _) = transfer::<FLIP>(g.grid, st, ratio, v, c);
+            *x += nv * dt;
+            if FLIP {
+                // the moment this move gives the particle's momentum (zero
+                // for APIC, which moves with its own velocity)
+                *spin = dt * cross(nv, *v);
+            }
+            for o in g.obstacles {
+                project_out(o, x, v);
+            }
+            clamp_to_grid(x, v, lo, hi);
+            // Finite, and no faster than one cell per substep (CFL): beyond
+            // that the transfer is meaningless and the run is diverging.
+            let ok = x.x.is_finite()
+                && x.y.is_finite()
+                && v.x.is_finite()
+                && v.y.is_finite()
+                && c.iter().all(|e| e.is_finite())
+                && nv.norm_squared() * (dt * dt) <= geom.dx * geom.dx;
+            if !ok && bad.is_none() {
+                bad = Some(BadVertex {
+                    index: k,
+                    grid_velocity: nv,
+                });
+            }
+        }
+        bad
+    }
+}
+
+/// Pass 4: grid-to-particle for quadrature particles: velocity and `C` by
+/// the transfer scheme, position and `d1` from the (already moved)
+/// vertices, `d2 += dt grad(v_grid) d2` and the return mapping (when
+/// `plastic`); then, for the next step, the particle's stencil and its
+/// stress from the new frame. Returns the first quadrature particle with a
+/// non-finite frame or velocity, if any.
+pub fn gather_quads(
+    quad: &mut Quads,
+    vx: &[Vec2],
+    grid: &Grid,
+    dt: f64,
+    energy: &YarnEnergy,
+    plastic: bool,
+    transfer: Transfer,
+) -> Option<usize> {
+    let rest = QuadRest {
+        left: &quad.left,
+        l0: &quad.l0,
+        vol: &quad.vol,
+        vx,
+        dt,
+        energy,
+        plastic,
+        ratio: transfer.flip_ratio(),
+    };
+    let flip = transfer.needs_delta();
+    (
+        quad.x.par_chunks_mut(PAR_MIN),
+        quad.v.par_chunks_mut(PAR_MIN),
+        quad.c.par_chunks_mut(PAR_MIN),
+        quad.d.par_chunks_mut(PAR_MIN),
+        quad.frame.par_chunks_mut(PAR_MIN),
+        quad.stencil.par_chunks_mut(PAR_MIN),
+        quad.t1.par_chunks_mut(PAR_MIN),
+        quad.t2.par_chunks_mut(PAR_MIN),
+        quad.spin.par_chunks_mut(PAR_MIN),
+    )
+        .into_par_iter()
+        .enumerate()
+        .filter_map(|(k, (x, v, c, d, frame, st, t1, t2, spin))| {
+            let chunk = QuadChunk {
+                x,
+                v,
+                c,
+                d,
+                frame,
+                stencil: st,
+                t1,
+                t2,
+                spin,
+            };
+            let bad = if flip {
+                gather_quad_chunk::<true>(k * PAR_MIN, chunk, grid, &rest)
+            } else {
+                gather_quad_chunk::<false>(k * PAR_MIN, chunk, grid, &rest)
+            };
+            bad.map(|i| k * PAR_MIN + i)
+        })
+        .min()
+}
+
+/// The per-particle arrays [`gather_quads`] writes, for one chunk.
+struct QuadChunk<'a> {
+    x: &'a mut [Vec2],
+    v: &'a mut [Vec2],
+    c: &'a mut [Mat2],
+    d: &'a mut [Mat2],
+    frame: &'a mut [Qr2],
+    stencil: &'a mut [Stencil],
+    t1: &'a mut [Vec2],
+    t2: &'a mut [Vec2],
+    spin: &'a mut [f64],
+}
+
+/// What [`gather_quads`] only reads (indexed by global particle index).
+struct QuadRest<'a> {
+    left: &'a [u32],
+    l0: &'a [f64],
+    vol: &'a [f64],
+    vx: &'a [Vec2],
+    dt: f64,
+    energy: &'a YarnEnergy,
+    plastic: bool,
+    ratio: f64,
+}
+
+multiversion! {
+    /// [`gather_quads`] on the chunk starting at particle `base`; returns the
+    /// first bad index in it.
+    fn gather_quad_chunk<const FLIP: bool>(
+        base: usize,
+        q: QuadChunk,
+        grid: &Grid,
+        rest: &QuadRest,
+    ) -> Option<usize> {
+        let (dt, energy) = (rest.dt, rest.energy);
+        let inv_dx = grid.geom.inv_dx;
+        let mut bad = None;
+        for k in 0..q.x.len() {
+            let g = base + k;
+            let l0 = rest.l0[g];
+            let (_, nc) = transfer::<FLIP>(grid, &q.stencil[k], rest.ratio, &mut q.v[k], &mut q.c[k]);
+            let left = rest.left[g] as usize;
+            let (xl, xr) = (rest.vx[left], rest.vx[left + 1]);
+            let x = (xl + xr) * 0.5;
+            if FLIP {
+                q.spin[k] = cross(x - q.x[k], q.v[k]);
+            }
+            q.x[k] = x;
+            let d1 = xr - xl;
+            let d2o = q.d[k].column(1).into_owned();
+            let mut d2 = d2o + nc * d2o * dt;
+            let inv_l0 = 1.0 / l0;
+            let mut r = qr(&(Mat2::from_columns(&[d1, d2]) * inv_l0));
+            if rest.plastic {
+                let (r12, r22) = energy.return_map(r.r12, r.r22);
+                if r12 != r.r12 || r22 != r.r22 {
+                    d2 = r.rotate(Vec2::new(r12, r22)) * l0;
+                    // refactor (rather than patch r12, r22) so that `frame` is
+                    // always bitwise qr(d / l0), as after a state restore
+                    r = qr(&(Mat2::from_columns(&[d1, d2]) * inv_l0));
+                }
+            }
+            let d = Mat2::from_columns(&[d1, d2]);
+            q.frame[k] = r;
+            q.d[k] = d;
+            q.stencil[k] = Stencil::new(x, inv_dx);
+            (q.t1[k], q.t2[k]) = frame_gradient_qr(energy, &r, l0, rest.vol[g]);
+            let v = q.v[k];
+            let ok = d.iter().all(|e| e.is_finite()) && v.x.is_finite() && v.y.is_finite();
+            if !ok && bad.is_none() {
+                bad = Some(k);
+            }
+        }
+        bad
+    }
+}

@@ -1,0 +1,140 @@
+//! Pass 2 of a substep, the grid update: sums the chunk buffers on the
+//! active blocks, turns momentum into velocity and applies gravity, the
+//! attractor, obstacle contact and walls ([`super::contact`]). Each node
+//! keeps its new velocity and, for the FLIP transfer, the change over the
+//! substep. Work is done per active block; obstacle and wall laws run only
+//! on blocks near one.
+
+use rayon::prelude::*;
+
+use super::contact::{obstacle_velocity, wall_velocity};
+use super::grid::{Grid, GridGeom, Node, ScatterBuffer, BLOCK, CHUNKS, FX, FY, M, MC, PX, PY};
+use super::simd::multiversion;
+use crate::math::Vec2;
+use crate::scene::{Obstacle, WallMode};
+
+/// The external-force and boundary settings of the grid update.
+#[derive(Clone, Debug)]
+pub struct GridForces<'a> {
+    pub gravity: Vec2,
+    /// `(position, strength)` when the attractor acts.
+    pub attractor: Option<(Vec2, f64)>,
+    pub obstacles: &'a [Obstacle],
+    pub walls: WallMode,
+    pub wall_cells: usize,
+}
+
+/// Pass 2 (see the module documentation). `flip`: also store each node's
+/// velocity change (the buffers then hold the impulse alone, see
+/// [`super::particle_to_grid::scatter`]).
+pub fn grid_update(grid: &mut Grid, dt: f64, ext: &GridForces, flip: bool) {
+    let geom = grid.geom;
+    let buffers = &grid.buffers;
+    let is_active = &grid.is_active;
+    grid.node
+        .par_chunks_mut(geom.stride * BLOCK)
+        .enumerate()
+        .for_each(|(bi, band)| {
+            if flip {
+                grid_band::<true>(bi, band, buffers, is_active, &geom, dt, ext)
+            } else {
+                grid_band::<false>(bi, band, buffers, is_active, &geom, dt, ext)
+            }
+        });
+}
+
+multiversion! {
+    /// [`grid_update`] on the active blocks of block row `bi`.
+    fn grid_band<const FLIP: bool>(
+        bi: usize,
+        band: &mut [Node],
+        buffers: &[ScatterBuffer],
+        is_active: &[bool],
+        geom: &GridGeom,
+        dt: f64,
+        ext: &GridForces,
+    ) {
+        let cells = ext.wall_cells;
+        let dx = geom.dx;
+        // contact reaches nodes up to the particles' stencil (1.5 cells) plus
+        // the contact margin outside an obstacle
+        let reach = 2.0 * dx;
+        for bj in 0..geom.nb {
+            let b = bi * geom.nb + bj;
+            if !is_active[b] {
+                continue;
+            }
+            let (i0, j0) = (bi * BLOCK, bj * BLOCK);
+            let mut srcs: [&ScatterBuffer; CHUNKS] = [&buffers[0]; CHUNKS];
+            let mut nsrc = 0;
+            for s in buffers.iter().filter(|s| s.touched[b]) {
+                srcs[nsrc] = s;
+                nsrc += 1;
+            }
+            let srcs = &srcs[..nsrc];
+            let lo = Vec2::new(i0 as f64, j0 as f64) * dx;
+            let hi = lo + Vec2::new((BLOCK - 1) as f64, (BLOCK - 1) as f64) * dx;
+            let near_obstacle = ext.obstacles.iter().any(|o| {
+                let c = Vec2::from(o.center);
+                let q = Vec2::new(c.x.clamp(lo.x, hi.x), c.y.clamp(lo.y, hi.y));
+                (q - c).norm() < o.radius + reach
+            });
+            let near_wall = ext.walls != WallMode::None
+                && (i0 < cells
+                    || j0 < cells
+                    || i0 + BLOCK + cells > geom.n
+                    || j0 + BLOCK + cells > geom.n);
+            for r in 0..BLOCK {
+                let i = i0 + r;
+                let row = r * geom.stride + j0;
+                let gidx = bi * BLOCK * geom.stride + row;
+                for c in 0..BLOCK {
+                    let j = j0 + c;
+                    let mut acc = [0.0; 6];
+                    for s in srcs {
+                        let n = &s.node[gidx + c];
+                        for l in 0..4 {
+                            acc[l] += n[l];
+                        }
+                        if FLIP {
+                            acc[FX] += n[FX];
+                            acc[FY] += n[FY];
+                        }
+                    }
+                    let out = &mut band[row + c];
+                    if acc[M] <= 0.0 {
+                        *out = [0.0; 4];
+                        continue;
+                    }
+                    let inv_m = 1.0 / acc[M];
+                    let mut v = Vec2::new(acc[PX] * inv_m, acc[PY] * inv_m) + ext.gravity * dt;
+                    if ext.attractor.is_some() || near_obstacle {
+                        let xi = Vec2::new(i as f64, j as f64) * dx;
+                        if let Some((pos, strength)) = ext.attractor {
+                            let d = pos - xi;
+                            v += d * (dt * strength / (d.norm() + 0.01));
+                        }
+                        if near_obstacle {
+                            let touching = acc[MC] * inv_m;
+                            for o in ext.obstacles {
+                                v = obstacle_velocity(o, xi, v, touching);
+                            }
+                        }
+                    }
+                    if near_wall {
+                        v = wall_velocity(ext.walls, cells, geom.n, i, j, v);
+                    }
+                    *out = if FLIP {
+                        let v_old = Vec2::new(
+                            (acc[PX] - acc[FX]) * inv_m,
+                            (acc[PY] - acc[FY]) * inv_m,
+                        );
+                        [v.x, v.y, v.x - v_old.x, v.y - v_old.y]
+                    } else {
+                        [v.x, v.y, 0.0, 0.0]
+                    };
+                }
+            }
+        }
+    }
+}

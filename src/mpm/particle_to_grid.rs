@@ -1,0 +1,201 @@
+//! Pass 1 of a substep, particle-to-grid: mass and momentum of every particle
+//! (APIC affine transfer with quadratic B-splines), with the internal forces
+//! added as `dt f` to the momentum: the vertex forces of
+//! [`super::vertex_forces`] at the vertices, and each quadrature particle's
+//! normal force through its affine term (MLS). For the FLIP transfer the
+//! impulse is also kept alone, so the grid knows its velocity before the
+//! forces; near obstacles, the mass of particles touching one is marked.
+
+use rayon::prelude::*;
+
+use super::grid::{Grid, GridGeom, ScatterBuffer, CHUNKS};
+use super::particles::{Particles, Quads, Vertices};
+use super::simd::{chunk_range, multiversion};
+use super::vertex_forces::vertex_forces;
+use crate::math::bspline::Stencil;
+use crate::math::{Mat2, Vec2};
+use crate::scene::Obstacle;
+
+/// A particle closer than this many cells to an obstacle's surface (or
+/// inside it) counts as touching it: its grid weight gets Coulomb friction.
+pub const CONTACT_CELLS: f64 = 0.5;
+
+/// What one particle adds to the grid: node `i` of the stencil gets mass
+/// `w_i m`, momentum `w_i (p0 + A (x_i - x_p) / dx)` and, for FLIP, the
+/// impulse `w_i (f0 + Af (x_i - x_p) / dx)` alone (`p0`, `A` include it).
+struct Splat {
+    m: f64,
+    /// Mass in contact with an obstacle (`m` or 0).
+    mc: f64,
+    p0: Vec2,
+    a: Mat2,
+    f0: Vec2,
+    af: Mat2,
+}
+
+#[inline(always)]
+fn splat<const FLIP: bool>(buf: &mut ScatterBuffer, geom: &GridGeom, st: &Stencil, s: &Splat) {
+    buf.touch_stencil(geom, st.base);
+    let (a, af) = (&s.a, &s.af);
+    let oy = [-st.fx[1], 1.0 - st.fx[1], 2.0 - st.fx[1]];
+    let ay = [a[(0, 1)] * oy[0], a[(0, 1)] * oy[1], a[(0, 1)] * oy[2]];
+    let by = [a[(1, 1)] * oy[0], a[(1, 1)] * oy[1], a[(1, 1)] * oy[2]];
+    let fay = [af[(0, 1)] * oy[0], af[(0, 1)] * oy[1], af[(0, 1)] * oy[2]];
+    let fby = [af[(1, 1)] * oy[0], af[(1, 1)] * oy[1], af[(1, 1)] * oy[2]];
+    let (bi, bj) = (st.base[0] as usize, st.base[1] as usize);
+    for i in 0..3 {
+        let ox = i as f64 - st.fx[0];
+        let rx = s.p0.x + a[(0, 0)] * ox;
+        let ry = s.p0.y + a[(1, 0)] * ox;
+        let (fx, fy) = if FLIP {
+            (s.f0.x + af[(0, 0)] * ox, s.f0.y + af[(1, 0)] * ox)
+        } else {
+            (0.0, 0.0)
+        };
+        let wi = st.w[0][i];
+        let start = geom.index(bi + i, bj);
+        let row = &mut buf.node[start..start + 3];
+        for j in 0..3 {
+            let w = wi * st.w[1][j];
+            let n = &mut row[j];
+            let add: [f64; 4] = [rx + ay[j], ry + by[j], s.m, s.mc];
+            for l in 0..4 {
+                n[l] += w * add[l];
+            }
+            if FLIP {
+                n[4] += w * (fx + fay[j]);
+                n[5] += w * (fy + fby[j]);
+            }
+        }
+    }
+}
+
+/// Mass of a particle at `x` that touches an obstacle (`m` or 0).
+#[inline(always)]
+fn contact_mass(obstacles: &[Obstacle], margin: f64, x: Vec2, m: f64) -> f64 {
+    for o in obstacles {
+        let r = o.radius + margin;
+        if (x - Vec2::from(o.center)).norm_squared() <= r * r {
+            return m;
+        }
+    }
+    0.0
+}
+
+/// What every scatter chunk reads.
+struct ScatterCtx<'a> {
+    vert: &'a Vertices,
+    quad: &'a Quads,
+    geom: GridGeom,
+    dt: f64,
+    bending: f64,
+    obstacles: &'a [Obstacle],
+}
+
+/// Splits `v` into the scatter's chunks of `n` items.
+fn split_chunks<T>(v: &mut [T], n: usize) -> Vec<&mut [T]> {
+    let mut out = Vec::with_capacity(CHUNKS);
+    let mut rest = v;
+    for k in 0..CHUNKS {
+        let (head, tail) = rest.split_at_mut(chunk_range(n, k).len());
+        out.push(head);
+        rest = tail;
+    }
+    out
+}
+
+/// Pass 1: particle-to-grid of mass, momentum and `dt` times the internal
+/// force. Vertex stencils and forces are computed here, chunk by chunk;
+/// quadrature stencils and stress come from the previous gather (or
+/// [`super::grid_to_particle::quad_stress`]). `flip` keeps the impulse
+/// alone too; `obstacles` are the ones whose contact mass is marked.
+pub fn scatter(
+    p: &mut Particles,
+    grid: &mut Grid,
+    dt: f64,
+    bending: f64,
+    obstacles: &[Obstacle],
+    flip: bool,
+) {
+    let geom = grid.geom;
+    let (nv, nq) = (p.vert.x.len(), p.quad.x.len());
+    // Each chunk writes the stencils and forces of its own vertex range
+    // (taken out of `p.vert` meanwhile, so the rest of it can be shared).
+    let mut vert_stencils = std::mem::take(&mut p.vert.stencil);
+    let mut vert_forces = std::mem::take(&mut p.vert.f);
+    let stencils = split_chunks(&mut vert_stencils, nv);
+    let forces = split_chunks(&mut vert_forces, nv);
+    let ctx = ScatterCtx {
+        vert: &p.vert,
+        quad: &p.quad,
+        geom,
+        dt,
+        bending,
+        obstacles,
+    };
+    grid.buffers
+        .par_iter_mut()
+        .zip(stencils)
+        .zip(forces)
+        .enumerate()
+        .for_each(|(k, ((buf, sts), fs))| {
+            let (vr, qr) = (chunk_range(nv, k), chunk_range(nq, k));
+            if flip {
+                scatter_chunk::<true>(buf, sts, fs, vr, qr, &ctx)
+            } else {
+                scatter_chunk::<false>(buf, sts, fs, vr, qr, &ctx)
+            }
+        });
+    p.vert.stencil = vert_stencils;
+    p.vert.f = vert_forces;
+    grid.collect_active();
+}
+
+multiversion! {
+    /// Scatters vertices `vr` (writing their stencils to `sts` and forces to
+    /// `fs`) and quadrature particles `qr` into one chunk's buffer.
+    fn scatter_chunk<const FLIP: bool>(
+        buf: &mut ScatterBuffer,
+        sts: &mut [Stencil],
+        fs: &mut [Vec2],
+        vr: std::ops::Range<usize>,
+        qr: std::ops::Range<usize>,
+        ctx: &ScatterCtx,
+    ) {
+        let (vert, quad, geom, dt) = (ctx.vert, ctx.quad, &ctx.geom, ctx.dt);
+        let dx = geom.dx;
+        let margin = super::particle_to_grid::CONTACT_CELLS * dx;
+        // the normal force per unit of (w_i (x_i - x_p) / dx . d2): -dt dE/dd2 4 / dx
+        let normal_scale = -dt * 4.0 * geom.inv_dx;
+        buf.clear(geom);
+        vertex_forces(vert, &quad.t1, ctx.bending, vr.clone(), fs);
+        for ((i, st), f) in vr.zip(sts.iter_mut()).zip(fs.iter()) {
+            *st = Stencil::new(vert.x[i], geom.inv_dx);
+            let m = vert.m[i];
+            let f0 = f * dt;
+            let s = Splat {
+                m,
+                mc: contact_mass(ctx.obstacles, margin, vert.x[i], m),
+                p0: vert.v[i] * m + f0,
+                a: vert.c[i] * (m * dx),
+                f0,
+                af: Mat2::zeros(),
+            };
+            splat::<FLIP>(buf, geom, st, &s);
+        }
+        for q in qr {
+            let m = quad.m[q];
+            let d2 = quad.d[q].column(1).into_owned();
+            let af = quad.t2[q] * normal_scale * d2.transpose();
+            let s = Splat {
+                m,
+                mc: contact_mass(ctx.obstacles, margin, quad.x[q], m),
+                p0: quad.v[q] * m,
+                a: quad.c[q] * (m * dx) + af,
+                f0: Vec2::zeros(),
+                af,
+            };
+            splat::<FLIP>(buf, geom, &quad.stencil[q], &s);
+        }
+    }
+}

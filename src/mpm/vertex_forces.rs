@@ -1,0 +1,285 @@
+//! The internal forces on the yarn vertices: the fiber (tangent) force of
+//! the two adjacent segments, from the quadrature particles' stress, and the
+//! discrete bending force of the turning angles.
+//!
+//! Bending follows discrete elastic rods (Bergou et al. 2008) in 2D: at each
+//! interior vertex `j` with edges `e1 = x_j - x_{j-1}`, `e2 = x_{j+1} - x_j`
+//! the curvature is `kappa_j = 2 tan(theta_j / 2) = 2 (e1 x e2) / (|e1| |e2| + e1 . e2)`
+//! (`theta_j` the turning angle) and the energy is
+//!
+//! ```text
+//! E = sum_j B / 2 (kappa_j - kappa0_j)^2 / l_j
+//! ```
+//!
+//! with `kappa0_j` the rest curvature and `l_j = (|E1| + |E2|) / 2` the rest
+//! Voronoi length: the discrete form of `int B / 2 kappa^2 ds`, so the same
+//! yarn bends alike at any number of vertices. `B` (`material.bending`) is
+//! the bending stiffness of the rod in N m^2 per m of depth (N m).
+//!
+//! [`vertex_forces`] is a plain function of the positions (and the quadrature
+//! stress), callable without a grid: the scatter calls it per chunk, and an
+//! implicit solver or a test can call it directly.
+
+use super::particles::{Vertices, NONE};
+use crate::math::{cross, perp, Vec2};
+
+/// Rest data of the bending energy at one vertex.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct BendRest {
+    /// Rest curvature `kappa0 = 2 tan(theta0 / 2)`.
+    pub kappa0: f64,
+    /// `1 / l` with `l` the rest Voronoi length; 0 at yarn ends (no bending).
+    pub inv_len: f64,
+}
+
+impl BendRest {
+    /// Rest data at a vertex between edges `e1` (incoming) and `e2` (outgoing).
+    pub fn new(e1: Vec2, e2: Vec2) -> Self {
+        BendRest {
+            kappa0: curvature(e1, e2),
+            inv_len: 2.0 / (e1.norm() + e2.norm()),
+        }
+    }
+}
+
+/// `2 tan(theta / 2)` of the turning angle from edge `e1` to edge `e2`.
+#[inline(always)]
+pub fn curvature(e1: Vec2, e2: Vec2) -> f64 {
+    let d = e1.norm() * e2.norm() + e1.dot(&e2);
+    if d > 0.0 {
+        2.0 * cross(e1, e2) / d
+    } else {
+        0.0
+    }
+}
+
+/// `(B (kappa - kappa0) / l) dkappa/de1` and `... dkappa/de2` at vertex `j`,
+/// zero where `j` is not an interior vertex (or out of range).
+#[inline(always)]
+fn bend_gradient(v: &Vertices, j: isize, b: f64) -> (Vec2, Vec2) {
+    if j < 0 || j as usize >= v.x.len() {
+        return (Vec2::zeros(), Vec2::zeros());
+    }
+    let j = j as usize;
+    let rest = v.bend[j];
+    if rest.inv_len == 0.0 {
+        return (Vec2::zeros(), Vec2::zeros());
+    }
+    let e1 = v.x[j] - v.x[j - 1];
+    let e2 = v.x[j + 1] - v.x[j];
+    let (n1, n2) = (e1.norm(), e2.norm());
+    let c = cross(e1, e2);
+    let d = n1 * n2 + e1.dot(&e2);
+    if !(d > 0.0 && n1 > 0.0 && n2 > 0.0) {
+        // a fully folded joint (theta = pi): no finite curvature gradient
+        return (Vec2::zeros(), Vec2::zeros());
+    }
+    let kappa = 2.0 * c / d;
+    let tau = b * (kappa - rest.kappa0) * rest.inv_len;
+    let s = 2.0 * tau / (d * d);
+    let g1 = (-perp(e2) * d - (e1 * (n2 / n1) + e2) * c) * s;
+    let g2 = (perp(e1) * d - (e2 * (n1 / n2) + e1) * c) * s;
+    (g1, g2)
+}
+
+/// Internal force on every vertex of `range`, written to `out` (same length):
+/// fiber forces from the quadrature particles' `t1 = dE/dd1` plus, when
+/// `bending > 0`, the bending force `-dE/dx`.
+pub fn vertex_forces(
+    v: &Vertices,
+    t1: &[Vec2],
+    bending: f64,
+    range: std::ops::Range<usize>,
+    out: &mut [Vec2],
+) {
+    debug_assert_eq!(range.len(), out.len());
+    // E depends on d1 = x_right - x_left: the left end gets +dE/dd1, the right end -dE/dd1.
+    for (i, f) in range.clone().zip(out.iter_mut()) {
+        let mut force = Vec2::zeros();
+        let (ql, qr) = (v.q_left[i], v.q_right[i]);
+        if qr != NONE {
+            force += t1[qr as usize];
+        }
+        if ql != NONE {
+            force -= t1[ql as usize];
+        }
+        *f = force;
+    }
+    if bending > 0.0 {
+        // a rolling window over the gradients at i - 1, i, i + 1: one
+        // curvature evaluation per vertex
+        let start = range.start as isize;
+        let mut prev = bend_gradient(v, start - 1, bending);
+        let mut cur = bend_gradient(v, start, bending);
+        for (k, f) in out.iter_mut().enumerate() {
+            let i = start + k as isize;
+            let next = bend_gradient(v, i + 1, bending);
+            // dkappa_{i-1}/dx_i = de2 of i-1; dkappa_i/dx_i = de1 - de2; dkappa_{i+1}/dx_i = -de1
+            *f -= prev.1 + cur.0 - cur.1 - next.0;
+            prev = cur;
+            cur = next;
+        }
+    }
+}
+
+/// Total bending energy `sum_j B / 2 (kappa_j - kappa0_j)^2 / l_j`.
+pub fn bending_energy(v: &Vertices, bending: f64) -> f64 {
+    if bending <= 0.0 {
+        return 0.0;
+    }
+    let mut e = 0.0;
+    for j in 0..v.x.len() {
+        let rest = v.bend[j];
+        if rest.inv_len == 0.0 {
+            continue;
+        }
+        let kappa = curvature(v.x[j] - v.x[j - 1], v.x[j + 1] - v.x[j]);
+        let dk = kappa - rest.kappa0;
+        e += 0.5 * bending * dk * dk * rest.inv_len;
+    }
+    e
+}
+
+/// Rest bending data of a yarn's vertices `curve`: interior vertices get
+/// their rest curvature and Voronoi length, the two ends none.
+pub fn rest_of_curve(curve: &[Vec2]) -> Vec<BendRest> {
+    let n = curve.len();
+    (0..n)
+        .map(|i| {
+            if i == 0 || i + 1 == n {
+                BendRest::default()
+            } else {
+                BendRest::new(curve[i] - curve[i - 1], curve[i + 1] - curve[i])
+            }
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mpm::particles::Particles;
+    use crate::scene::YarnScene;
+
+    /// A curved yarn (rest curvature) bent further, with random offsets.
+    fn bent_vertices() -> crate::mpm::particles::Vertices {
+        let scene = YarnScene::from_toml_str(
+            r#"
+[grid]
+resolution = 64
+[time]
+dt = 1e-4
+[material]
+k = 1000.0
+gamma = 500.0
+youngs_modulus = 1000.0
+friction = 0.0
+bending = 0.01
+[[yarns]]
+points = [[0.2, 0.3], [0.4, 0.45], [0.6, 0.4], [0.7, 0.6]]
+vertices = 30
+[[yarns]]
+start = [0.2, 0.8]
+end = [0.8, 0.8]
+vertices = 12
+"#,
+        )
+        .unwrap();
+        let mut p = Particles::from_scene(&scene);
+        let l = p.quad.l0[0];
+        for (i, x) in p.vert.x.iter_mut().enumerate() {
+            let a = i as f64 * 1.7;
+            *x += Vec2::new(a.sin(), (2.3 * a).cos()) * (0.2 * l);
+        }
+        p.vert
+    }
+
+    #[test]
+    fn bending_force_is_minus_the_energy_gradient() {
+        let v = bent_vertices();
+        let b = 0.01;
+        let n = v.x.len();
+        let t1 = vec![Vec2::zeros(); 64];
+        let mut f = vec![Vec2::zeros(); n];
+        // split in uneven chunks: the rolling window must not depend on them
+        vertex_forces(&v, &t1, b, 0..7, &mut f[0..7]);
+        vertex_forces(&v, &t1, b, 7..n, &mut f[7..n]);
+        let mut whole = vec![Vec2::zeros(); n];
+        vertex_forces(&v, &t1, b, 0..n, &mut whole);
+        assert_eq!(f, whole);
+        let eps = 1e-7;
+        let mut worst: f64 = 0.0;
+        let mut max_f: f64 = 0.0;
+        for (i, fi) in f.iter().enumerate() {
+            for axis in 0..2 {
+                let mut w = v.clone();
+                w.x[i][axis] += eps;
+                let ep = bending_energy(&w, b);
+                w.x[i][axis] -= 2.0 * eps;
+                let em = bending_energy(&w, b);
+                let fd = -(ep - em) / (2.0 * eps);
+                worst = worst.max((fd - fi[axis]).abs());
+                max_f = max_f.max(fi[axis].abs());
+            }
+        }
+        // central differences at eps 1e-7: truncation ~eps^2, round-off ~1e-16 E / eps
+        assert!(max_f > 0.1, "{max_f}");
+        assert!(worst < 1e-6 * max_f, "worst {worst} of {max_f}");
+    }
+
+    #[test]
+    fn straight_rest_yarn_has_no_bending_energy_or_force() {
+        let scene = YarnScene::from_toml_str(
+            r#"
+[grid]
+resolution = 64
+[time]
+dt = 1e-4
+[material]
+k = 1.0
+gamma = 1.0
+youngs_modulus = 1.0
+friction = 0.0
+bending = 1.0
+[[yarns]]
+points = [[0.2, 0.3], [0.5, 0.5], [0.7, 0.4]]
+vertices = 20
+"#,
+        )
+        .unwrap();
+        let p = Particles::from_scene(&scene);
+        // curved at rest: zero energy and force at rest, whatever the shape
+        assert_eq!(bending_energy(&p.vert, 1.0), 0.0);
+        let mut f = vec![Vec2::zeros(); 20];
+        vertex_forces(&p.vert, &[Vec2::zeros(); 19], 1.0, 0..20, &mut f);
+        assert!(f.iter().all(|f| f.norm() < 1e-12), "{f:?}");
+    }
+
+    #[test]
+    fn discrete_energy_of_a_circular_arc_matches_the_continuum() {
+        // an arc of radius R and length L: int B/2 kappa^2 ds = B L / (2 R^2),
+        // the same at every resolution (to O(h^2) from 2 tan(theta/2) ~ theta)
+        let (r, len, b) = (0.5, 0.6, 2.0);
+        for n in [20usize, 80, 320] {
+            let straight: Vec<Vec2> = (0..n)
+                .map(|i| Vec2::new(len * i as f64 / (n - 1) as f64, 0.0))
+                .collect();
+            let mut vert = crate::mpm::particles::Vertices {
+                bend: rest_of_curve(&straight),
+                ..Default::default()
+            };
+            vert.x = (0..n)
+                .map(|i| {
+                    let phi = len / r * i as f64 / (n - 1) as f64;
+                    Vec2::new(r * phi.sin(), r * (1.0 - phi.cos()))
+                })
+                .collect();
+            let e = bending_energy(&vert, b);
+            let exact = b * len / (2.0 * r * r);
+            // the discrete sum spans L - h (half cells at the ends are not
+            // counted), so the relative error is about 1/n
+            let rel = (e - exact).abs() / exact;
+            assert!(rel < 1.5 / n as f64, "n {n}: {e} vs {exact} ({rel})");
+        }
+    }
+}
