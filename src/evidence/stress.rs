@@ -21,12 +21,12 @@
 //! attractor (strength `a`) can give in the probe time `T` (Courant number 1).
 
 use super::plot::{LinePlot, Series};
-use super::{extent, num, small_yarn_scene, Table};
+use super::{extent, num, Table};
 use crate::massspring::integrators::stability::analyze;
 use crate::massspring::{scenes, Integrator, IntegratorOptions, Simulation, System};
 use crate::math::Vec2;
 use crate::mpm::{Attractor, YarnSim};
-use crate::scene::YarnScene;
+use crate::scene::{builtin::small_yarn_scene, YarnScene};
 
 /// Simulated time of one probe run, in s.
 pub const PROBE_TIME: f64 = 0.5;
