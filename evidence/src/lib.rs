@@ -1,5 +1,10 @@
-//! Evidence of speed and accuracy (issue 6): work-precision diagrams,
-//! stability stress maps and the "skip what a scene doesn't need" benchmark.
+//! # yarnsim-evidence
+//!
+//! Evidence of speed and accuracy of the `yarnsim` library (issue 6):
+//! work-precision diagrams, stability stress maps and the "skip what a scene
+//! doesn't need" benchmark. A crate of its own so that `yarnsim` holds physics
+//! only; the CLI (`yarnsim bench precision`, `yarnsim stress`,
+//! `yarnsim bench skip`) and the `evidence` example run it.
 //!
 //! * [`precision`]: run time against error for every scene and integrator,
 //!   with the observed convergence order and the fastest method per error level.
@@ -22,7 +27,7 @@ pub mod stress;
 use std::fmt::Write;
 use std::path::Path;
 
-use crate::massspring::V3;
+use yarnsim::massspring::V3;
 
 /// A table of strings with a header, rendered as CSV or aligned text.
 #[derive(Clone, Debug, Default, PartialEq)]
