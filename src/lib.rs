@@ -7,10 +7,7 @@
 //! * [`scene`]: scene descriptions ("layouts") and their TOML files.
 //! * [`mpm`]: the yarn-bundle MPM solver.
 //! * [`massspring`]: mass-spring wires and cloth (seeds 002, 004, 001).
-//! * [`evidence`]: work-precision, stability stress and skip-what-is-unneeded
-//!   benchmarks (issue 6).
 
-pub mod evidence;
 pub mod massspring;
 pub mod math;
 pub mod mpm;

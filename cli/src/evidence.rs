@@ -1,5 +1,5 @@
 //! `yarnsim bench precision`, `yarnsim stress` and `yarnsim bench skip`: the
-//! evidence studies of [`yarnsim::evidence`], writing CSV, SVG and a text
+//! evidence studies of [`yarnsim_evidence`], writing CSV, SVG and a text
 //! report into a directory and printing the report.
 //!
 //! `bench precision` and `bench skip` are spelled `bench-precision` and
@@ -10,7 +10,7 @@ use std::ffi::OsString;
 use std::path::{Path, PathBuf};
 
 use clap::Subcommand;
-use yarnsim::evidence::{precision, skip, stress, write_report};
+use yarnsim_evidence::{precision, skip, stress, write_report};
 
 use crate::error::CliError;
 

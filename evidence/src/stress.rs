@@ -12,7 +12,7 @@
 //!
 //! The largest stable `dt` is found by bisection on `log dt` between a floor
 //! and a cap (a result at the cap reads `>= cap`). Mass-spring theory
-//! (linearised, [`crate::massspring::StabilityInfo`]): forward Euler
+//! (linearised, [`yarnsim::massspring::StabilityInfo`]): forward Euler
 //! `h <= b/k` or its overdamped form, symplectic Euler
 //! `h <= -tau + sqrt(tau^2 + 4/w_max^2)`, the implicit schemes A-stable (no
 //! bound). Yarn theory: the CFL / elastic-wave bound
@@ -20,13 +20,13 @@
 //! fastest wave speed of the energy, `v = (|g| + a) T` the speed gravity and
 //! attractor (strength `a`) can give in the probe time `T` (Courant number 1).
 
-use super::plot::{LinePlot, Series};
-use super::{extent, num, small_yarn_scene, Table};
-use crate::massspring::integrators::stability::analyze;
-use crate::massspring::{scenes, Integrator, IntegratorOptions, Simulation, System};
-use crate::math::Vec2;
-use crate::mpm::{Attractor, YarnSim};
-use crate::scene::YarnScene;
+use crate::plot::{LinePlot, Series};
+use crate::{extent, num, Table};
+use yarnsim::massspring::integrators::stability::analyze;
+use yarnsim::massspring::{scenes, Integrator, IntegratorOptions, Simulation, System};
+use yarnsim::math::Vec2;
+use yarnsim::mpm::{Attractor, YarnSim};
+use yarnsim::scene::{builtin::small_yarn_scene, YarnScene};
 
 /// Simulated time of one probe run, in s.
 pub const PROBE_TIME: f64 = 0.5;
@@ -302,7 +302,7 @@ pub fn run(opts: &StressOptions) -> StressReport {
     };
     massspring_limits(
         "wire",
-        &super::precision::wire_system(),
+        &crate::precision::wire_system(),
         factors,
         it,
         &mut limits,
@@ -459,7 +459,7 @@ impl StressReport {
             .collect();
         out.push((
             "stress_yarn.svg".to_string(),
-            super::plot::bar_chart(
+            crate::plot::bar_chart(
                 "yarn MPM: largest stable dt / CFL bound dx/(c+v)",
                 "ratio (1 = the bound)",
                 &yarn,
@@ -504,7 +504,7 @@ mod tests {
     #[test]
     #[cfg_attr(debug_assertions, ignore = "bisects wire runs; release only")]
     fn symplectic_euler_limit_matches_the_theory_on_the_wire() {
-        let sys = crate::evidence::precision::wire_system();
+        let sys = crate::precision::wire_system();
         let bound = analyze(&sys, &sys.positions).symplectic_euler;
         let opt = IntegratorOptions::default();
         let (s, u, _) = largest_stable(1e-6, 0.1, 12, |h| {

@@ -25,11 +25,14 @@
 
 use std::time::Instant;
 
-use super::plot::{LinePlot, Series};
-use super::{extent, num, small_yarn_scene, Table};
-use crate::massspring::{scenes, Integrator, IntegratorOptions, Simulation, System, V3};
-use crate::mpm::YarnSim;
-use crate::scene::{builtin::yarn_reference, YarnScene};
+use crate::plot::{LinePlot, Series};
+use crate::{extent, num, Table};
+use yarnsim::massspring::{scenes, Integrator, IntegratorOptions, Simulation, System, V3};
+use yarnsim::mpm::YarnSim;
+use yarnsim::scene::{
+    builtin::{small_yarn_scene, yarn_reference},
+    YarnScene,
+};
 
 /// What to run.
 #[derive(Clone, Debug, Default)]

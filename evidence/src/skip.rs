@@ -16,10 +16,10 @@
 
 use std::time::Instant;
 
-use super::plot::bar_chart;
-use super::{num, Table};
-use crate::mpm::{PassTimes, YarnSim};
-use crate::scene::{builtin::yarn_reference, YarnScene};
+use crate::plot::bar_chart;
+use crate::{num, Table};
+use yarnsim::mpm::{PassTimes, YarnSim};
+use yarnsim::scene::{builtin::yarn_reference, YarnScene};
 
 /// What to run.
 #[derive(Clone, Debug)]

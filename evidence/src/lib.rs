@@ -1,5 +1,10 @@
-//! Evidence of speed and accuracy (issue 6): work-precision diagrams,
-//! stability stress maps and the "skip what a scene doesn't need" benchmark.
+//! # yarnsim-evidence
+//!
+//! Evidence of speed and accuracy of the `yarnsim` library (issue 6):
+//! work-precision diagrams, stability stress maps and the "skip what a scene
+//! doesn't need" benchmark. A crate of its own so that `yarnsim` holds physics
+//! only; the CLI (`yarnsim bench precision`, `yarnsim stress`,
+//! `yarnsim bench skip`) and the `evidence` example run it.
 //!
 //! * [`precision`]: run time against error for every scene and integrator,
 //!   with the observed convergence order and the fastest method per error level.
@@ -22,10 +27,7 @@ pub mod stress;
 use std::fmt::Write;
 use std::path::Path;
 
-use crate::massspring::V3;
-use crate::scene::{
-    builtin::reference_material, GridSpec, Obstacle, TimeSpec, YarnScene, YarnSpec,
-};
+use yarnsim::massspring::V3;
 
 /// A table of strings with a header, rendered as CSV or aligned text.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -129,48 +131,6 @@ pub fn write_report(dir: &Path, files: &[(String, String)]) -> std::io::Result<V
     Ok(written)
 }
 
-/// A small yarn scene for quick measurements: `yarns` yarns of `vertices`
-/// vertices (0.8 m long, 0.02 m apart) on a `resolution`^2 grid over 1 m,
-/// falling from y = 0.75 onto one circle (centre (0.5, 0.55), radius 0.1),
-/// reference material, gravity -9.8, sticky walls, dt 1e-4.
-pub fn small_yarn_scene(yarns: u32, vertices: u32, resolution: u32) -> YarnScene {
-    YarnScene {
-        kind: "yarn".into(),
-        name: "yarn-small".into(),
-        description: format!(
-            "{yarns} yarns x {vertices} vertices on {resolution}^2 falling onto one circle"
-        ),
-        grid: GridSpec {
-            resolution,
-            size: 1.0,
-        },
-        time: TimeSpec {
-            dt: 1e-4,
-            frame_dt: 1.0 / 60.0,
-        },
-        material: reference_material(),
-        gravity: [0.0, -9.8],
-        attractor: Default::default(),
-        walls: Default::default(),
-        obstacles: vec![Obstacle {
-            center: [0.5, 0.55],
-            radius: 0.1,
-            friction: 0.3,
-        }],
-        transfer: Default::default(),
-        pins: Vec::new(),
-        yarns: vec![YarnSpec {
-            start: Some([0.1, 0.75]),
-            direction: Some([1.0, 0.0]),
-            length: Some(0.8),
-            vertices,
-            count: yarns,
-            spacing: [0.0, 0.02],
-            ..Default::default()
-        }],
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -184,10 +144,5 @@ mod tests {
         assert!(text
             .lines()
             .all(|l| l.len() == text.lines().next().unwrap().len()));
-    }
-
-    #[test]
-    fn small_scene_is_valid() {
-        small_yarn_scene(2, 40, 64).validate().unwrap();
     }
 }

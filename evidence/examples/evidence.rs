@@ -1,9 +1,9 @@
 //! Runs the evidence studies without the CLI:
-//! `cargo run --release --example evidence -- precision|stress|skip [--quick] [--out DIR]`.
+//! `cargo run --release -p yarnsim-evidence --example evidence -- precision|stress|skip [--quick] [--out DIR]`.
 
 use std::path::PathBuf;
 
-use yarnsim::evidence::{precision, skip, stress, write_report};
+use yarnsim_evidence::{precision, skip, stress, write_report};
 
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
