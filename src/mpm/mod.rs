@@ -7,6 +7,7 @@
 //! * [`passes`]: the passes of one substep.
 //! * [`sim`]: [`YarnSim`], which runs the passes a scene needs.
 //! * [`state`]: byte serialization of the dynamic state.
+//! * [`timestep`]: the stable substep bound (CFL / elastic waves).
 
 pub mod constitutive;
 pub mod grid;
@@ -14,5 +15,6 @@ pub mod particles;
 pub mod passes;
 pub mod sim;
 pub mod state;
+pub mod timestep;
 
 pub use sim::{Attractor, Diagnostics, PassTimes, Passes, SimError, YarnSim};
