@@ -345,7 +345,19 @@ impl YarnSim {
         self.time += dt;
         let what = match (bad_v, bad_q) {
             (Some(i), _) => {
-                let v = self.particles.vert.v[i];
+                // The velocity the CFL check tested: the grid's, interpolated
+                // at the vertex's stencil, before the wall and obstacle
+                // projection changed the stored one.
+                let st = &self.particles.vert.stencil[i];
+                let g = &self.grid;
+                let mut v = Vec2::zeros();
+                for (a, wa) in st.w[0].iter().enumerate() {
+                    for (b, wb) in st.w[1].iter().enumerate() {
+                        let (ni, nj) = (st.base[0] as usize + a, st.base[1] as usize + b);
+                        let node = g.node[g.geom.index(ni, nj)];
+                        v += Vec2::new(node[0], node[1]) * (wa * wb);
+                    }
+                }
                 Some(if v.x.is_finite() && v.y.is_finite() {
                     format!(
                         "vertex {i} moves {:.3} m/s, more than one cell per substep (CFL limit {:.3} m/s)",
