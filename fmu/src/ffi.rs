@@ -295,7 +295,7 @@ pub unsafe extern "C" fn fmi2EnterInitializationMode(c: fmi2Component) -> fmi2St
 #[no_mangle]
 pub unsafe extern "C" fn fmi2ExitInitializationMode(c: fmi2Component) -> fmi2Status {
     call(c, "fmi2ExitInitializationMode", |inst| {
-        ok(inst.exit_initialization_mode())
+        inst.exit_initialization_mode()
     })
 }
 

@@ -9,7 +9,10 @@ use std::path::{Path, PathBuf};
 use yarnsim::mpm::state::fnv1a;
 
 use crate::massspring::MsModel;
-use crate::model::{FmuScene, LOG_CATEGORIES, SCENE_FILE, VR_SUBSTEPS};
+use crate::model::{
+    FmuScene, DEFAULT_MAX_SUBSTEPS, DEFAULT_THREADS, LOG_CATEGORIES, MAX_THREADS, SCENE_FILE,
+    VR_MAX_SUBSTEPS, VR_SUBSTEPS, VR_THREADS,
+};
 use crate::yarn::YarnModel;
 
 /// `fmi2Status` values.
@@ -163,7 +166,40 @@ impl Physics {
         }
     }
 
-    fn outputs_finite(&self) -> bool {
+    /// What a failed communication step goes back to: the yarn
+    /// simulation's own state bytes (a clone of the whole `YarnSim` with its
+    /// grid costs far more than its particles), the whole mass-spring model
+    /// (a clone is cheaper than its serialization).
+    fn checkpoint(&self) -> Checkpoint {
+        match self {
+            Physics::Yarn(m) => Checkpoint::Yarn(m.sim.save_state()),
+            Physics::MassSpring(m) => Checkpoint::MassSpring(m.clone()),
+        }
+    }
+
+    /// Puts back a [`Self::checkpoint`] of this model.
+    fn restore(&mut self, c: Checkpoint) {
+        match (self, c) {
+            (Physics::Yarn(m), Checkpoint::Yarn(bytes)) => {
+                m.sim
+                    .load_state(&bytes)
+                    .expect("the simulation's own state bytes load");
+                m.diag = None;
+            }
+            (Physics::MassSpring(m), Checkpoint::MassSpring(c)) => *m = c,
+            _ => unreachable!("a checkpoint of the other model"),
+        }
+    }
+
+    /// The model's stability bound on the substep in s (`None`: none).
+    fn stable_dt(&self) -> Option<f64> {
+        match self {
+            Physics::Yarn(m) => Some(m.sim.stable_dt()),
+            Physics::MassSpring(m) => m.sim.stable_dt(),
+        }
+    }
+
+    fn outputs_finite(&mut self) -> bool {
         each!(self, m => m.outputs_finite())
     }
 
@@ -192,6 +228,12 @@ impl Physics {
     }
 }
 
+/// The last good state of a communication step ([`Physics::checkpoint`]).
+enum Checkpoint {
+    Yarn(Vec<u8>),
+    MassSpring(Box<MsModel>),
+}
+
 /// Everything an FMU state holds: what `fmi2GetFMUstate` copies and
 /// `fmi2Reset` rebuilds.
 #[derive(Clone, Debug)]
@@ -209,6 +251,9 @@ pub struct Model {
     pub substeps: u64,
     /// Set when a step diverged (`fmi2Terminated` status).
     pub terminated: bool,
+    /// The outputs were found finite and nothing changed since (no
+    /// substep, no value set); not part of the serialized state.
+    pub outputs_checked: bool,
 }
 
 impl Model {
@@ -222,6 +267,7 @@ impl Model {
             last_successful_time: 0.0,
             substeps: 0,
             terminated: false,
+            outputs_checked: false,
         })
     }
 
@@ -273,6 +319,25 @@ pub const STATE_MAGICS: [&[u8; 8]; 2] = [YARN_STATE_MAGIC, MASS_SPRING_STATE_MAG
 pub const STATE_VERSION: u32 = 1;
 const STATE_HEADER: usize = 8 + 4 + 8 + 8;
 
+/// The execution parameters `max_substeps_per_step` and `threads`: how an
+/// instance runs, not what it simulates, so they are not part of the FMU
+/// state (`fmi2SetFMUstate` keeps the instance's own); `fmi2Reset` restores
+/// the defaults.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Execution {
+    pub max_substeps: u32,
+    pub threads: u32,
+}
+
+impl Default for Execution {
+    fn default() -> Self {
+        Execution {
+            max_substeps: DEFAULT_MAX_SUBSTEPS,
+            threads: DEFAULT_THREADS,
+        }
+    }
+}
+
 /// One FMU instance.
 pub struct Instance {
     magic: u64,
@@ -288,6 +353,10 @@ pub struct Instance {
     count: usize,
     pub phase: Phase,
     pub model: Model,
+    pub execution: Execution,
+    /// The instance's own thread pool (`threads` > 0), built at
+    /// `fmi2ExitInitializationMode`; `None`: rayon's global pool.
+    pool: Option<(u32, rayon::ThreadPool)>,
     /// Strings handed out by `fmi2GetString`, valid until the next call.
     pub strings: Vec<CString>,
 }
@@ -339,8 +408,7 @@ pub fn resource_path(uri: &str) -> Result<PathBuf, String> {
 }
 
 fn read_scene(path: &Path) -> Result<FmuScene, String> {
-    let text = std::fs::read_to_string(path)
-        .map_err(|e| format!("cannot read scene file {}: {e}", path.display()))?;
+    let text = crate::model::read_scene_text(path)?;
     FmuScene::from_toml_str(&text).map_err(|e| format!("scene file {}: {e}", path.display()))
 }
 
@@ -405,6 +473,8 @@ impl Instance {
             count,
             phase: Phase::Instantiated,
             model,
+            execution: Execution::default(),
+            pool: None,
             strings: Vec::new(),
         });
         inst.log(
@@ -440,11 +510,14 @@ impl Instance {
         self.count
     }
 
-    /// Sends a message to the logger: errors and fatal errors and discards
-    /// always, other messages when logging is on for their category.
+    /// Sends a message to the logger: warnings, discards, errors and fatal
+    /// errors always, other messages when logging is on for their category.
     pub fn log(&self, status: Status, category: usize, msg: &str) {
         let Some(logger) = self.logger else { return };
-        let always = matches!(status, Status::Error | Status::Fatal | Status::Discard);
+        let always = matches!(
+            status,
+            Status::Warning | Status::Error | Status::Fatal | Status::Discard
+        );
         if !(always || (self.logging_on && self.categories[category])) {
             return;
         }
@@ -528,9 +601,24 @@ impl Instance {
         Ok(())
     }
 
-    pub fn exit_initialization_mode(&mut self) -> Res {
+    pub fn exit_initialization_mode(&mut self) -> Res<Status> {
         self.require("fmi2ExitInitializationMode", &[Phase::InitializationMode])?;
-        self.model.ensure_built(self.count)?;
+        let threads = self.execution.threads;
+        if threads == 0 {
+            self.pool = None;
+        } else if self.pool.as_ref().map(|p| p.0) != Some(threads) {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads as usize)
+                .thread_name(|i| format!("yarnsim-fmu-{i}"))
+                .build()
+                .or_else(|e| error(format!("cannot start a pool of {threads} threads: {e}")))?;
+            self.pool = Some((threads, pool));
+        }
+        let m = &mut self.model;
+        match &self.pool {
+            Some((_, pool)) => pool.install(|| m.ensure_built(self.count))?,
+            None => m.ensure_built(self.count)?,
+        }
         let m = &mut self.model;
         m.time = m.start_time;
         m.last_successful_time = m.start_time;
@@ -548,7 +636,19 @@ impl Instance {
                 self.model.physics.dt()
             ),
         );
-        Ok(())
+        let dt = self.model.physics.dt();
+        if let Some(bound) = self.model.physics.stable_dt().filter(|&b| dt > b) {
+            self.log(
+                Status::Warning,
+                LOG_WARNING,
+                &format!(
+                    "fmi2ExitInitializationMode: substep dt = {dt} s exceeds the stability bound {bound:.6e} s of this {} model; the run may diverge (fmi2DoStep then returns fmi2Discard)",
+                    self.bundled.identifier()
+                ),
+            );
+            return Ok(Status::Warning);
+        }
+        Ok(Status::Ok)
     }
 
     pub fn terminate(&mut self) -> Res {
@@ -561,6 +661,7 @@ impl Instance {
     pub fn reset(&mut self) -> Res {
         self.require("fmi2Reset", NOT_FATAL)?;
         self.model = Model::new(&self.bundled)?;
+        self.execution = Execution::default();
         self.phase = Phase::Instantiated;
         self.log(Status::Ok, LOG_EVENTS, "reset to the instantiated state");
         Ok(())
@@ -602,37 +703,72 @@ impl Instance {
             return error(format!("step to {end} needs {target} substeps of {dt} s"));
         }
         let target = target as u64;
-        while m.substeps < target {
-            if let Err(e) = m.physics.substep(m.substeps) {
-                m.terminated = true;
-                self.phase = Phase::StepFailed;
-                let msg = if e.terminal {
-                    format!(
-                        "step from t = {t} by {h} failed: {}; the simulation is terminated (restore a state or reset)",
-                        e.msg
-                    )
-                } else {
-                    format!("step from t = {t} by {h} failed: {}", e.msg)
-                };
-                return Err(Fail {
-                    status: Status::Discard,
-                    msg,
-                });
+        let needed = target.saturating_sub(m.substeps);
+        let budget = self.execution.max_substeps;
+        if needed > budget as u64 {
+            return error(format!(
+                "step from t = {t} by {h} needs {needed} substeps of {dt} s, more than max_substeps_per_step = {budget}; no substep was run (take shorter communication steps or raise the parameter)"
+            ));
+        }
+        // The last good state: the one at the start of this communication
+        // step (time t = lastSuccessfulTime). A failed step puts it back, so
+        // the outputs stay readable after a Discard (one checkpoint per step
+        // that runs substeps; measured in the README).
+        let start_substeps = m.substeps;
+        let mut last_good = (m.substeps < target).then(|| m.physics.checkpoint());
+        let mut restore = |m: &mut Model| {
+            if let Some(c) = last_good.take() {
+                m.physics.restore(c);
+                m.substeps = start_substeps;
             }
-            m.substeps += 1;
+        };
+        let run = |m: &mut Model| -> Result<(), StepFailure> {
+            while m.substeps < target {
+                m.physics.substep(m.substeps)?;
+                m.substeps += 1;
+            }
+            Ok(())
+        };
+        let ran = match &self.pool {
+            Some((_, pool)) => pool.install(|| run(m)),
+            None => run(m),
+        };
+        if let Err(e) = ran {
+            m.terminated = true;
+            restore(m);
+            self.phase = Phase::StepFailed;
+            let msg = if e.terminal {
+                format!(
+                    "step from t = {t} by {h} failed: {}; the simulation is terminated (restore a state or reset; the outputs are those of t = {t})",
+                    e.msg
+                )
+            } else {
+                format!("step from t = {t} by {h} failed: {}", e.msg)
+            };
+            return Err(Fail {
+                status: Status::Discard,
+                msg,
+            });
         }
         // The libraries report divergence themselves; the outputs are
         // checked too, so a step never ends OK with a non-finite output.
-        if !m.physics.outputs_finite() {
+        // Unchanged since the last check (no substep ran, no value was set):
+        // nothing to check again.
+        if m.substeps > start_substeps {
+            m.outputs_checked = false;
+        }
+        if !m.outputs_checked && !m.physics.outputs_finite() {
             m.terminated = true;
+            restore(m);
             self.phase = Phase::StepFailed;
             return Err(Fail {
                 status: Status::Discard,
                 msg: format!(
-                    "step from t = {t} by {h} left non-finite outputs; the simulation is terminated (restore a state or reset)"
+                    "step from t = {t} by {h} left non-finite outputs; the simulation is terminated (restore a state or reset; the outputs are those of t = {t})"
                 ),
             });
         }
+        m.outputs_checked = true;
         m.time = end;
         m.last_successful_time = end;
         Ok(Status::Ok)
@@ -646,15 +782,10 @@ impl Instance {
         )
     }
 
-    /// Values that depend on the simulated state are not available after a
-    /// diverged step.
-    fn require_state(&mut self, func: &str) -> Res {
-        if self.phase == Phase::StepFailed {
-            return error(format!(
-                "{func}: the state diverged in the last step (t = {}); its outputs are not available until fmi2SetFMUstate or fmi2Reset",
-                self.model.last_successful_time
-            ));
-        }
+    /// Values that depend on the simulated state need a built simulation.
+    /// After a diverged step they are those of the last good state (at
+    /// `lastSuccessfulTime`), which the failed step restored.
+    fn require_state(&mut self) -> Res {
         self.model.ensure_built(self.count)
     }
 
@@ -662,7 +793,7 @@ impl Instance {
         self.require_get("fmi2GetReal")?;
         for (k, &vr) in vrs.iter().enumerate() {
             if self.model.physics.is_state_output(vr) {
-                self.require_state("fmi2GetReal")?;
+                self.require_state()?;
             }
             let Some(v) = self.model.physics.get_real(vr) else {
                 return error(format!(
@@ -686,6 +817,8 @@ impl Instance {
             out[k] = match vr {
                 // Saturates instead of wrapping past 2^31 - 1 substeps.
                 VR_SUBSTEPS => self.model.substeps.min(c_int::MAX as u64) as c_int,
+                VR_MAX_SUBSTEPS => self.execution.max_substeps as c_int,
+                VR_THREADS => self.execution.threads as c_int,
                 _ => {
                     return error(format!(
                         "fmi2GetInteger: no Integer variable has value reference {vr}"
@@ -747,6 +880,7 @@ impl Instance {
             &self.bundled,
         )?;
         self.model.dirty |= changed;
+        self.model.outputs_checked = false;
         Ok(())
     }
 
@@ -761,14 +895,41 @@ impl Instance {
         })
     }
 
-    pub fn set_integer(&mut self, vrs: &[u32], _vals: &[c_int]) -> Res {
+    /// Sets the execution parameters `max_substeps_per_step` and `threads`
+    /// (fixed: only before `fmi2ExitInitializationMode`). A rejected call
+    /// changes nothing.
+    pub fn set_integer(&mut self, vrs: &[u32], vals: &[c_int]) -> Res {
         self.require_set_input("fmi2SetInteger")?;
-        match vrs.first() {
-            None => Ok(()),
-            Some(vr) => error(format!(
-                "fmi2SetInteger: value reference {vr} is not an Integer input or parameter"
-            )),
+        let mut e = self.execution;
+        for (&vr, &v) in vrs.iter().zip(vals) {
+            match vr {
+                VR_MAX_SUBSTEPS | VR_THREADS => {
+                    parameter_settable(self.phase, "fmi2SetInteger", vr)?
+                }
+                _ => {
+                    return error(format!(
+                        "fmi2SetInteger: value reference {vr} is not an Integer input or parameter"
+                    ))
+                }
+            }
+            if vr == VR_MAX_SUBSTEPS {
+                if v < 1 {
+                    return error(format!(
+                        "fmi2SetInteger: max_substeps_per_step = {v} must be at least 1"
+                    ));
+                }
+                e.max_substeps = v as u32;
+            } else {
+                if !(0..=MAX_THREADS as c_int).contains(&v) {
+                    return error(format!(
+                        "fmi2SetInteger: threads = {v} must be 0 (all cores) to {MAX_THREADS}"
+                    ));
+                }
+                e.threads = v as u32;
+            }
         }
+        self.execution = e;
+        Ok(())
     }
 
     pub fn set_boolean(&mut self, vrs: &[u32], vals: &[c_int]) -> Res {
@@ -1068,6 +1229,7 @@ pub fn deserialize(bytes: &[u8], current: &Model, count: usize) -> Result<(Phase
             last_successful_time,
             substeps,
             terminated,
+            outputs_checked: false,
         },
     ))
 }

@@ -19,7 +19,7 @@ use crate::model::{real, Description, VarType, Variable};
 pub const MODEL_IDENTIFIER: &str = "MassSpring";
 
 /// Bumped whenever the variable layout changes; part of the GUID.
-pub const INTERFACE_VERSION: u32 = 1;
+pub const INTERFACE_VERSION: u32 = 2;
 
 /// The integrator an instance uses unless the `integrator` parameter says
 /// otherwise (the CLI's default too).
@@ -157,6 +157,7 @@ pub fn variables(layout: &Layout) -> Result<Vec<Variable>, String> {
         None,
         "Substeps taken since initialization".into(),
     ));
+    v.extend(crate::model::execution_parameters());
     for i in 0..n {
         for (k, axis) in ["x", "y", "z"].into_iter().enumerate() {
             v.push(var(
@@ -267,11 +268,21 @@ impl MsModel {
         })
     }
 
+    /// Every Real output this model serves is finite: the positions, the
+    /// four energies and the largest strain (energies overflow to inf long
+    /// before the positions do).
     pub fn outputs_finite(&self) -> bool {
-        self.sim
-            .positions()
-            .iter()
-            .all(|p| p.iter().all(|c| c.is_finite()))
+        let e = self.sim.energies();
+        e.kinetic.is_finite()
+            && e.elastic.is_finite()
+            && e.gravity.is_finite()
+            && e.total().is_finite()
+            && self.sim.max_strain().is_finite()
+            && self
+                .sim
+                .positions()
+                .iter()
+                .all(|p| p.iter().all(|c| c.is_finite()))
     }
 
     /// Whether the Real variable `vr` depends on the simulated state.

@@ -11,7 +11,7 @@ use yarnsim::scene::{Scene, YarnScene};
 pub const MODEL_IDENTIFIER: &str = "YarnBundle";
 
 /// Bumped whenever the variable layout changes; part of the GUID.
-pub const INTERFACE_VERSION: u32 = 1;
+pub const INTERFACE_VERSION: u32 = 2;
 
 /// Name of the scene file inside the FMU's `resources/` folder.
 pub const SCENE_FILE: &str = "scene.toml";
@@ -35,9 +35,93 @@ pub const VR_KINETIC_ENERGY: u32 = 100;
 pub const VR_ELASTIC_ENERGY: u32 = 101;
 pub const VR_MAX_STRETCH: u32 = 102;
 pub const VR_SUBSTEPS: u32 = 200; // Integer
+/// `max_substeps_per_step` (Integer parameter of every model).
+pub const VR_MAX_SUBSTEPS: u32 = 201;
+/// `threads` (Integer parameter of every model).
+pub const VR_THREADS: u32 = 202;
 pub const VR_SCENE: u32 = 300; // String
 /// `yarn[i].left.x` has `VR_YARN_BASE + 4 i`, then `left.y`, `right.x`, `right.y`.
 pub const VR_YARN_BASE: u32 = 1000;
+
+/// Largest scene file the FMU reads (the bundled one and the `scene`
+/// parameter): 1 MiB. The built-in scenes are below 4 KiB.
+pub const MAX_SCENE_BYTES: u64 = 1 << 20;
+
+/// Reads a scene file: a regular file (symbolic links are followed) of at
+/// most [`MAX_SCENE_BYTES`], UTF-8. Devices, FIFOs, directories and larger
+/// files are refused before anything is read.
+pub fn read_scene_text(path: &std::path::Path) -> Result<String, String> {
+    use std::io::Read as _;
+    let shown = path.display();
+    let meta =
+        std::fs::metadata(path).map_err(|e| format!("cannot read scene file {shown}: {e}"))?;
+    if !meta.is_file() {
+        let what = if meta.is_dir() {
+            "a directory"
+        } else {
+            "not a regular file (device, FIFO or socket)"
+        };
+        return Err(format!("scene file {shown} is {what}"));
+    }
+    if meta.len() > MAX_SCENE_BYTES {
+        return Err(format!(
+            "scene file {shown} has {} bytes, more than the limit of {MAX_SCENE_BYTES}",
+            meta.len()
+        ));
+    }
+    let file =
+        std::fs::File::open(path).map_err(|e| format!("cannot read scene file {shown}: {e}"))?;
+    // The file may grow between the check and the read: read one byte
+    // past the limit at most.
+    let mut bytes = Vec::new();
+    file.take(MAX_SCENE_BYTES + 1)
+        .read_to_end(&mut bytes)
+        .map_err(|e| format!("cannot read scene file {shown}: {e}"))?;
+    if bytes.len() as u64 > MAX_SCENE_BYTES {
+        return Err(format!(
+            "scene file {shown} is larger than the limit of {MAX_SCENE_BYTES} bytes"
+        ));
+    }
+    String::from_utf8(bytes).map_err(|_| format!("scene file {shown} is not UTF-8 text"))
+}
+
+/// Default of `max_substeps_per_step`: about 2.3 s of work for a step of the
+/// default yarn scene (228 us per substep), 12 s on the cloth (1.2 ms per
+/// substep), 0.06 s on the wire.
+pub const DEFAULT_MAX_SUBSTEPS: u32 = 10_000;
+
+/// Default of `threads`: 0, the process-wide rayon pool (one thread per core).
+pub const DEFAULT_THREADS: u32 = 0;
+
+/// Largest accepted `threads`.
+pub const MAX_THREADS: u32 = 1024;
+
+/// The execution parameters every model has (after `substeps`): the
+/// substep budget of one `fmi2DoStep` and the instance's thread count.
+pub fn execution_parameters() -> Vec<Variable> {
+    vec![
+        Variable {
+            name: "max_substeps_per_step".into(),
+            vr: VR_MAX_SUBSTEPS,
+            ty: VarType::Integer,
+            causality: "parameter",
+            variability: "fixed",
+            unit: None,
+            start: Some(DEFAULT_MAX_SUBSTEPS.to_string()),
+            description: "Most substeps one fmi2DoStep may run (at least 1); a longer step is refused with fmi2Error before any substep runs".into(),
+        },
+        Variable {
+            name: "threads".into(),
+            vr: VR_THREADS,
+            ty: VarType::Integer,
+            causality: "parameter",
+            variability: "fixed",
+            unit: None,
+            start: Some(DEFAULT_THREADS.to_string()),
+            description: format!("Worker threads of this instance's own thread pool (1 to {MAX_THREADS}); 0: the process-wide pool, one thread per core. Results are bit-identical for every value"),
+        },
+    ]
+}
 
 /// The real parameters in value-reference order `VR_K..=VR_DT`.
 pub const REAL_PARAMETERS: [u32; 7] = [
@@ -321,6 +405,18 @@ pub fn variables(scene: &YarnScene) -> Vec<Variable> {
         None,
         "Substeps taken since initialization",
     );
+    for p in execution_parameters() {
+        add(
+            &p.name,
+            p.vr,
+            p.ty,
+            p.causality,
+            p.variability,
+            p.unit,
+            p.start,
+            &p.description,
+        );
+    }
     for i in 0..num_yarns(scene) {
         for (k, end, axis) in [
             (0, "left", "x"),

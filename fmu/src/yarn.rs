@@ -135,8 +135,7 @@ fn effective_scene(base: &YarnScene, config: &Config) -> YarnScene {
 }
 
 fn read_scene(path: &Path) -> Result<YarnScene, String> {
-    let text = std::fs::read_to_string(path)
-        .map_err(|e| format!("cannot read scene file {}: {e}", path.display()))?;
+    let text = read_scene_text(path)?;
     YarnScene::from_toml_str(&text).map_err(|e| format!("scene file {}: {e}", path.display()))
 }
 
@@ -197,13 +196,19 @@ impl YarnModel {
         })
     }
 
-    /// Every output is finite (the library reports divergence itself; this
-    /// makes sure no step ends OK with a non-finite output).
-    pub fn outputs_finite(&self) -> bool {
-        (0..self.count()).all(|y| {
-            let (l, r) = self.sim.yarn_endpoints(y);
-            l.x.is_finite() && l.y.is_finite() && r.x.is_finite() && r.y.is_finite()
-        })
+    /// Every Real output is finite: the yarn ends, the energies and the
+    /// largest stretch (the library reports divergence itself; this makes
+    /// sure no step ends OK with a non-finite output). The diagnostics it
+    /// computes are cached for the `fmi2GetReal` calls that follow.
+    pub fn outputs_finite(&mut self) -> bool {
+        let d = self.diagnostics();
+        d.kinetic_energy.is_finite()
+            && d.elastic_energy.is_finite()
+            && d.max_stretch.is_finite()
+            && (0..self.count()).all(|y| {
+                let (l, r) = self.sim.yarn_endpoints(y);
+                l.x.is_finite() && l.y.is_finite() && r.x.is_finite() && r.y.is_finite()
+            })
     }
 
     fn diagnostics(&mut self) -> Diagnostics {
