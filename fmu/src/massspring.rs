@@ -175,6 +175,22 @@ pub fn variables(layout: &Layout) -> Result<Vec<Variable>, String> {
     Ok(v)
 }
 
+/// The gravitational and the total energy change as soon as `gravity.*` is
+/// set (`-sum m g . x` with the current gravity), at initialization and
+/// between steps; every other output depends on no input and no parameter
+/// at the same instant (`dt` and `integrator` act through the substeps).
+pub fn dependencies() -> Vec<crate::model::Dependency> {
+    let gravity = vec![VR_GRAVITY_X, VR_GRAVITY_Y, VR_GRAVITY_Z];
+    [VR_GRAVITY_ENERGY, VR_TOTAL_ENERGY]
+        .into_iter()
+        .map(|output| crate::model::Dependency {
+            output,
+            step: gravity.clone(),
+            initial: gravity.clone(),
+        })
+        .collect()
+}
+
 /// The GUID of the FMU for this layout: a hash of the interface version and
 /// the layout's normalized TOML text.
 pub fn guid(layout: &Layout) -> String {
@@ -198,6 +214,7 @@ pub fn description(layout: &Layout) -> Result<Description, String> {
         variables: variables(layout)?,
         stop_time: layout.time.frame_time * layout.time.frames as f64,
         step_size: layout.time.frame_time,
+        dependencies: dependencies(),
     })
 }
 

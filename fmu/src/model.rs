@@ -509,6 +509,58 @@ pub struct Description {
     /// `DefaultExperiment` stop time and step size in s.
     pub stop_time: f64,
     pub step_size: f64,
+    /// What each output depends on ([`Dependency`]); an output without an
+    /// entry depends on nothing (`dependencies=""`).
+    pub dependencies: Vec<Dependency>,
+}
+
+/// The `ModelStructure` dependencies of one output, by value reference.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Dependency {
+    pub output: u32,
+    /// Inputs that change the output at the same instant, without a step
+    /// (`<Outputs>`).
+    pub step: Vec<u32>,
+    /// Inputs and parameters its value after initialization depends on
+    /// (`<InitialUnknowns>`).
+    pub initial: Vec<u32>,
+}
+
+/// `generationDateAndTime` when `SOURCE_DATE_EPOCH` is not set: the date of
+/// the interface version (fixed, so the same sources give the same XML).
+pub const GENERATION_DATE_AND_TIME: &str = "2026-12-01T00:00:00Z";
+
+/// `generationDateAndTime`: `SOURCE_DATE_EPOCH` (seconds since 1970, the
+/// reproducible-builds convention) when set to an integer, else
+/// [`GENERATION_DATE_AND_TIME`].
+pub fn generation_date_and_time() -> String {
+    std::env::var("SOURCE_DATE_EPOCH")
+        .ok()
+        .and_then(|v| v.trim().parse::<i64>().ok())
+        .map(utc_date_time)
+        .unwrap_or_else(|| GENERATION_DATE_AND_TIME.to_string())
+}
+
+/// ISO 8601 UTC of a Unix time (proleptic Gregorian calendar).
+pub fn utc_date_time(secs: i64) -> String {
+    let days = secs.div_euclid(86_400);
+    let sod = secs.rem_euclid(86_400);
+    // Days to civil date (H. Hinnant's algorithm).
+    let z = days + 719_468;
+    let era = z.div_euclid(146_097);
+    let doe = z.rem_euclid(146_097);
+    let yoe = (doe - doe / 1460 + doe / 36_524 - doe / 146_096) / 365;
+    let doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
+    let mp = (5 * doy + 2) / 153;
+    let d = doy - (153 * mp + 2) / 5 + 1;
+    let m = if mp < 10 { mp + 3 } else { mp - 9 };
+    let y = yoe + era * 400 + i64::from(m <= 2);
+    format!(
+        "{y:04}-{m:02}-{d:02}T{:02}:{:02}:{:02}Z",
+        sod / 3600,
+        sod / 60 % 60,
+        sod % 60
+    )
 }
 
 /// The description of the YarnBundle FMU for this scene.
@@ -528,7 +580,35 @@ pub fn description(scene: &YarnScene) -> Description {
         variables: variables(scene),
         stop_time: default_stop_time(scene),
         step_size: scene.time.frame_dt,
+        dependencies: yarn_dependencies(scene),
     }
+}
+
+/// The yarn bundle's outputs depend on no input at the same instant (the
+/// inputs act through the substeps). After initialization (`<InitialUnknowns>`)
+/// the yarn ends and the largest stretch depend on the `scene` parameter;
+/// the kinetic energy on the scene and the density (the scene's initial
+/// velocities); the elastic energy on the scene and the stiffnesses;
+/// `substeps` on nothing. `dt`, `friction`, `plasticity` and the execution
+/// parameters act only through the substeps.
+pub fn yarn_dependencies(scene: &YarnScene) -> Vec<Dependency> {
+    let dep = |output: u32, initial: &[u32]| Dependency {
+        output,
+        step: Vec::new(),
+        initial: initial.to_vec(),
+    };
+    let mut d = vec![
+        dep(VR_KINETIC_ENERGY, &[VR_DENSITY, VR_SCENE]),
+        dep(
+            VR_ELASTIC_ENERGY,
+            &[VR_K, VR_GAMMA, VR_YOUNGS_MODULUS, VR_BENDING, VR_SCENE],
+        ),
+        dep(VR_MAX_STRETCH, &[VR_SCENE]),
+    ];
+    for k in 0..4 * num_yarns(scene) as u32 {
+        d.push(dep(VR_YARN_BASE + k, &[VR_SCENE]));
+    }
+    d
 }
 
 /// Writes `modelDescription.xml`; only the units the variables use are defined.
@@ -539,10 +619,11 @@ pub fn write_model_description(d: &Description) -> String {
     x.push_str("<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n");
     let _ = writeln!(
         x,
-        "<fmiModelDescription fmiVersion=\"2.0\" modelName=\"{ident}\" guid=\"{}\" description=\"{}\" generationTool=\"yarnsim-fmu {}\" variableNamingConvention=\"structured\" numberOfEventIndicators=\"0\">",
+        "<fmiModelDescription fmiVersion=\"2.0\" modelName=\"{ident}\" guid=\"{}\" description=\"{}\" generationTool=\"yarnsim-fmu {}\" generationDateAndTime=\"{}\" variableNamingConvention=\"structured\" numberOfEventIndicators=\"0\">",
         d.guid,
         xml_escape(&d.description),
         env!("CARGO_PKG_VERSION"),
+        generation_date_and_time(),
     );
     let _ = writeln!(
         x,
@@ -610,12 +691,44 @@ pub fn write_model_description(d: &Description) -> String {
         .filter(|(_, v)| v.causality == "output")
         .map(|(i, _)| i + 1)
         .collect();
-    for i in &outputs {
-        let _ = writeln!(x, "      <Unknown index=\"{i}\"/>");
+    // 1-based indices of value references, ascending.
+    let indices = |vrs: &[u32]| -> String {
+        let mut ix: Vec<usize> = vrs
+            .iter()
+            .map(|vr| {
+                1 + vars
+                    .iter()
+                    .position(|v| v.vr == *vr)
+                    .unwrap_or_else(|| panic!("dependency on unknown value reference {vr}"))
+            })
+            .collect();
+        ix.sort_unstable();
+        ix.iter()
+            .map(|i| i.to_string())
+            .collect::<Vec<_>>()
+            .join(" ")
+    };
+    let deps_of = |i: usize, initial: bool| -> String {
+        d.dependencies
+            .iter()
+            .find(|dep| dep.output == vars[i - 1].vr)
+            .map(|dep| indices(if initial { &dep.initial } else { &dep.step }))
+            .unwrap_or_default()
+    };
+    for &i in &outputs {
+        let _ = writeln!(
+            x,
+            "      <Unknown index=\"{i}\" dependencies=\"{}\"/>",
+            deps_of(i, false)
+        );
     }
     x.push_str("    </Outputs>\n    <InitialUnknowns>\n");
-    for i in &outputs {
-        let _ = writeln!(x, "      <Unknown index=\"{i}\"/>");
+    for &i in &outputs {
+        let _ = writeln!(
+            x,
+            "      <Unknown index=\"{i}\" dependencies=\"{}\"/>",
+            deps_of(i, true)
+        );
     }
     x.push_str("    </InitialUnknowns>\n  </ModelStructure>\n</fmiModelDescription>\n");
     x
