@@ -74,8 +74,17 @@ fn model_description_structure() {
         .collect();
     assert_eq!(outputs.len(), 4 * yarns + 4);
     for i in &outputs {
-        assert_eq!(xml.matches(&format!("<Unknown index=\"{i}\"/>")).count(), 2);
+        // Listed in <Outputs> and <InitialUnknowns>, always with dependencies.
+        assert_eq!(
+            xml.matches(&format!("<Unknown index=\"{i}\" dependencies=\""))
+                .count(),
+            2
+        );
     }
+    assert_eq!(
+        xml.matches("<Unknown ").count(),
+        xml.matches("dependencies=").count()
+    );
     let mut vrs: Vec<(u32, String)> = vars.iter().map(|v| (v.vr, format!("{:?}", v.ty))).collect();
     vrs.sort();
     vrs.dedup();
