@@ -298,7 +298,9 @@ impl Snapshot {
     /// # Safety
     /// `p` must be null or a pointer this FMU returned and has not freed.
     pub unsafe fn from_ptr<'a>(p: *mut c_void) -> Option<&'a mut Snapshot> {
-        let s = (p as *mut Snapshot).as_mut()?;
+        // SAFETY: null, or a live `Snapshot` this FMU handed out (the caller's
+        // contract); the magic number below rejects most foreign pointers.
+        let s = unsafe { (p as *mut Snapshot).as_mut() }?;
         (s.magic == SNAPSHOT_MAGIC).then_some(s)
     }
 }
@@ -496,7 +498,9 @@ impl Instance {
     /// # Safety
     /// `p` must be null or a pointer this FMU returned and has not freed.
     pub unsafe fn from_ptr<'a>(p: *mut c_void) -> Option<&'a mut Instance> {
-        let s = (p as *mut Instance).as_mut()?;
+        // SAFETY: null, or a live `Instance` this FMU handed out (the caller's
+        // contract); the magic number below rejects most foreign pointers.
+        let s = unsafe { (p as *mut Instance).as_mut() }?;
         (s.magic == INSTANCE_MAGIC).then_some(s)
     }
 

@@ -164,3 +164,48 @@ fn crc32_known_value() {
     assert_eq!(crc32(b"123456789"), 0xCBF4_3926);
     assert_eq!(crc32(b""), 0);
 }
+
+/// `ffi.rs` (the C ABI) has a SAFETY comment above every `unsafe` block;
+/// `#![deny(unsafe_op_in_unsafe_fn)]` in lib.rs makes every unsafe operation
+/// in an `unsafe fn` take such a block.
+#[test]
+fn every_unsafe_block_in_ffi_has_a_safety_comment() {
+    for file in ["src/ffi.rs", "src/instance.rs"] {
+        let text =
+            std::fs::read_to_string(std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(file))
+                .unwrap();
+        let lines: Vec<&str> = text.lines().collect();
+        let mut blocks = 0;
+        for (i, line) in lines.iter().enumerate() {
+            let code = line.split("//").next().unwrap();
+            if !code.contains("unsafe {") {
+                continue;
+            }
+            blocks += 1;
+            // The comment lines right above this statement (or above the
+            // statement this line continues).
+            let mut j = i;
+            let mut found = false;
+            while j > 0 {
+                j -= 1;
+                let l = lines[j].trim_start();
+                if l.starts_with("//") {
+                    if l.contains("SAFETY:") {
+                        found = true;
+                        break;
+                    }
+                } else if l.ends_with(';') || l.ends_with('{') || l.ends_with('}') || l.is_empty() {
+                    break;
+                }
+            }
+            assert!(
+                found,
+                "{file}:{}: unsafe block without a SAFETY comment",
+                i + 1
+            );
+        }
+        assert!(blocks > 0, "{file}");
+    }
+    let lib = include_str!("../src/lib.rs");
+    assert!(lib.contains("#![deny(unsafe_op_in_unsafe_fn)]"));
+}
