@@ -714,10 +714,7 @@ pub unsafe extern "C" fn fmi2CancelStep(c: fmi2Component) -> fmi2Status {
 }
 
 fn require_status(inst: &Instance, func: &str) -> Res {
-    inst.require(
-        func,
-        &[Phase::StepComplete, Phase::StepFailed, Phase::Terminated],
-    )
+    inst.require(func)
 }
 
 fn discard(msg: String) -> Res<Status> {

@@ -13,8 +13,11 @@
 //!   `modelDescription.xml` writer shared by both FMUs.
 //! * [`yarn`], [`massspring`]: each model's inputs, parameters, outputs and
 //!   its part of a serialized FMU state.
-//! * [`instance`]: the FMI state machine around either model, FMU state
-//!   snapshots and their serialization.
+//! * [`instance`]: an instance around either model: clock, stepping, values.
+//! * [`state_machine`]: statuses, states and the table of the states each
+//!   function is allowed in.
+//! * [`state_bytes`]: FMU state snapshots and their serialization.
+//! * [`resources`], [`logging`]: the resource location and the logger.
 //! * [`ffi`]: the C ABI.
 //!
 //! See the README, section "YarnBundle: the FMI 2.0 Co-Simulation FMU", for
@@ -28,9 +31,13 @@
 
 pub mod ffi;
 pub mod instance;
+pub mod logging;
 pub mod massspring;
 pub mod model;
 pub mod package;
+pub mod resources;
+pub mod state_bytes;
+pub mod state_machine;
 pub mod yarn;
 
 pub use model::{guid, model_description, FmuScene, MODEL_IDENTIFIER};
