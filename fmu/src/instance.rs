@@ -1,5 +1,5 @@
 //! One FMU instance: the time keeping, the stepping and the values around a
-//! [`Physics`] (the yarn bundle of [`crate::yarn`] or the mass-spring system
+//! [`FmuModel`] (the yarn bundle of [`crate::yarn`] or the mass-spring system
 //! of [`crate::massspring`]), independent of the C ABI (which lives in
 //! [`crate::ffi`]). The state table is in [`crate::state_machine`], the FMU
 //! state bytes in [`crate::state_bytes`], the resource location in
@@ -7,156 +7,27 @@
 //! re-exported here.
 
 use std::ffi::{c_int, c_void, CString};
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
+pub use crate::fmu_model::{
+    new_model, FmuModel, ModelError, ModelResult, ParamCheck, SetContext, StepFailure,
+};
 pub use crate::logging::*;
 use crate::resources::read_scene;
 pub use crate::resources::resource_path;
 pub use crate::state_bytes::*;
-pub use crate::state_machine::{
-    error, parameter_settable, phase_name, Fail, ParamCheck, Phase, Res, Status,
-};
+pub use crate::state_machine::{error, parameter_settable, phase_name, Fail, Phase, Res, Status};
 
-use crate::massspring::MsModel;
 use crate::model::{
     FmuScene, DEFAULT_MAX_SUBSTEPS, DEFAULT_THREADS, LOG_CATEGORIES, MAX_THREADS, SCENE_FILE,
     VR_MAX_SUBSTEPS, VR_SUBSTEPS, VR_THREADS,
 };
-use crate::yarn::YarnModel;
-
-/// A substep that failed: the message, and whether the simulation is lost
-/// (non-finite state) rather than refused an input.
-#[derive(Clone, Debug, PartialEq)]
-pub struct StepFailure {
-    pub terminal: bool,
-    pub msg: String,
-}
-
-/// What an FMU simulates: the same state machine drives either model.
-#[derive(Clone, Debug)]
-pub enum Physics {
-    Yarn(Box<YarnModel>),
-    MassSpring(Box<MsModel>),
-}
-
-/// Calls the same method on either model.
-macro_rules! each {
-    ($p:expr, $m:ident => $e:expr) => {
-        match $p {
-            Physics::Yarn($m) => $e,
-            Physics::MassSpring($m) => $e,
-        }
-    };
-}
-
-impl Physics {
-    fn new(scene: &FmuScene) -> Res<Physics> {
-        Ok(match scene {
-            FmuScene::Yarn(s) => Physics::Yarn(Box::new(YarnModel::new(s.clone())?)),
-            FmuScene::MassSpring(l) => Physics::MassSpring(Box::new(MsModel::new(l.clone())?)),
-        })
-    }
-
-    /// Yarns or particles: the objects the outputs describe.
-    pub fn count(&self) -> usize {
-        each!(self, m => m.count())
-    }
-
-    /// The substep size in s.
-    pub fn dt(&self) -> f64 {
-        each!(self, m => m.dt())
-    }
-
-    fn rebuild(&mut self, count: usize) -> Res {
-        each!(self, m => m.rebuild(count))
-    }
-
-    /// Substep number `k` since initialization.
-    fn substep(&mut self, k: u64) -> Result<(), StepFailure> {
-        match self {
-            Physics::Yarn(m) => m.substep(),
-            Physics::MassSpring(m) => m.substep(k),
-        }
-    }
-
-    /// What a failed communication step goes back to: the yarn
-    /// simulation's own state bytes (a clone of the whole `YarnSim` with its
-    /// grid costs far more than its particles), the whole mass-spring model
-    /// (a clone is cheaper than its serialization).
-    fn checkpoint(&self) -> Checkpoint {
-        match self {
-            Physics::Yarn(m) => Checkpoint::Yarn(m.sim.save_state()),
-            Physics::MassSpring(m) => Checkpoint::MassSpring(m.clone()),
-        }
-    }
-
-    /// Puts back a [`Self::checkpoint`] of this model.
-    fn restore(&mut self, c: Checkpoint) {
-        match (self, c) {
-            (Physics::Yarn(m), Checkpoint::Yarn(bytes)) => {
-                m.sim
-                    .load_state(&bytes)
-                    .expect("the simulation's own state bytes load");
-                m.diag = None;
-            }
-            (Physics::MassSpring(m), Checkpoint::MassSpring(c)) => *m = c,
-            _ => unreachable!("a checkpoint of the other model"),
-        }
-    }
-
-    /// The model's stability bound on the substep in s (`None`: none).
-    fn stable_dt(&self) -> Option<f64> {
-        match self {
-            Physics::Yarn(m) => Some(m.sim.stable_dt()),
-            Physics::MassSpring(m) => m.sim.stable_dt(),
-        }
-    }
-
-    fn outputs_finite(&mut self) -> bool {
-        each!(self, m => m.outputs_finite())
-    }
-
-    fn is_state_output(&self, vr: u32) -> bool {
-        each!(self, m => m.is_state_output(vr))
-    }
-
-    fn get_real(&mut self, vr: u32) -> Option<f64> {
-        each!(self, m => m.get_real(vr))
-    }
-
-    fn get_boolean(&self, vr: u32) -> Option<c_int> {
-        each!(self, m => m.get_boolean(vr))
-    }
-
-    fn get_string(&self, vr: u32) -> Option<&str> {
-        each!(self, m => m.get_string(vr))
-    }
-
-    /// This model's part of a serialized FMU state.
-    pub fn write(&self, w: &mut Writer) {
-        each!(self, m => m.write(w))
-    }
-
-    /// First bytes of a serialized FMU state of this model.
-    pub fn state_magic(&self) -> &'static [u8; 8] {
-        match self {
-            Physics::Yarn(_) => YARN_STATE_MAGIC,
-            Physics::MassSpring(_) => MASS_SPRING_STATE_MAGIC,
-        }
-    }
-}
-
-/// The last good state of a communication step ([`Physics::checkpoint`]).
-enum Checkpoint {
-    Yarn(Vec<u8>),
-    MassSpring(Box<MsModel>),
-}
 
 /// Everything an FMU state holds: what `fmi2GetFMUstate` copies and
 /// `fmi2Reset` rebuilds.
 #[derive(Clone, Debug)]
 pub struct Model {
-    pub physics: Physics,
+    pub physics: Box<dyn FmuModel>,
     /// The simulation must be rebuilt from the scene and the parameters
     /// before use (a parameter changed).
     pub dirty: bool,
@@ -177,7 +48,7 @@ pub struct Model {
 impl Model {
     fn new(scene: &FmuScene) -> Res<Self> {
         Ok(Model {
-            physics: Physics::new(scene)?,
+            physics: new_model(scene)?,
             dirty: false,
             start_time: 0.0,
             stop_time: None,
@@ -629,7 +500,7 @@ impl Instance {
                     "fmi2GetBoolean: no Boolean variable has value reference {vr}"
                 ));
             };
-            out[k] = v;
+            out[k] = v as c_int;
         }
         Ok(())
     }
@@ -655,30 +526,29 @@ impl Instance {
     fn set_values(
         &mut self,
         func: &str,
-        set: impl FnOnce(&mut Physics, ParamCheck, &Path, &FmuScene) -> Res<bool>,
+        set: impl FnOnce(&mut dyn FmuModel, ParamCheck, &SetContext) -> ModelResult<bool>,
     ) -> Res {
         self.require(func)?;
         let phase = self.phase;
-        let check = |func: &str, vr: u32| parameter_settable(phase, func, vr);
-        let changed = set(
-            &mut self.model.physics,
-            &check,
-            &self.resources,
-            &self.bundled,
-        )?;
+        let check = |vr: u32| parameter_settable(phase, func, vr).map_err(|f| ModelError(f.msg));
+        let ctx = SetContext {
+            resources: &self.resources,
+            bundled: &self.bundled,
+        };
+        let changed = set(self.model.physics.as_mut(), &check, &ctx)?;
         self.model.dirty |= changed;
         self.model.outputs_checked = false;
         Ok(())
     }
 
     pub fn set_real(&mut self, vrs: &[u32], vals: &[f64]) -> Res {
-        self.set_values("fmi2SetReal", |physics, check, _, _| {
+        self.set_values("fmi2SetReal", |m, check, _| {
             if let Some((vr, v)) = vrs.iter().zip(vals).find(|(_, v)| !v.is_finite()) {
-                return error(format!(
-                    "fmi2SetReal: value {v} for value reference {vr} is not finite"
-                ));
+                return Err(ModelError(format!(
+                    "value {v} for value reference {vr} is not finite"
+                )));
             }
-            each!(physics, m => m.set_real(vrs, vals, check))
+            m.set_real(vrs, vals, check)
         })
     }
 
@@ -720,25 +590,16 @@ impl Instance {
     }
 
     pub fn set_boolean(&mut self, vrs: &[u32], vals: &[c_int]) -> Res {
-        self.set_values(
-            "fmi2SetBoolean",
-            |physics, check, _, _| each!(physics, m => m.set_boolean(vrs, vals, check)),
-        )
+        let vals: Vec<bool> = vals.iter().map(|&v| v != 0).collect();
+        self.set_values("fmi2SetBoolean", |m, check, _| {
+            m.set_boolean(vrs, &vals, check)
+        })
     }
 
     pub fn set_string(&mut self, vrs: &[u32], vals: &[Option<String>]) -> Res {
-        self.set_values(
-            "fmi2SetString",
-            |physics, check, resources, bundled| match (physics, bundled) {
-                (Physics::Yarn(m), FmuScene::Yarn(bundled)) => {
-                    m.set_string(vrs, vals, check, resources, bundled)
-                }
-                (Physics::MassSpring(m), _) => m.set_string(vrs, vals, check),
-                (Physics::Yarn(_), FmuScene::MassSpring(_)) => {
-                    unreachable!("a yarn model from a mass-spring scene")
-                }
-            },
-        )
+        self.set_values("fmi2SetString", |m, check, ctx| {
+            m.set_string(vrs, vals, check, ctx)
+        })
     }
 
     pub fn get_fmu_state(&mut self, into: Option<&mut Snapshot>) -> Res<Option<Box<Snapshot>>> {
@@ -763,8 +624,7 @@ impl Instance {
 
     pub fn set_fmu_state(&mut self, s: &Snapshot) -> Res {
         self.require("fmi2SetFMUstate")?;
-        let same_kind =
-            std::mem::discriminant(&s.model.physics) == std::mem::discriminant(&self.model.physics);
+        let same_kind = s.model.physics.state_magic() == self.model.physics.state_magic();
         if !same_kind || s.model.physics.count() != self.count {
             return error(
                 "fmi2SetFMUstate: the state belongs to another FMU (other model or number of outputs)",

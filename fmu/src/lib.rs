@@ -11,8 +11,10 @@
 //!
 //! * [`model`]: the YarnBundle variables and value references, GUIDs, the
 //!   `modelDescription.xml` writer shared by both FMUs.
+//! * [`fmu_model`]: the [`fmu_model::FmuModel`] trait between the FMI front
+//!   end and the models, with typed errors.
 //! * [`yarn`], [`massspring`]: each model's inputs, parameters, outputs and
-//!   its part of a serialized FMU state.
+//!   its part of a serialized FMU state (they implement `FmuModel`).
 //! * [`instance`]: an instance around either model: clock, stepping, values.
 //! * [`state_machine`]: statuses, states and the table of the states each
 //!   function is allowed in.
@@ -30,6 +32,7 @@
 #![deny(unsafe_op_in_unsafe_fn)]
 
 pub mod ffi;
+pub mod fmu_model;
 pub mod instance;
 pub mod logging;
 pub mod massspring;

@@ -6,10 +6,8 @@ use std::ffi::c_void;
 
 use yarnsim::mpm::state::fnv1a;
 
-use crate::instance::{Model, Physics};
-use crate::massspring::MsModel;
+use crate::instance::Model;
 use crate::state_machine::Phase;
-use crate::yarn::YarnModel;
 
 /// A saved FMU state (`fmi2FMUstate`).
 pub struct Snapshot {
@@ -222,12 +220,7 @@ pub fn deserialize(bytes: &[u8], current: &Model, count: usize) -> Result<(Phase
     let last_successful_time = r.f64()?;
     let substeps = r.u64()?;
     let built = !current.dirty;
-    let physics = match &current.physics {
-        Physics::Yarn(c) => Physics::Yarn(Box::new(YarnModel::read(&mut r, c, built, count)?)),
-        Physics::MassSpring(c) => {
-            Physics::MassSpring(Box::new(MsModel::read(&mut r, c, built, count)?))
-        }
-    };
+    let physics = current.physics.read(&mut r, built, count)?;
     Ok((
         phase,
         Model {

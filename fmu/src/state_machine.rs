@@ -25,6 +25,16 @@ pub struct Fail {
 
 pub type Res<T = ()> = Result<T, Fail>;
 
+/// A model's refusal is an fmi2Error.
+impl From<crate::fmu_model::ModelError> for Fail {
+    fn from(e: crate::fmu_model::ModelError) -> Self {
+        Fail {
+            status: Status::Error,
+            msg: e.0,
+        }
+    }
+}
+
 pub fn error<T>(msg: impl Into<String>) -> Res<T> {
     Err(Fail {
         status: Status::Error,
@@ -109,9 +119,6 @@ pub fn parameter_settable(phase: Phase, func: &str, vr: u32) -> Res {
         ))
     }
 }
-
-/// Checks that a parameter may be set now: `(function, value reference)`.
-pub type ParamCheck<'a> = &'a dyn Fn(&str, u32) -> Res;
 
 /// Where `fmi2Get*` may read values.
 const GET: &[Phase] = &[InitializationMode, StepComplete, StepFailed, Terminated];

@@ -54,7 +54,7 @@ fn run() -> Result<(), String> {
             .map_err(|e| e.to_string()),
         FmuScene::MassSpring(l) => YarnBundle::massspring::MsModel::new(l.clone())
             .map(|_| ())
-            .map_err(|f| f.msg),
+            .map_err(|e| e.0),
     }
     .map_err(|e| format!("{name}: {e}"))?;
     let xml = scene.model_description()?;
