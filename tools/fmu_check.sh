@@ -19,7 +19,7 @@ fi
 if ! "$venv/bin/python" -c 'import importlib.metadata as m; assert m.version("libcosimpy") == "0.0.6"' 2>/dev/null; then
     "$venv/bin/pip" install --quiet libcosimpy==0.0.6
 fi
-cargo build --release -p yarnsim-fmu --bins --lib
+cargo build --release -p yarnsim-fmu -p yarnsim-fmu-pack --bins --lib
 target=$(cargo metadata --format-version 1 --no-deps | "$venv/bin/python" -c 'import json,sys; print(json.load(sys.stdin)["target_directory"])')
 "$target/release/build-fmu" --no-build
 "$target/release/build-fmu" --no-build --scene fmu/scenes/small.toml -o "$target/fmu/YarnBundle-small.fmu"

@@ -7,7 +7,9 @@
 //! yarn bundle (`YarnBundle`), a mass-spring layout (`wire`, `cloth`, ...) the
 //! mass-spring system (`MassSpring`). The scene fixes the outputs (yarns or
 //! particles), so `modelDescription.xml` is generated from it
-//! ([`model::FmuScene::model_description`]) by the `build-fmu` packager.
+//! ([`model::FmuScene::model_description`]) by the `build-fmu` packager (crate
+//! `yarnsim-fmu-pack` in `fmu-pack/`, so this library does not carry the zip
+//! writer and the ELF reader).
 //!
 //! * [`model`]: the YarnBundle variables and value references, GUIDs, the
 //!   `modelDescription.xml` writer shared by both FMUs.
@@ -37,7 +39,6 @@ pub mod instance;
 pub mod logging;
 pub mod massspring;
 pub mod model;
-pub mod package;
 pub mod resources;
 pub mod state_bytes;
 pub mod state_machine;

@@ -1,51 +1,12 @@
-//! The packaged artefacts: the shared library's exports and dependencies,
-//! the generated modelDescription.xml and the .fmu archive.
+//! The generated modelDescription.xml (checked-in copies, structure, GUID)
+//! and the unsafe-code rules of the C ABI. The archive and the shared
+//! library's ELF check are tested in `fmu-pack/tests/pack.rs`.
 
 mod common;
-
-use std::path::PathBuf;
 
 use yarnsim::scene::builtin::yarn_reference;
 use yarnsim::scene::YarnScene;
 use YarnBundle::model::*;
-use YarnBundle::package::*;
-
-fn cdylib() -> PathBuf {
-    common::cdylib_path()
-}
-
-#[test]
-fn shared_library_exports_all_34_functions_and_needs_only_libc() {
-    let path = cdylib();
-    let so = std::fs::read(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-    let info = elf_info(&so).unwrap();
-    let mut fmi: Vec<&str> = info
-        .exported
-        .iter()
-        .map(|s| s.as_str())
-        .filter(|s| s.starts_with("fmi2"))
-        .collect();
-    fmi.sort();
-    fmi.dedup();
-    let mut expected = FMI2_FUNCTIONS.to_vec();
-    expected.sort();
-    assert_eq!(fmi, expected);
-    assert_eq!(fmi.len(), 34);
-    // libc and libm (plus the loader and libgcc_s, which Rust's unwinder
-    // needs for catch_unwind); nothing else.
-    assert!(
-        info.needed.iter().any(|n| n == "libc.so.6"),
-        "{:?}",
-        info.needed
-    );
-    for n in &info.needed {
-        assert!(
-            ALLOWED_NEEDED.contains(&n.as_str()),
-            "unexpected dependency {n}"
-        );
-    }
-    check_library(&so).unwrap();
-}
 
 #[test]
 fn checked_in_model_description_is_current() {
@@ -53,7 +14,7 @@ fn checked_in_model_description_is_current() {
     let generated = model_description(&yarn_reference());
     assert!(
         checked_in == generated,
-        "modelDescription/YarnBundle.xml drifted from the generator; refresh it with\n  cargo run --release -p yarnsim-fmu --bin build-fmu -- --model-description modelDescription/YarnBundle.xml"
+        "modelDescription/YarnBundle.xml drifted from the generator; refresh it with\n  cargo run --release -p yarnsim-fmu-pack --bin build-fmu -- --model-description modelDescription/YarnBundle.xml"
     );
 }
 
@@ -128,41 +89,6 @@ fn guid_follows_the_scene_and_survives_the_scene_file() {
     other.time.dt *= 0.5;
     assert_ne!(guid(&other), guid(&scene));
     assert_ne!(guid(&yarn_reference()), guid(&scene));
-}
-
-#[test]
-fn fmu_archive_layout_and_contents() {
-    let scene = common::small_scene();
-    let so = b"\x7fELF not really".to_vec();
-    let zip = build_fmu(&scene.clone().into(), &so).unwrap();
-    let entries = zip_entries(&zip).unwrap();
-    let names: Vec<&str> = entries.iter().map(|(n, _)| n.as_str()).collect();
-    assert_eq!(
-        names,
-        [
-            "modelDescription.xml",
-            "binaries/linux64/YarnBundle.so",
-            "resources/scene.toml",
-            "documentation/index.html"
-        ]
-    );
-    assert_eq!(entries[0].1, model_description(&scene).into_bytes());
-    assert_eq!(entries[1].1, so);
-    let packed = YarnScene::from_toml_str(std::str::from_utf8(&entries[2].1).unwrap()).unwrap();
-    assert_eq!(guid(&packed), guid(&scene));
-    // Reproducible: the same inputs give the same bytes.
-    assert_eq!(build_fmu(&scene.clone().into(), &so).unwrap(), zip);
-    // A corrupted archive is detected.
-    let mut bad = zip.clone();
-    let at = zip.windows(4).position(|w| w == b"kind").unwrap();
-    bad[at] ^= 1;
-    assert!(zip_entries(&bad).is_err());
-}
-
-#[test]
-fn crc32_known_value() {
-    assert_eq!(crc32(b"123456789"), 0xCBF4_3926);
-    assert_eq!(crc32(b""), 0);
 }
 
 /// `ffi.rs` (the C ABI) has a SAFETY comment above every `unsafe` block;

@@ -1,7 +1,7 @@
 //! Packs the YarnBundle FMU, or a MassSpring FMU for a mass-spring scene.
 //!
 //! ```text
-//! cargo run --release -p yarnsim-fmu --bin build-fmu -- [--scene NAME_OR_FILE] [-o OUT.fmu]
+//! cargo run --release -p yarnsim-fmu-pack --bin build-fmu -- [--scene NAME_OR_FILE] [-o OUT.fmu]
 //!     [--lib libYarnBundle.so | --no-build] [--model-description FILE]
 //! ```
 //!
@@ -18,7 +18,7 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use yarnsim::scene::{Scene, DEFAULT_SCENE};
-use YarnBundle::package::{build_fmu, check_library, zip_entries};
+use yarnsim_fmu_pack::{build_fmu, check_library, zip_entries};
 use YarnBundle::{FmuScene, MODEL_IDENTIFIER};
 
 const USAGE: &str = "usage: build-fmu [--scene NAME_OR_FILE] [-o OUT.fmu] [--lib libYarnBundle.so | --no-build] [--model-description FILE]";
