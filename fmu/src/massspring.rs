@@ -37,7 +37,8 @@ pub const VR_ELASTIC_ENERGY: u32 = 101;
 pub const VR_GRAVITY_ENERGY: u32 = 102;
 pub const VR_TOTAL_ENERGY: u32 = 103;
 pub const VR_MAX_STRAIN: u32 = 104;
-pub const VR_SUBSTEPS: u32 = 200; // Integer
+/// The substep count, common to every model ([`crate::model::COMMON_VARIABLES`]).
+pub use crate::model::VR_SUBSTEPS;
 /// `particle[i].x` has `VR_PARTICLE_BASE + 3 i`, then `.y`, `.z`.
 pub const VR_PARTICLE_BASE: u32 = 1000;
 
@@ -148,17 +149,7 @@ pub fn variables(layout: &Layout) -> Result<Vec<Variable>, String> {
             d.into(),
         ));
     }
-    v.push(var(
-        "substeps".into(),
-        VR_SUBSTEPS,
-        VarType::Integer,
-        "output",
-        "discrete",
-        None,
-        None,
-        "Substeps taken since initialization".into(),
-    ));
-    v.extend(crate::model::execution_parameters());
+    v.extend(crate::model::common_variables());
     for i in 0..n {
         for (k, axis) in ["x", "y", "z"].into_iter().enumerate() {
             v.push(var(

@@ -75,8 +75,8 @@ impl Inputs {
 #[derive(Clone, Debug, PartialEq)]
 pub struct Config {
     pub scene_path: String,
-    /// Overrides of [`REAL_PARAMETERS`], in that order.
-    pub reals: [Option<f64>; 7],
+    /// Overrides of [`yarn_real_parameters`], in that order.
+    pub reals: [Option<f64>; YARN_REAL_PARAMETERS],
     pub plasticity: Option<bool>,
 }
 
@@ -84,50 +84,27 @@ impl Default for Config {
     fn default() -> Self {
         Config {
             scene_path: SCENE_FILE.to_string(),
-            reals: [None; 7],
+            reals: [None; YARN_REAL_PARAMETERS],
             plasticity: None,
         }
     }
 }
 
-fn real_param_index(vr: u32) -> Option<usize> {
-    REAL_PARAMETERS.iter().position(|&p| p == vr)
-}
-
-fn scene_real(scene: &YarnScene, vr: u32) -> f64 {
-    let m = &scene.material;
-    match vr {
-        VR_K => m.k,
-        VR_GAMMA => m.gamma,
-        VR_YOUNGS_MODULUS => m.youngs_modulus,
-        VR_FRICTION => m.friction,
-        VR_BENDING => m.bending,
-        VR_DENSITY => m.density,
-        VR_DT => scene.time.dt,
-        _ => unreachable!("not a real parameter: {vr}"),
-    }
-}
-
-fn set_scene_real(scene: &mut YarnScene, vr: u32, v: f64) {
-    let m = &mut scene.material;
-    match vr {
-        VR_K => m.k = v,
-        VR_GAMMA => m.gamma = v,
-        VR_YOUNGS_MODULUS => m.youngs_modulus = v,
-        VR_FRICTION => m.friction = v,
-        VR_BENDING => m.bending = v,
-        VR_DENSITY => m.density = v,
-        VR_DT => scene.time.dt = v,
-        _ => unreachable!("not a real parameter: {vr}"),
-    }
+/// Index of the Real parameter `vr` in [`yarn_real_parameters`] and its
+/// scene field.
+fn real_param(vr: u32) -> Option<(usize, SceneField)> {
+    yarn_real_parameters()
+        .enumerate()
+        .find(|(_, (p, _))| *p == vr)
+        .map(|(i, (_, f))| (i, f))
 }
 
 /// The base scene with the parameter overrides applied.
 fn effective_scene(base: &YarnScene, config: &Config) -> YarnScene {
     let mut s = base.clone();
-    for (k, &vr) in REAL_PARAMETERS.iter().enumerate() {
+    for (k, (_, field)) in yarn_real_parameters().enumerate() {
         if let Some(v) = config.reals[k] {
-            set_scene_real(&mut s, vr, v);
+            (field.set)(&mut s, v);
         }
     }
     if let Some(p) = config.plasticity {
@@ -231,9 +208,9 @@ impl YarnModel {
             VR_ATTRACTOR_STRENGTH => self.inputs.strength,
             VR_GRAVITY_X => self.inputs.gravity[0],
             VR_GRAVITY_Y => self.inputs.gravity[1],
-            _ if real_param_index(vr).is_some() => {
-                let i = real_param_index(vr).unwrap();
-                self.config.reals[i].unwrap_or_else(|| scene_real(&self.base, vr))
+            _ if real_param(vr).is_some() => {
+                let (i, field) = real_param(vr).unwrap();
+                self.config.reals[i].unwrap_or_else(|| (field.get)(&self.base))
             }
             VR_KINETIC_ENERGY => self.diagnostics().kinetic_energy,
             VR_ELASTIC_ENERGY => self.diagnostics().elastic_energy,
@@ -280,18 +257,16 @@ impl YarnModel {
                 VR_ATTRACTOR_STRENGTH => inputs.strength = v,
                 VR_GRAVITY_X => inputs.gravity[0] = v,
                 VR_GRAVITY_Y => inputs.gravity[1] = v,
-                _ if real_param_index(vr).is_some() => {
+                _ if real_param(vr).is_some() => {
                     param_ok(vr)?;
-                    let ok = match vr {
-                        VR_DENSITY | VR_DT => v > 0.0,
-                        _ => v >= 0.0,
-                    } && v <= 1e12;
+                    let (i, field) = real_param(vr).unwrap();
+                    let ok = if field.positive { v > 0.0 } else { v >= 0.0 } && v <= 1e12;
                     if !ok {
                         return refuse(format!(
                             "parameter value reference {vr} = {v} is out of range"
                         ));
                     }
-                    reals[real_param_index(vr).unwrap()] = Some(v);
+                    reals[i] = Some(v);
                 }
                 _ => {
                     return refuse(format!(
@@ -419,7 +394,7 @@ impl YarnModel {
         };
         inputs.check().map_err(|e| e.0)?;
         let scene_path = r.string()?;
-        let mut reals = [None; 7];
+        let mut reals = [None; YARN_REAL_PARAMETERS];
         for v in &mut reals {
             *v = r.opt_f64()?;
         }
