@@ -72,7 +72,7 @@ prop_compose! {
         vx in -20.0f64..20.0, vy in -20.0f64..20.0,
         gx in -200.0f64..200.0, gy in -200.0f64..200.0,
         walls in 0u8..3, obstacle in proptest::option::of((0.3f64..0.7, 0.3f64..0.7, 0.03f64..0.15)),
-        plastic in any::<bool>(), bending in 0.0f64..200.0, stiffness in 0.1f64..10.0,
+        plastic in any::<bool>(), bending in 0.0f64..1e-2, stiffness in 0.1f64..10.0,
         dt in 2e-5f64..2e-4,
     ) -> YarnScene {
         random_scene((sx, sy), angle, length, vertices, count, (vx, vy), (gx, gy), walls,
@@ -160,6 +160,8 @@ proptest! {
     /// A scene survives the TOML round trip unchanged.
     #[test]
     fn random_scenes_round_trip_through_toml(scene in scenes()) {
+        // only valid scenes load (a copy may leave the grid interior)
+        prop_assume!(scene.validate().is_ok());
         let text = scene.to_toml_string();
         let back = YarnScene::from_toml_str(&text).unwrap();
         prop_assert_eq!(back, scene);

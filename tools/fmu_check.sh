@@ -5,7 +5,10 @@
 # simulates the small one and the wire (two integrators) with input signals
 # and compares their outputs bit for bit with the Rust library run of the
 # same inputs (fmu-replay), round-trips FMU states through fmpy, and runs
-# the default FMU for two frames. Exits non-zero on failure.
+# the default FMU for two frames; then runs the small and the wire FMUs in
+# libcosimpy 0.0.6 (the Open Simulation Platform's libcosim: an input
+# changed through its override manipulator, two FMUs connected output ->
+# input) and compares them bit for bit with fmpy. Exits non-zero on failure.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 venv=tools/.venv
@@ -13,7 +16,10 @@ if ! "$venv/bin/python" -c 'import fmpy; assert fmpy.__version__ == "0.3.32"' 2>
     python3 -m venv "$venv"
     "$venv/bin/pip" install --quiet fmpy==0.3.32
 fi
-cargo build --release -p yarnsim-fmu --bins --lib
+if ! "$venv/bin/python" -c 'import importlib.metadata as m; assert m.version("libcosimpy") == "0.0.6"' 2>/dev/null; then
+    "$venv/bin/pip" install --quiet libcosimpy==0.0.6
+fi
+cargo build --release -p yarnsim-fmu -p yarnsim-fmu-pack --bins --lib
 target=$(cargo metadata --format-version 1 --no-deps | "$venv/bin/python" -c 'import json,sys; print(json.load(sys.stdin)["target_directory"])')
 "$target/release/build-fmu" --no-build
 "$target/release/build-fmu" --no-build --scene fmu/scenes/small.toml -o "$target/fmu/YarnBundle-small.fmu"
@@ -22,3 +28,4 @@ work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 "$venv/bin/python" tools/fmu_check.py "$target/fmu/YarnBundle-small.fmu" "$target/fmu/YarnBundle.fmu" \
     "$work" "$target/release/fmu-replay" fmu/scenes/small.toml "$target/fmu/MassSpring-wire.fmu"
+"$venv/bin/python" tools/cosim_check.py "$target/fmu/YarnBundle-small.fmu" "$target/fmu/MassSpring-wire.fmu"

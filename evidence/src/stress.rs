@@ -237,10 +237,10 @@ pub fn yarn_stable(scene: &YarnScene, dt: f64) -> bool {
 }
 
 /// The yarn's theoretical step bound (Courant number 1), see the module docs.
+/// The wave speed and the formula are the solver's
+/// ([`crate::mpm::timestep::stable_dt`]); the speed is the one gravity and
+/// attractor can give over the probe time.
 pub fn yarn_bound(scene: &YarnScene) -> f64 {
-    let m = &scene.material;
-    let stiff = m.k.max(m.gamma).max(2.0 * m.mu() + m.lambda());
-    let c = (stiff / m.density).sqrt();
     let g = Vec2::from(scene.gravity).norm();
     let a = if scene.attractor.active {
         scene.attractor.strength
@@ -248,7 +248,7 @@ pub fn yarn_bound(scene: &YarnScene) -> f64 {
         0.0
     };
     let v = (g + a) * YARN_PROBE_TIME;
-    scene.dx() / (c + v)
+    yarnsim::mpm::timestep::stable_dt(&scene.material, scene.dx(), v)
 }
 
 /// The yarn parameter sweep: (label, value, scene).

@@ -14,6 +14,11 @@
 //! 3. For scale: `fmi2DoStep` with h = dt (one substep) against the
 //!    library's step called directly, interleaved, alternating which goes
 //!    first (each evicts the other's data from the caches).
+//! 4. The end-of-step work of a step that runs substeps: the finite check
+//!    of every output (for the yarn bundle with its diagnostics, computed
+//!    anew after a substep) and the checkpoint of the last good state (the
+//!    yarn's state bytes, a clone of the mass-spring model), each against
+//!    one substep (3.).
 //!
 //! SCENE is a yarn scene (default `fmu/scenes/small.toml`) or a mass-spring
 //! one (`wire`, `cloth`, a file), which measures the MassSpring FMU.
@@ -199,6 +204,55 @@ fn main() {
             lib_s / steps as f64 * 1e6
         );
         fmi2FreeInstance(c);
+        let one_substep = fmu_s / steps as f64;
+
+        // 4. What a communication step that runs substeps adds: the check
+        // of every output (the yarn's diagnostics are recomputed after a
+        // substep) and the clone of the last good state.
+        let reps = 200.min(calls).max(1);
+        let (check_s, clone_s) = match &scene {
+            FmuScene::Yarn(s) => {
+                let mut m = YarnBundle::yarn::YarnModel::new(s.clone()).unwrap();
+                for _ in 0..20 {
+                    m.substep().unwrap();
+                }
+                let t0 = Instant::now();
+                for _ in 0..reps {
+                    m.diag = None;
+                    assert!(black_box(&mut m).outputs_finite());
+                }
+                let check = t0.elapsed().as_secs_f64() / reps as f64;
+                // The yarn's checkpoint is the library's state bytes.
+                let t0 = Instant::now();
+                for _ in 0..reps {
+                    black_box(m.sim.save_state());
+                }
+                (check, t0.elapsed().as_secs_f64() / reps as f64)
+            }
+            FmuScene::MassSpring(l) => {
+                let mut m = MsModel::new(l.clone()).unwrap();
+                for k in 0..20 {
+                    m.substep(k).unwrap();
+                }
+                let t0 = Instant::now();
+                for _ in 0..reps {
+                    assert!(black_box(&m).outputs_finite());
+                }
+                let check = t0.elapsed().as_secs_f64() / reps as f64;
+                let t0 = Instant::now();
+                for _ in 0..reps {
+                    black_box(m.clone());
+                }
+                (check, t0.elapsed().as_secs_f64() / reps as f64)
+            }
+        };
+        println!(
+            "end of a step with substeps: output check {:.2} us ({:.1} % of one substep), last-good checkpoint {:.2} us ({:.1} %)",
+            check_s * 1e6,
+            100.0 * check_s / one_substep,
+            clone_s * 1e6,
+            100.0 * clone_s / one_substep
+        );
     }
     let _ = std::fs::remove_dir_all(dir);
 }

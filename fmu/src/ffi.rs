@@ -136,33 +136,88 @@ fn ok(r: Res) -> Res<Status> {
 }
 
 /// A slice from a C array; `None` for a null pointer with a nonzero length.
+///
+/// # Safety
+/// `p` must be null or point to `n` initialized, aligned elements that stay
+/// valid and unchanged for `'a` (the FMI contract for the arrays it passes).
 unsafe fn slice<'a, T>(p: *const T, n: size_t) -> Option<&'a [T]> {
     if n == 0 {
         Some(&[])
     } else if p.is_null() {
         None
     } else {
-        Some(std::slice::from_raw_parts(p, n))
+        // SAFETY: non-null, `n` elements valid for `'a` (the caller's contract).
+        Some(unsafe { std::slice::from_raw_parts(p, n) })
     }
 }
 
+/// A mutable slice from a C array; `None` for a null pointer with a nonzero
+/// length.
+///
+/// # Safety
+/// `p` must be null or point to `n` aligned elements, writable and not
+/// aliased for `'a`.
 unsafe fn slice_mut<'a, T>(p: *mut T, n: size_t) -> Option<&'a mut [T]> {
     if n == 0 {
         Some(&mut [])
     } else if p.is_null() {
         None
     } else {
-        Some(std::slice::from_raw_parts_mut(p, n))
+        // SAFETY: non-null, `n` writable unaliased elements (the caller's contract).
+        Some(unsafe { std::slice::from_raw_parts_mut(p, n) })
     }
 }
 
+/// A C string as an owned Rust string (invalid UTF-8 replaced); `None` for null.
+///
+/// # Safety
+/// `p` must be null or point to a NUL-terminated string valid for the call.
 unsafe fn string(p: fmi2String) -> Option<String> {
-    (!p.is_null()).then(|| CStr::from_ptr(p).to_string_lossy().into_owned())
+    // SAFETY: non-null and NUL-terminated (the caller's contract).
+    (!p.is_null()).then(|| unsafe { CStr::from_ptr(p) }.to_string_lossy().into_owned())
 }
 
 fn null(func: &str, what: &str) -> Res<Status> {
     error(format!("{func}: {what} is a null pointer"))
 }
+
+/// The 34 functions of FMI 2.0 Co-Simulation (25 common, 9 co-simulation).
+pub const FMI2_FUNCTIONS: [&str; 34] = [
+    "fmi2GetTypesPlatform",
+    "fmi2GetVersion",
+    "fmi2SetDebugLogging",
+    "fmi2Instantiate",
+    "fmi2FreeInstance",
+    "fmi2SetupExperiment",
+    "fmi2EnterInitializationMode",
+    "fmi2ExitInitializationMode",
+    "fmi2Terminate",
+    "fmi2Reset",
+    "fmi2GetReal",
+    "fmi2GetInteger",
+    "fmi2GetBoolean",
+    "fmi2GetString",
+    "fmi2SetReal",
+    "fmi2SetInteger",
+    "fmi2SetBoolean",
+    "fmi2SetString",
+    "fmi2GetFMUstate",
+    "fmi2SetFMUstate",
+    "fmi2FreeFMUstate",
+    "fmi2SerializedFMUstateSize",
+    "fmi2SerializeFMUstate",
+    "fmi2DeSerializeFMUstate",
+    "fmi2GetDirectionalDerivative",
+    "fmi2SetRealInputDerivatives",
+    "fmi2GetRealOutputDerivatives",
+    "fmi2DoStep",
+    "fmi2CancelStep",
+    "fmi2GetStatus",
+    "fmi2GetRealStatus",
+    "fmi2GetIntegerStatus",
+    "fmi2GetBooleanStatus",
+    "fmi2GetStringStatus",
+];
 
 // ---------------------------------------------------------------- common
 
@@ -184,12 +239,14 @@ pub unsafe extern "C" fn fmi2SetDebugLogging(
     categories: *const fmi2String,
 ) -> fmi2Status {
     call(c, "fmi2SetDebugLogging", |inst| {
-        let Some(cats) = slice(categories, nCategories) else {
+        // SAFETY: FMI passes `nCategories` category strings.
+        let Some(cats) = (unsafe { slice(categories, nCategories) }) else {
             return null("fmi2SetDebugLogging", "categories");
         };
         let mut names = Vec::with_capacity(cats.len());
         for &p in cats {
-            match string(p) {
+            // SAFETY: each category is null or a NUL-terminated string.
+            match unsafe { string(p) } {
                 Some(s) => names.push(s),
                 None => return null("fmi2SetDebugLogging", "a category"),
             }
@@ -209,21 +266,28 @@ pub unsafe extern "C" fn fmi2Instantiate(
     _visible: fmi2Boolean,
     loggingOn: fmi2Boolean,
 ) -> fmi2Component {
-    let Some(cb) = functions.as_ref().copied() else {
+    // SAFETY: `functions` is null or points to the environment's callback
+    // struct, valid for the call; it is copied out.
+    let Some(cb) = (unsafe { functions.as_ref() }).copied() else {
         return std::ptr::null_mut();
     };
-    let name = string(instanceName);
+    // SAFETY: null or a NUL-terminated string (FMI contract).
+    let name = unsafe { string(instanceName) };
     let fail = |msg: &str| {
         if let Some(logger) = cb.logger {
             let n = crate::instance::escape_nul(name.as_deref().unwrap_or("?"));
             let m = crate::instance::escape_log(&format!("fmi2Instantiate: {msg}"));
-            logger(
-                cb.componentEnvironment,
-                n.as_ptr(),
-                fmi2Error,
-                c"logStatusError".as_ptr(),
-                m.as_ptr(),
-            );
+            // SAFETY: the environment's logger; the message is
+            // pre-formatted and escaped, so no variadic argument is read.
+            unsafe {
+                logger(
+                    cb.componentEnvironment,
+                    n.as_ptr(),
+                    fmi2Error,
+                    c"logStatusError".as_ptr(),
+                    m.as_ptr(),
+                )
+            };
         }
         std::ptr::null_mut()
     };
@@ -236,10 +300,12 @@ pub unsafe extern "C" fn fmi2Instantiate(
                 "fmuType {fmuType} is not fmi2CoSimulation: this is a Co-Simulation FMU only"
             ));
         }
-        let Some(guid) = string(fmuGUID) else {
+        // SAFETY: null or NUL-terminated strings (FMI contract).
+        let Some(guid) = (unsafe { string(fmuGUID) }) else {
             return Err("the GUID is a null pointer".into());
         };
-        let Some(res) = string(fmuResourceLocation) else {
+        // SAFETY: as above.
+        let Some(res) = (unsafe { string(fmuResourceLocation) }) else {
             return Err("the resource location is a null pointer".into());
         };
         Instance::new(
@@ -260,11 +326,16 @@ pub unsafe extern "C" fn fmi2Instantiate(
 
 #[no_mangle]
 pub unsafe extern "C" fn fmi2FreeInstance(c: fmi2Component) {
-    let Some(inst) = Instance::from_ptr(c) else {
+    // SAFETY: `c` is null or a component this FMU handed out and the
+    // environment has not freed (FMI contract); the magic number rejects
+    // foreign pointers in most cases.
+    let Some(inst) = (unsafe { Instance::from_ptr(c) }) else {
         return;
     };
     inst.invalidate();
-    let b = Box::from_raw(inst as *mut Instance);
+    // SAFETY: the component was made by `Box::into_raw` in fmi2Instantiate
+    // and is freed once (the magic is cleared above).
+    let b = unsafe { Box::from_raw(inst as *mut Instance) };
     let _ = catch_unwind(AssertUnwindSafe(move || drop(b)));
 }
 
@@ -295,7 +366,7 @@ pub unsafe extern "C" fn fmi2EnterInitializationMode(c: fmi2Component) -> fmi2St
 #[no_mangle]
 pub unsafe extern "C" fn fmi2ExitInitializationMode(c: fmi2Component) -> fmi2Status {
     call(c, "fmi2ExitInitializationMode", |inst| {
-        ok(inst.exit_initialization_mode())
+        inst.exit_initialization_mode()
     })
 }
 
@@ -317,7 +388,10 @@ pub unsafe extern "C" fn fmi2GetReal(
     value: *mut fmi2Real,
 ) -> fmi2Status {
     call(c, "fmi2GetReal", |inst| {
-        let (Some(vrs), Some(out)) = (slice(vr, nvr), slice_mut(value, nvr)) else {
+        // SAFETY: FMI passes `nvr` value references and a writable array of
+        // `nvr` values (null only when `nvr` is 0, else refused).
+        let (Some(vrs), Some(out)) = (unsafe { slice(vr, nvr) }, unsafe { slice_mut(value, nvr) })
+        else {
             return null("fmi2GetReal", "vr or value");
         };
         ok(inst.get_real(vrs, out))
@@ -332,7 +406,10 @@ pub unsafe extern "C" fn fmi2GetInteger(
     value: *mut fmi2Integer,
 ) -> fmi2Status {
     call(c, "fmi2GetInteger", |inst| {
-        let (Some(vrs), Some(out)) = (slice(vr, nvr), slice_mut(value, nvr)) else {
+        // SAFETY: FMI passes `nvr` value references and a writable array of
+        // `nvr` values (null only when `nvr` is 0, else refused).
+        let (Some(vrs), Some(out)) = (unsafe { slice(vr, nvr) }, unsafe { slice_mut(value, nvr) })
+        else {
             return null("fmi2GetInteger", "vr or value");
         };
         ok(inst.get_integer(vrs, out))
@@ -347,7 +424,10 @@ pub unsafe extern "C" fn fmi2GetBoolean(
     value: *mut fmi2Boolean,
 ) -> fmi2Status {
     call(c, "fmi2GetBoolean", |inst| {
-        let (Some(vrs), Some(out)) = (slice(vr, nvr), slice_mut(value, nvr)) else {
+        // SAFETY: FMI passes `nvr` value references and a writable array of
+        // `nvr` values (null only when `nvr` is 0, else refused).
+        let (Some(vrs), Some(out)) = (unsafe { slice(vr, nvr) }, unsafe { slice_mut(value, nvr) })
+        else {
             return null("fmi2GetBoolean", "vr or value");
         };
         ok(inst.get_boolean(vrs, out))
@@ -362,7 +442,10 @@ pub unsafe extern "C" fn fmi2GetString(
     value: *mut fmi2String,
 ) -> fmi2Status {
     call(c, "fmi2GetString", |inst| {
-        let (Some(vrs), Some(out)) = (slice(vr, nvr), slice_mut(value, nvr)) else {
+        // SAFETY: FMI passes `nvr` value references and a writable array of
+        // `nvr` values (null only when `nvr` is 0, else refused).
+        let (Some(vrs), Some(out)) = (unsafe { slice(vr, nvr) }, unsafe { slice_mut(value, nvr) })
+        else {
             return null("fmi2GetString", "vr or value");
         };
         let strings = inst.get_string(vrs)?;
@@ -381,7 +464,10 @@ pub unsafe extern "C" fn fmi2SetReal(
     value: *const fmi2Real,
 ) -> fmi2Status {
     call(c, "fmi2SetReal", |inst| {
-        let (Some(vrs), Some(vals)) = (slice(vr, nvr), slice(value, nvr)) else {
+        // SAFETY: FMI passes `nvr` value references and `nvr` values (null
+        // only when `nvr` is 0, else refused).
+        let (Some(vrs), Some(vals)) = (unsafe { slice(vr, nvr) }, unsafe { slice(value, nvr) })
+        else {
             return null("fmi2SetReal", "vr or value");
         };
         ok(inst.set_real(vrs, vals))
@@ -396,7 +482,10 @@ pub unsafe extern "C" fn fmi2SetInteger(
     value: *const fmi2Integer,
 ) -> fmi2Status {
     call(c, "fmi2SetInteger", |inst| {
-        let (Some(vrs), Some(vals)) = (slice(vr, nvr), slice(value, nvr)) else {
+        // SAFETY: FMI passes `nvr` value references and `nvr` values (null
+        // only when `nvr` is 0, else refused).
+        let (Some(vrs), Some(vals)) = (unsafe { slice(vr, nvr) }, unsafe { slice(value, nvr) })
+        else {
             return null("fmi2SetInteger", "vr or value");
         };
         ok(inst.set_integer(vrs, vals))
@@ -411,7 +500,10 @@ pub unsafe extern "C" fn fmi2SetBoolean(
     value: *const fmi2Boolean,
 ) -> fmi2Status {
     call(c, "fmi2SetBoolean", |inst| {
-        let (Some(vrs), Some(vals)) = (slice(vr, nvr), slice(value, nvr)) else {
+        // SAFETY: FMI passes `nvr` value references and `nvr` values (null
+        // only when `nvr` is 0, else refused).
+        let (Some(vrs), Some(vals)) = (unsafe { slice(vr, nvr) }, unsafe { slice(value, nvr) })
+        else {
             return null("fmi2SetBoolean", "vr or value");
         };
         ok(inst.set_boolean(vrs, vals))
@@ -426,10 +518,14 @@ pub unsafe extern "C" fn fmi2SetString(
     value: *const fmi2String,
 ) -> fmi2Status {
     call(c, "fmi2SetString", |inst| {
-        let (Some(vrs), Some(vals)) = (slice(vr, nvr), slice(value, nvr)) else {
+        // SAFETY: FMI passes `nvr` value references and `nvr` values (null
+        // only when `nvr` is 0, else refused).
+        let (Some(vrs), Some(vals)) = (unsafe { slice(vr, nvr) }, unsafe { slice(value, nvr) })
+        else {
             return null("fmi2SetString", "vr or value");
         };
-        let vals: Vec<Option<String>> = vals.iter().map(|&p| string(p)).collect();
+        // SAFETY: each value is null or a NUL-terminated string (FMI contract).
+        let vals: Vec<Option<String>> = vals.iter().map(|&p| unsafe { string(p) }).collect();
         ok(inst.set_string(vrs, &vals))
     })
 }
@@ -440,13 +536,16 @@ pub unsafe extern "C" fn fmi2GetFMUstate(
     FMUstate: *mut fmi2FMUstate,
 ) -> fmi2Status {
     call(c, "fmi2GetFMUstate", |inst| {
-        let Some(slot) = FMUstate.as_mut() else {
+        // SAFETY: `FMUstate` is null or points to the environment's state slot.
+        let Some(slot) = (unsafe { FMUstate.as_mut() }) else {
             return null("fmi2GetFMUstate", "FMUstate");
         };
         let existing = if slot.is_null() {
             None
         } else {
-            match Snapshot::from_ptr(*slot) {
+            // SAFETY: a non-null slot holds a state this FMU handed out
+            // (FMI contract); the magic number rejects others.
+            match unsafe { Snapshot::from_ptr(*slot) } {
                 Some(s) => Some(s),
                 None => return error("*FMUstate is not an FMU state of this FMU"),
             }
@@ -461,7 +560,8 @@ pub unsafe extern "C" fn fmi2GetFMUstate(
 #[no_mangle]
 pub unsafe extern "C" fn fmi2SetFMUstate(c: fmi2Component, FMUstate: fmi2FMUstate) -> fmi2Status {
     call(c, "fmi2SetFMUstate", |inst| {
-        let Some(s) = Snapshot::from_ptr(FMUstate) else {
+        // SAFETY: null or a state this FMU handed out (checked by its magic).
+        let Some(s) = (unsafe { Snapshot::from_ptr(FMUstate) }) else {
             return error("FMUstate is null or not an FMU state of this FMU");
         };
         ok(inst.set_fmu_state(s))
@@ -474,16 +574,20 @@ pub unsafe extern "C" fn fmi2FreeFMUstate(
     FMUstate: *mut fmi2FMUstate,
 ) -> fmi2Status {
     call(c, "fmi2FreeFMUstate", |_inst| {
-        let Some(slot) = FMUstate.as_mut() else {
+        // SAFETY: `FMUstate` is null or points to the environment's state slot.
+        let Some(slot) = (unsafe { FMUstate.as_mut() }) else {
             return Ok(Status::Ok);
         };
         if slot.is_null() {
             return Ok(Status::Ok);
         }
-        let Some(s) = Snapshot::from_ptr(*slot) else {
+        // SAFETY: a non-null slot holds a state this FMU handed out.
+        let Some(s) = (unsafe { Snapshot::from_ptr(*slot) }) else {
             return error("*FMUstate is not an FMU state of this FMU");
         };
-        drop(Box::from_raw(s as *mut Snapshot));
+        // SAFETY: states are made by `Box::into_raw`; the slot is cleared
+        // below, so it is freed once.
+        drop(unsafe { Box::from_raw(s as *mut Snapshot) });
         *slot = std::ptr::null_mut();
         Ok(Status::Ok)
     })
@@ -496,10 +600,12 @@ pub unsafe extern "C" fn fmi2SerializedFMUstateSize(
     size: *mut size_t,
 ) -> fmi2Status {
     call(c, "fmi2SerializedFMUstateSize", |inst| {
-        let Some(s) = Snapshot::from_ptr(FMUstate) else {
+        // SAFETY: null or a state this FMU handed out (checked by its magic).
+        let Some(s) = (unsafe { Snapshot::from_ptr(FMUstate) }) else {
             return error("FMUstate is null or not an FMU state of this FMU");
         };
-        let Some(size) = size.as_mut() else {
+        // SAFETY: `size` is null or points to a writable size_t.
+        let Some(size) = (unsafe { size.as_mut() }) else {
             return null("fmi2SerializedFMUstateSize", "size");
         };
         *size = inst.serialize("fmi2SerializedFMUstateSize", s)?.len();
@@ -515,7 +621,8 @@ pub unsafe extern "C" fn fmi2SerializeFMUstate(
     size: size_t,
 ) -> fmi2Status {
     call(c, "fmi2SerializeFMUstate", |inst| {
-        let Some(s) = Snapshot::from_ptr(FMUstate) else {
+        // SAFETY: null or a state this FMU handed out (checked by its magic).
+        let Some(s) = (unsafe { Snapshot::from_ptr(FMUstate) }) else {
             return error("FMUstate is null or not an FMU state of this FMU");
         };
         let bytes = inst.serialize("fmi2SerializeFMUstate", s)?;
@@ -528,7 +635,11 @@ pub unsafe extern "C" fn fmi2SerializeFMUstate(
         if serializedState.is_null() {
             return null("fmi2SerializeFMUstate", "serializedState");
         }
-        std::ptr::copy_nonoverlapping(bytes.as_ptr(), serializedState as *mut u8, bytes.len());
+        // SAFETY: the buffer is non-null and holds `size` >= len bytes
+        // (FMI contract); it does not overlap the snapshot's own bytes.
+        unsafe {
+            std::ptr::copy_nonoverlapping(bytes.as_ptr(), serializedState as *mut u8, bytes.len())
+        };
         Ok(Status::Ok)
     })
 }
@@ -541,23 +652,28 @@ pub unsafe extern "C" fn fmi2DeSerializeFMUstate(
     FMUstate: *mut fmi2FMUstate,
 ) -> fmi2Status {
     call(c, "fmi2DeSerializeFMUstate", |inst| {
-        let Some(bytes) = slice(serializedState as *const u8, size) else {
+        // SAFETY: FMI passes `size` bytes of a serialized state.
+        let Some(bytes) = (unsafe { slice(serializedState as *const u8, size) }) else {
             return null("fmi2DeSerializeFMUstate", "serializedState");
         };
-        let Some(slot) = FMUstate.as_mut() else {
+        // SAFETY: `FMUstate` is null or points to the environment's state slot.
+        let Some(slot) = (unsafe { FMUstate.as_mut() }) else {
             return null("fmi2DeSerializeFMUstate", "FMUstate");
         };
         let old = if slot.is_null() {
             None
         } else {
-            match Snapshot::from_ptr(*slot) {
+            // SAFETY: a non-null slot holds a state this FMU handed out.
+            match unsafe { Snapshot::from_ptr(*slot) } {
                 Some(s) => Some(s as *mut Snapshot),
                 None => return error("*FMUstate is not an FMU state of this FMU"),
             }
         };
         let new = inst.deserialize(bytes)?;
         if let Some(old) = old {
-            drop(Box::from_raw(old));
+            // SAFETY: made by `Box::into_raw`; the slot is overwritten
+            // below, so the old state is freed once.
+            drop(unsafe { Box::from_raw(old) });
         }
         *slot = Box::into_raw(new) as fmi2FMUstate;
         Ok(Status::Ok)
@@ -636,10 +752,7 @@ pub unsafe extern "C" fn fmi2CancelStep(c: fmi2Component) -> fmi2Status {
 }
 
 fn require_status(inst: &Instance, func: &str) -> Res {
-    inst.require(
-        func,
-        &[Phase::StepComplete, Phase::StepFailed, Phase::Terminated],
-    )
+    inst.require(func)
 }
 
 fn discard(msg: String) -> Res<Status> {
@@ -674,7 +787,8 @@ pub unsafe extern "C" fn fmi2GetRealStatus(
 ) -> fmi2Status {
     call(c, "fmi2GetRealStatus", |inst| {
         require_status(inst, "fmi2GetRealStatus")?;
-        let Some(v) = value.as_mut() else {
+        // SAFETY: `value` is null or points to a writable value (FMI contract).
+        let Some(v) = (unsafe { value.as_mut() }) else {
             return null("fmi2GetRealStatus", "value");
         };
         if s != fmi2LastSuccessfulTime {
@@ -708,7 +822,8 @@ pub unsafe extern "C" fn fmi2GetBooleanStatus(
 ) -> fmi2Status {
     call(c, "fmi2GetBooleanStatus", |inst| {
         require_status(inst, "fmi2GetBooleanStatus")?;
-        let Some(v) = value.as_mut() else {
+        // SAFETY: `value` is null or points to a writable value (FMI contract).
+        let Some(v) = (unsafe { value.as_mut() }) else {
             return null("fmi2GetBooleanStatus", "value");
         };
         if s != fmi2Terminated {
@@ -727,7 +842,8 @@ pub unsafe extern "C" fn fmi2GetStringStatus(
 ) -> fmi2Status {
     call(c, "fmi2GetStringStatus", |inst| {
         require_status(inst, "fmi2GetStringStatus")?;
-        let Some(v) = value.as_mut() else {
+        // SAFETY: `value` is null or points to a writable value (FMI contract).
+        let Some(v) = (unsafe { value.as_mut() }) else {
             return null("fmi2GetStringStatus", "value");
         };
         *v = c"".as_ptr();

@@ -8,18 +8,19 @@
 //! and `integrator`; outputs the energies, the largest strain, the substep
 //! count and every particle's position `particle[i].x/y/z`.
 
-use std::ffi::c_int;
-
 use yarnsim::massspring::{Integrator, IntegratorOptions, Layout, Simulation, V3};
 
-use crate::instance::{error, ParamCheck, Reader, Res, StepFailure, Writer};
+use crate::fmu_model::{
+    refuse, Checkpoint, FmuModel, ModelResult, ParamCheck, SetContext, StepFailure,
+};
 use crate::model::{real, Description, VarType, Variable};
+use crate::state_bytes::{Reader, Writer};
 
 /// The FMI model identifier of a mass-spring FMU.
 pub const MODEL_IDENTIFIER: &str = "MassSpring";
 
 /// Bumped whenever the variable layout changes; part of the GUID.
-pub const INTERFACE_VERSION: u32 = 1;
+pub const INTERFACE_VERSION: u32 = 2;
 
 /// The integrator an instance uses unless the `integrator` parameter says
 /// otherwise (the CLI's default too).
@@ -36,7 +37,8 @@ pub const VR_ELASTIC_ENERGY: u32 = 101;
 pub const VR_GRAVITY_ENERGY: u32 = 102;
 pub const VR_TOTAL_ENERGY: u32 = 103;
 pub const VR_MAX_STRAIN: u32 = 104;
-pub const VR_SUBSTEPS: u32 = 200; // Integer
+/// The substep count, common to every model ([`crate::model::COMMON_VARIABLES`]).
+pub use crate::model::VR_SUBSTEPS;
 /// `particle[i].x` has `VR_PARTICLE_BASE + 3 i`, then `.y`, `.z`.
 pub const VR_PARTICLE_BASE: u32 = 1000;
 
@@ -147,16 +149,7 @@ pub fn variables(layout: &Layout) -> Result<Vec<Variable>, String> {
             d.into(),
         ));
     }
-    v.push(var(
-        "substeps".into(),
-        VR_SUBSTEPS,
-        VarType::Integer,
-        "output",
-        "discrete",
-        None,
-        None,
-        "Substeps taken since initialization".into(),
-    ));
+    v.extend(crate::model::common_variables());
     for i in 0..n {
         for (k, axis) in ["x", "y", "z"].into_iter().enumerate() {
             v.push(var(
@@ -172,6 +165,22 @@ pub fn variables(layout: &Layout) -> Result<Vec<Variable>, String> {
         }
     }
     Ok(v)
+}
+
+/// The gravitational and the total energy change as soon as `gravity.*` is
+/// set (`-sum m g . x` with the current gravity), at initialization and
+/// between steps; every other output depends on no input and no parameter
+/// at the same instant (`dt` and `integrator` act through the substeps).
+pub fn dependencies() -> Vec<crate::model::Dependency> {
+    let gravity = vec![VR_GRAVITY_X, VR_GRAVITY_Y, VR_GRAVITY_Z];
+    [VR_GRAVITY_ENERGY, VR_TOTAL_ENERGY]
+        .into_iter()
+        .map(|output| crate::model::Dependency {
+            output,
+            step: gravity.clone(),
+            initial: gravity.clone(),
+        })
+        .collect()
 }
 
 /// The GUID of the FMU for this layout: a hash of the interface version and
@@ -197,6 +206,7 @@ pub fn description(layout: &Layout) -> Result<Description, String> {
         variables: variables(layout)?,
         stop_time: layout.time.frame_time * layout.time.frames as f64,
         step_size: layout.time.frame_time,
+        dependencies: dependencies(),
     })
 }
 
@@ -213,16 +223,16 @@ pub struct MsModel {
     pub sim: Simulation,
 }
 
-fn build(base: &Layout, integrator: Integrator, dt: Option<f64>) -> Res<Simulation> {
+fn build(base: &Layout, integrator: Integrator, dt: Option<f64>) -> ModelResult<Simulation> {
     let options = IntegratorOptions {
         dt,
         ..IntegratorOptions::default()
     };
-    Simulation::new(base, integrator, options).or_else(|e| error(e.to_string()))
+    Simulation::new(base, integrator, options).or_else(|e| refuse(e.to_string()))
 }
 
 impl MsModel {
-    pub fn new(base: Layout) -> Res<Self> {
+    pub fn new(base: Layout) -> ModelResult<Self> {
         let sim = build(&base, DEFAULT_INTEGRATOR, None)?;
         Ok(MsModel {
             gravity: base.gravity,
@@ -234,16 +244,16 @@ impl MsModel {
     }
 
     /// Rebuilds the simulation from the layout and the parameters.
-    pub fn rebuild(&mut self, particles: usize) -> Res {
+    pub fn rebuild(&mut self, particles: usize) -> ModelResult {
         let mut sim = build(&self.base, self.integrator, self.dt)?;
         if sim.positions().len() != particles {
-            return error(format!(
+            return refuse(format!(
                 "the scene has {} particles, but this FMU has outputs for {particles}",
                 sim.positions().len()
             ));
         }
         sim.set_gravity(V3::from(self.gravity))
-            .or_else(|e| error(e.to_string()))?;
+            .or_else(|e| refuse(e.to_string()))?;
         self.sim = sim;
         Ok(())
     }
@@ -267,11 +277,21 @@ impl MsModel {
         })
     }
 
+    /// Every Real output this model serves is finite: the positions, the
+    /// four energies and the largest strain (energies overflow to inf long
+    /// before the positions do).
     pub fn outputs_finite(&self) -> bool {
-        self.sim
-            .positions()
-            .iter()
-            .all(|p| p.iter().all(|c| c.is_finite()))
+        let e = self.sim.energies();
+        e.kinetic.is_finite()
+            && e.elastic.is_finite()
+            && e.gravity.is_finite()
+            && e.total().is_finite()
+            && self.sim.max_strain().is_finite()
+            && self
+                .sim
+                .positions()
+                .iter()
+                .all(|p| p.iter().all(|c| c.is_finite()))
     }
 
     /// Whether the Real variable `vr` depends on the simulated state.
@@ -298,7 +318,7 @@ impl MsModel {
         })
     }
 
-    pub fn get_boolean(&self, _vr: u32) -> Option<c_int> {
+    pub fn get_boolean(&self, _vr: u32) -> Option<bool> {
         None
     }
 
@@ -308,24 +328,29 @@ impl MsModel {
 
     /// Sets the gravity inputs and the `dt` parameter; true when the
     /// parameter changed. A rejected call changes nothing.
-    pub fn set_real(&mut self, vrs: &[u32], vals: &[f64], param_ok: ParamCheck) -> Res<bool> {
+    pub fn set_real(
+        &mut self,
+        vrs: &[u32],
+        vals: &[f64],
+        param_ok: ParamCheck,
+    ) -> ModelResult<bool> {
         let mut gravity = self.gravity;
         let mut dt = self.dt;
         for (&vr, &v) in vrs.iter().zip(vals) {
             match vr {
                 VR_GRAVITY_X..=VR_GRAVITY_Z => gravity[(vr - VR_GRAVITY_X) as usize] = v,
                 VR_DT => {
-                    param_ok("fmi2SetReal", vr)?;
+                    param_ok(vr)?;
                     if !(0.0..=1e3).contains(&v) {
-                        return error(format!(
-                            "fmi2SetReal: dt = {v} s is out of range (0 = automatic, else up to 1e3 s)"
+                        return refuse(format!(
+                            "dt = {v} s is out of range (0 = automatic, else up to 1e3 s)"
                         ));
                     }
                     dt = (v > 0.0).then_some(v);
                 }
                 _ => {
-                    return error(format!(
-                        "fmi2SetReal: value reference {vr} is not a Real input or parameter"
+                    return refuse(format!(
+                        "value reference {vr} is not a Real input or parameter"
                     ))
                 }
             }
@@ -333,7 +358,7 @@ impl MsModel {
         if gravity != self.gravity {
             self.sim
                 .set_gravity(V3::from(gravity))
-                .or_else(|e| error(format!("fmi2SetReal: {e}")))?;
+                .or_else(|e| refuse(format!("{e}")))?;
             self.gravity = gravity;
         }
         let changed = dt != self.dt;
@@ -341,11 +366,11 @@ impl MsModel {
         Ok(changed)
     }
 
-    pub fn set_boolean(&mut self, vrs: &[u32], _vals: &[c_int], _: ParamCheck) -> Res<bool> {
+    pub fn set_boolean(&mut self, vrs: &[u32], _vals: &[bool], _: ParamCheck) -> ModelResult<bool> {
         match vrs.first() {
             None => Ok(false),
-            Some(vr) => error(format!(
-                "fmi2SetBoolean: value reference {vr} is not a Boolean input or parameter"
+            Some(vr) => refuse(format!(
+                "value reference {vr} is not a Boolean input or parameter"
             )),
         }
     }
@@ -356,21 +381,17 @@ impl MsModel {
         vrs: &[u32],
         vals: &[Option<String>],
         param_ok: ParamCheck,
-    ) -> Res<bool> {
+    ) -> ModelResult<bool> {
         let mut integrator = self.integrator;
         for (&vr, v) in vrs.iter().zip(vals) {
             if vr != VR_INTEGRATOR {
-                return error(format!(
-                    "fmi2SetString: value reference {vr} is not a String parameter"
-                ));
+                return refuse(format!("value reference {vr} is not a String parameter"));
             }
-            param_ok("fmi2SetString", vr)?;
+            param_ok(vr)?;
             let Some(v) = v else {
-                return error("fmi2SetString: the integrator name is a null pointer");
+                return refuse("the integrator name is a null pointer");
             };
-            integrator = v
-                .parse()
-                .or_else(|e| error(format!("fmi2SetString: {e}")))?;
+            integrator = v.parse::<Integrator>().or_else(|e| refuse(e.to_string()))?;
         }
         let changed = integrator != self.integrator;
         self.integrator = integrator;
@@ -435,7 +456,7 @@ impl MsModel {
         let mut sim = if same {
             current.sim.clone()
         } else {
-            build(&base, integrator, dt).map_err(|f| f.msg)?
+            build(&base, integrator, dt).map_err(|e| e.0)?
         };
         if sim.positions().len() != particles {
             return Err(format!(
@@ -458,5 +479,74 @@ impl MsModel {
             gravity,
             sim,
         })
+    }
+}
+
+impl FmuModel for MsModel {
+    fn state_magic(&self) -> &'static [u8; 8] {
+        crate::state_bytes::MASS_SPRING_STATE_MAGIC
+    }
+    fn count(&self) -> usize {
+        MsModel::count(self)
+    }
+    fn dt(&self) -> f64 {
+        MsModel::dt(self)
+    }
+    fn stable_dt(&self) -> Option<f64> {
+        self.sim.stable_dt()
+    }
+    fn rebuild(&mut self, count: usize) -> ModelResult {
+        MsModel::rebuild(self, count)
+    }
+    fn substep(&mut self, k: u64) -> Result<(), StepFailure> {
+        MsModel::substep(self, k)
+    }
+    fn outputs_finite(&mut self) -> bool {
+        MsModel::outputs_finite(self)
+    }
+    /// A clone of the model (cheaper than its serialization).
+    fn checkpoint(&self) -> Checkpoint {
+        Box::new(self.clone())
+    }
+    fn restore(&mut self, c: Checkpoint) {
+        *self = *c
+            .downcast::<MsModel>()
+            .expect("a checkpoint of a mass-spring model");
+    }
+    fn is_state_output(&self, vr: u32) -> bool {
+        MsModel::is_state_output(self, vr)
+    }
+    fn get_real(&mut self, vr: u32) -> Option<f64> {
+        MsModel::get_real(self, vr)
+    }
+    fn get_boolean(&self, vr: u32) -> Option<bool> {
+        MsModel::get_boolean(self, vr)
+    }
+    fn get_string(&self, vr: u32) -> Option<&str> {
+        MsModel::get_string(self, vr)
+    }
+    fn set_real(&mut self, vrs: &[u32], vals: &[f64], check: ParamCheck) -> ModelResult<bool> {
+        MsModel::set_real(self, vrs, vals, check)
+    }
+    fn set_boolean(&mut self, vrs: &[u32], vals: &[bool], check: ParamCheck) -> ModelResult<bool> {
+        MsModel::set_boolean(self, vrs, vals, check)
+    }
+    fn set_string(
+        &mut self,
+        vrs: &[u32],
+        vals: &[Option<String>],
+        check: ParamCheck,
+        _ctx: &SetContext,
+    ) -> ModelResult<bool> {
+        MsModel::set_string(self, vrs, vals, check)
+    }
+    fn write(&self, w: &mut Writer) {
+        MsModel::write(self, w)
+    }
+    fn read(&self, r: &mut Reader, built: bool, count: usize) -> Result<Box<dyn FmuModel>, String> {
+        Ok(Box::new(MsModel::read(r, self, built, count)?))
+    }
+    fn box_clone(&self) -> Box<dyn FmuModel> {
+        Box::new(self.clone())
     }
 }

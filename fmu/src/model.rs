@@ -1,6 +1,11 @@
 //! The FMU's variables, its GUID and its `modelDescription.xml`, all derived
 //! from the scene the FMU runs: the number of yarns fixes the outputs, the
-//! scene's material, substep and inputs give the start values.
+//! scene's material, substep and inputs give the start values. The
+//! YarnBundle's variables are one static table ([`YARN_VARIABLES`]: name,
+//! value reference, type, causality, variability, unit, start, description,
+//! and for the Real parameters the scene field that the getter and setter
+//! use); the variables every model has ([`COMMON_VARIABLES`]: `substeps` and
+//! the execution parameters) are another, served by the instance.
 
 use std::fmt::Write as _;
 
@@ -11,7 +16,7 @@ use yarnsim::scene::{Scene, YarnScene};
 pub const MODEL_IDENTIFIER: &str = "YarnBundle";
 
 /// Bumped whenever the variable layout changes; part of the GUID.
-pub const INTERFACE_VERSION: u32 = 1;
+pub const INTERFACE_VERSION: u32 = 2;
 
 /// Name of the scene file inside the FMU's `resources/` folder.
 pub const SCENE_FILE: &str = "scene.toml";
@@ -35,20 +40,107 @@ pub const VR_KINETIC_ENERGY: u32 = 100;
 pub const VR_ELASTIC_ENERGY: u32 = 101;
 pub const VR_MAX_STRETCH: u32 = 102;
 pub const VR_SUBSTEPS: u32 = 200; // Integer
+/// `max_substeps_per_step` (Integer parameter of every model).
+pub const VR_MAX_SUBSTEPS: u32 = 201;
+/// `threads` (Integer parameter of every model).
+pub const VR_THREADS: u32 = 202;
 pub const VR_SCENE: u32 = 300; // String
 /// `yarn[i].left.x` has `VR_YARN_BASE + 4 i`, then `left.y`, `right.x`, `right.y`.
 pub const VR_YARN_BASE: u32 = 1000;
 
-/// The real parameters in value-reference order `VR_K..=VR_DT`.
-pub const REAL_PARAMETERS: [u32; 7] = [
-    VR_K,
-    VR_GAMMA,
-    VR_YOUNGS_MODULUS,
-    VR_FRICTION,
-    VR_BENDING,
-    VR_DENSITY,
-    VR_DT,
+/// Largest scene file the FMU reads (the bundled one and the `scene`
+/// parameter): 1 MiB. The built-in scenes are below 4 KiB.
+pub const MAX_SCENE_BYTES: u64 = 1 << 20;
+
+/// Reads a scene file: a regular file (symbolic links are followed) of at
+/// most [`MAX_SCENE_BYTES`], UTF-8. Devices, FIFOs, directories and larger
+/// files are refused before anything is read.
+pub fn read_scene_text(path: &std::path::Path) -> Result<String, String> {
+    use std::io::Read as _;
+    let shown = path.display();
+    let meta =
+        std::fs::metadata(path).map_err(|e| format!("cannot read scene file {shown}: {e}"))?;
+    if !meta.is_file() {
+        let what = if meta.is_dir() {
+            "a directory"
+        } else {
+            "not a regular file (device, FIFO or socket)"
+        };
+        return Err(format!("scene file {shown} is {what}"));
+    }
+    if meta.len() > MAX_SCENE_BYTES {
+        return Err(format!(
+            "scene file {shown} has {} bytes, more than the limit of {MAX_SCENE_BYTES}",
+            meta.len()
+        ));
+    }
+    let file =
+        std::fs::File::open(path).map_err(|e| format!("cannot read scene file {shown}: {e}"))?;
+    // The file may grow between the check and the read: read one byte
+    // past the limit at most.
+    let mut bytes = Vec::new();
+    file.take(MAX_SCENE_BYTES + 1)
+        .read_to_end(&mut bytes)
+        .map_err(|e| format!("cannot read scene file {shown}: {e}"))?;
+    if bytes.len() as u64 > MAX_SCENE_BYTES {
+        return Err(format!(
+            "scene file {shown} is larger than the limit of {MAX_SCENE_BYTES} bytes"
+        ));
+    }
+    String::from_utf8(bytes).map_err(|_| format!("scene file {shown} is not UTF-8 text"))
+}
+
+/// Default of `max_substeps_per_step`: about 2.3 s of work for a step of the
+/// default yarn scene (228 us per substep), 12 s on the cloth (1.2 ms per
+/// substep), 0.06 s on the wire.
+pub const DEFAULT_MAX_SUBSTEPS: u32 = 10_000;
+
+/// Default of `threads`: 0, the process-wide rayon pool (one thread per core).
+pub const DEFAULT_THREADS: u32 = 0;
+
+/// Largest accepted `threads`.
+pub const MAX_THREADS: u32 = 1024;
+// The `threads` description in [`COMMON_VARIABLES`] names this limit.
+const _: () = assert!(MAX_THREADS == 1024);
+
+/// The variables every model has, after the model's own and before its
+/// per-object outputs: the substep count and the execution parameters
+/// (the substep budget of one `fmi2DoStep`, the instance's thread count).
+/// They are served by the instance ([`crate::instance`]), not the models.
+/// A row of [`COMMON_VARIABLES`]: name, value reference, causality,
+/// variability, start value, description (all Integer).
+pub type CommonVariable = (
+    &'static str,
+    u32,
+    &'static str,
+    &'static str,
+    Option<u32>,
+    &'static str,
+);
+
+pub static COMMON_VARIABLES: [CommonVariable; 3] = [
+    ("substeps", VR_SUBSTEPS, "output", "discrete", None, "Substeps taken since initialization"),
+    ("max_substeps_per_step", VR_MAX_SUBSTEPS, "parameter", "fixed", Some(DEFAULT_MAX_SUBSTEPS), "Most substeps one fmi2DoStep may run (at least 1); a longer step is refused with fmi2Error before any substep runs"),
+    ("threads", VR_THREADS, "parameter", "fixed", Some(DEFAULT_THREADS), "Worker threads of this instance's own thread pool (1 to 1024); 0: the process-wide pool, one thread per core. Results are bit-identical for every value"),
 ];
+
+/// [`COMMON_VARIABLES`] as written in `modelDescription.xml` (all Integer).
+pub fn common_variables() -> impl Iterator<Item = Variable> {
+    COMMON_VARIABLES
+        .iter()
+        .map(
+            |&(name, vr, causality, variability, start, description)| Variable {
+                name: name.into(),
+                vr,
+                ty: VarType::Integer,
+                causality,
+                variability,
+                unit: None,
+                start: start.map(|s| s.to_string()),
+                description: description.into(),
+            },
+        )
+}
 
 /// The standard FMI 2.0 log categories, all of which this FMU uses.
 pub const LOG_CATEGORIES: [(&str, &str); 7] = [
@@ -115,230 +207,213 @@ pub fn num_yarns(scene: &YarnScene) -> usize {
     scene.curves().len()
 }
 
-/// Every variable of the FMU for this scene, in `ModelVariables` order.
-pub fn variables(scene: &YarnScene) -> Vec<Variable> {
-    let mut v = Vec::new();
-    let mut add = |name: &str,
-                   vr: u32,
-                   ty: VarType,
-                   causality: &'static str,
-                   variability: &'static str,
-                   unit: Option<&'static str>,
-                   start: Option<String>,
-                   description: &str| {
-        v.push(Variable {
-            name: name.to_string(),
-            vr,
-            ty,
-            causality,
-            variability,
-            unit,
-            start,
-            description: description.to_string(),
-        })
-    };
-    use VarType::{Boolean, Integer, Real};
-    let a = &scene.attractor;
-    let m = &scene.material;
-    add(
-        "attractor.x",
-        VR_ATTRACTOR_X,
-        Real,
-        "input",
-        "continuous",
-        Some("m"),
-        Some(real(a.position[0])),
-        "Attractor position x",
-    );
-    add(
-        "attractor.y",
-        VR_ATTRACTOR_Y,
-        Real,
-        "input",
-        "continuous",
-        Some("m"),
-        Some(real(a.position[1])),
-        "Attractor position y",
-    );
-    add(
-        "attractor.strength",
-        VR_ATTRACTOR_STRENGTH,
-        Real,
-        "input",
-        "continuous",
-        Some("m/s2"),
-        Some(real(a.strength)),
-        "Attractor acceleration magnitude, 0 to 1e6",
-    );
-    add(
-        "attractor.active",
-        VR_ATTRACTOR_ACTIVE,
-        Boolean,
-        "input",
-        "discrete",
-        None,
-        Some(boolean(a.active)),
-        "Whether the attractor acts",
-    );
-    add(
-        "gravity.x",
-        VR_GRAVITY_X,
-        Real,
-        "input",
-        "continuous",
-        Some("m/s2"),
-        Some(real(scene.gravity[0])),
-        "Gravity x, |g| at most 1e6",
-    );
-    add(
-        "gravity.y",
-        VR_GRAVITY_Y,
-        Real,
-        "input",
-        "continuous",
-        Some("m/s2"),
-        Some(real(scene.gravity[1])),
-        "Gravity y, |g| at most 1e6",
-    );
-    add(
-        "material.k",
-        VR_K,
-        Real,
-        "parameter",
-        "fixed",
-        Some("Pa"),
-        Some(real(m.k)),
-        "Fiber stretch stiffness",
-    );
-    add(
-        "material.gamma",
-        VR_GAMMA,
-        Real,
-        "parameter",
-        "fixed",
-        Some("Pa"),
-        Some(real(m.gamma)),
-        "Fiber shear stiffness",
-    );
-    add(
-        "material.youngs_modulus",
-        VR_YOUNGS_MODULUS,
-        Real,
-        "parameter",
-        "fixed",
-        Some("Pa"),
-        Some(real(m.youngs_modulus)),
-        "Young's modulus of the cross-section",
-    );
-    add(
-        "material.friction",
-        VR_FRICTION,
-        Real,
-        "parameter",
-        "fixed",
-        None,
-        Some(real(m.friction)),
-        "Mohr-Coulomb friction coefficient",
-    );
-    add(
-        "material.bending",
-        VR_BENDING,
-        Real,
-        "parameter",
-        "fixed",
-        Some("Pa"),
-        Some(real(m.bending)),
-        "Bending modulus (0 disables bending)",
-    );
-    add(
-        "material.density",
-        VR_DENSITY,
-        Real,
-        "parameter",
-        "fixed",
-        Some("kg/m"),
-        Some(real(m.density)),
-        "Line density",
-    );
-    add(
-        "dt",
-        VR_DT,
-        Real,
-        "parameter",
-        "fixed",
-        Some("s"),
-        Some(real(scene.time.dt)),
-        "Substep size; a communication step runs an integer number of substeps",
-    );
-    add(
-        "material.plasticity",
-        VR_PLASTICITY,
-        Boolean,
-        "parameter",
-        "fixed",
-        None,
-        Some(boolean(m.plasticity)),
-        "Mohr-Coulomb return mapping on or off",
-    );
-    add("scene", VR_SCENE, VarType::String, "parameter", "fixed", None, Some(SCENE_FILE.to_string()), "Scene file: a path relative to the FMU's resources folder, or absolute; it must create as many yarns as the bundled scene");
-    add(
-        "kinetic_energy",
-        VR_KINETIC_ENERGY,
-        Real,
-        "output",
-        "continuous",
-        Some("J"),
-        None,
-        "Kinetic energy (per unit depth)",
-    );
-    add(
-        "elastic_energy",
-        VR_ELASTIC_ENERGY,
-        Real,
-        "output",
-        "continuous",
-        Some("J"),
-        None,
-        "Elastic energy (per unit depth)",
-    );
-    add(
-        "max_stretch",
-        VR_MAX_STRETCH,
-        Real,
-        "output",
-        "continuous",
-        None,
-        None,
-        "Largest segment stretch |x_r - x_l| / l0",
-    );
-    add(
-        "substeps",
-        VR_SUBSTEPS,
-        Integer,
-        "output",
-        "discrete",
-        None,
-        None,
-        "Substeps taken since initialization",
-    );
-    for i in 0..num_yarns(scene) {
-        for (k, end, axis) in [
-            (0, "left", "x"),
-            (1, "left", "y"),
-            (2, "right", "x"),
-            (3, "right", "y"),
-        ] {
-            add(
-                &format!("yarn[{i}].{end}.{axis}"),
-                VR_YARN_BASE + 4 * i as u32 + k,
-                Real,
-                "output",
-                "continuous",
-                Some("m"),
-                None,
-                &format!("Yarn {i}, {end} end, {axis}"),
-            );
+/// A Real parameter that lives in the scene: how to read and override it.
+#[derive(Clone, Copy)]
+pub struct SceneField {
+    pub get: fn(&YarnScene) -> f64,
+    pub set: fn(&mut YarnScene, f64),
+    /// Must be > 0 (else >= 0).
+    pub positive: bool,
+}
+
+/// Where a variable's start value comes from.
+#[derive(Clone, Copy)]
+pub enum Start {
+    /// Outputs have none.
+    None,
+    /// A Real parameter in the scene (also its getter and setter).
+    Scene(SceneField),
+    /// A Real read from the scene.
+    Real(fn(&YarnScene) -> f64),
+    /// A Boolean read from the scene.
+    Bool(fn(&YarnScene) -> bool),
+    /// A fixed text.
+    Text(&'static str),
+}
+
+/// One row of a model's variable table.
+#[derive(Clone, Copy)]
+pub struct VarSpec {
+    pub name: &'static str,
+    pub vr: u32,
+    pub ty: VarType,
+    pub causality: &'static str,
+    pub variability: &'static str,
+    pub unit: Option<&'static str>,
+    pub start: Start,
+    pub description: &'static str,
+}
+
+impl VarSpec {
+    /// The variable as written in `modelDescription.xml`, for this scene.
+    pub fn variable(&self, scene: &YarnScene) -> Variable {
+        Variable {
+            name: self.name.to_string(),
+            vr: self.vr,
+            ty: self.ty,
+            causality: self.causality,
+            variability: self.variability,
+            unit: self.unit,
+            start: match self.start {
+                Start::None => None,
+                Start::Scene(f) => Some(real((f.get)(scene))),
+                Start::Real(f) => Some(real(f(scene))),
+                Start::Bool(f) => Some(boolean(f(scene))),
+                Start::Text(t) => Some(t.to_string()),
+            },
+            description: self.description.to_string(),
         }
+    }
+}
+
+const fn input(
+    name: &'static str,
+    vr: u32,
+    ty: VarType,
+    unit: Option<&'static str>,
+    start: Start,
+    description: &'static str,
+) -> VarSpec {
+    VarSpec {
+        name,
+        vr,
+        ty,
+        causality: "input",
+        variability: match ty {
+            VarType::Real => "continuous",
+            _ => "discrete",
+        },
+        unit,
+        start,
+        description,
+    }
+}
+
+const fn parameter(
+    name: &'static str,
+    vr: u32,
+    ty: VarType,
+    unit: Option<&'static str>,
+    start: Start,
+    description: &'static str,
+) -> VarSpec {
+    VarSpec {
+        name,
+        vr,
+        ty,
+        causality: "parameter",
+        variability: "fixed",
+        unit,
+        start,
+        description,
+    }
+}
+
+const fn output(
+    name: &'static str,
+    vr: u32,
+    unit: Option<&'static str>,
+    description: &'static str,
+) -> VarSpec {
+    VarSpec {
+        name,
+        vr,
+        ty: VarType::Real,
+        causality: "output",
+        variability: "continuous",
+        unit,
+        start: Start::None,
+        description,
+    }
+}
+
+const fn material(
+    get: fn(&YarnScene) -> f64,
+    set: fn(&mut YarnScene, f64),
+    positive: bool,
+) -> Start {
+    Start::Scene(SceneField { get, set, positive })
+}
+
+use VarType::{Boolean, Real};
+
+/// The YarnBundle's variables before the ones every model has
+/// ([`COMMON_VARIABLES`]) and the per-yarn outputs ([`yarn_outputs`]), in
+/// `ModelVariables` order. The Real parameters read and override the scene
+/// through their [`SceneField`].
+pub static YARN_VARIABLES: [VarSpec; 18] = [
+    input("attractor.x", VR_ATTRACTOR_X, Real, Some("m"), Start::Real(|s| s.attractor.position[0]), "Attractor position x"),
+    input("attractor.y", VR_ATTRACTOR_Y, Real, Some("m"), Start::Real(|s| s.attractor.position[1]), "Attractor position y"),
+    input("attractor.strength", VR_ATTRACTOR_STRENGTH, Real, Some("m/s2"), Start::Real(|s| s.attractor.strength), "Attractor acceleration magnitude, 0 to 1e6"),
+    input("attractor.active", VR_ATTRACTOR_ACTIVE, Boolean, None, Start::Bool(|s| s.attractor.active), "Whether the attractor acts"),
+    input("gravity.x", VR_GRAVITY_X, Real, Some("m/s2"), Start::Real(|s| s.gravity[0]), "Gravity x, |g| at most 1e6"),
+    input("gravity.y", VR_GRAVITY_Y, Real, Some("m/s2"), Start::Real(|s| s.gravity[1]), "Gravity y, |g| at most 1e6"),
+    parameter("material.k", VR_K, Real, Some("Pa"), material(|s| s.material.k, |s, v| s.material.k = v, false), "Fiber stretch stiffness"),
+    parameter("material.gamma", VR_GAMMA, Real, Some("Pa"), material(|s| s.material.gamma, |s, v| s.material.gamma = v, false), "Fiber shear stiffness"),
+    parameter("material.youngs_modulus", VR_YOUNGS_MODULUS, Real, Some("Pa"), material(|s| s.material.youngs_modulus, |s, v| s.material.youngs_modulus = v, false), "Young's modulus of the cross-section"),
+    parameter("material.friction", VR_FRICTION, Real, None, material(|s| s.material.friction, |s, v| s.material.friction = v, false), "Mohr-Coulomb friction coefficient"),
+    parameter("material.bending", VR_BENDING, Real, Some("Pa"), material(|s| s.material.bending, |s, v| s.material.bending = v, false), "Bending modulus (0 disables bending)"),
+    parameter("material.density", VR_DENSITY, Real, Some("kg/m"), material(|s| s.material.density, |s, v| s.material.density = v, true), "Line density"),
+    parameter("dt", VR_DT, Real, Some("s"), material(|s| s.time.dt, |s, v| s.time.dt = v, true), "Substep size; a communication step runs an integer number of substeps"),
+    parameter("material.plasticity", VR_PLASTICITY, Boolean, None, Start::Bool(|s| s.material.plasticity), "Mohr-Coulomb return mapping on or off"),
+    parameter("scene", VR_SCENE, VarType::String, None, Start::Text(SCENE_FILE), "Scene file: a path relative to the FMU's resources folder, or absolute; it must create as many yarns as the bundled scene"),
+    output("kinetic_energy", VR_KINETIC_ENERGY, Some("J"), "Kinetic energy (per unit depth)"),
+    output("elastic_energy", VR_ELASTIC_ENERGY, Some("J"), "Elastic energy (per unit depth)"),
+    output("max_stretch", VR_MAX_STRETCH, None, "Largest segment stretch |x_r - x_l| / l0"),
+];
+
+/// The yarn's Real parameters that live in the scene, in table order (the
+/// order of [`crate::yarn::Config::reals`] and of the FMU state).
+pub fn yarn_real_parameters() -> impl Iterator<Item = (u32, SceneField)> {
+    YARN_VARIABLES.iter().filter_map(|v| match v.start {
+        Start::Scene(f) => Some((v.vr, f)),
+        _ => None,
+    })
+}
+
+/// Number of [`yarn_real_parameters`].
+pub const YARN_REAL_PARAMETERS: usize = 7;
+const _: () = {
+    let mut n = 0;
+    let mut i = 0;
+    while i < YARN_VARIABLES.len() {
+        if let Start::Scene(_) = YARN_VARIABLES[i].start {
+            n += 1;
+        }
+        i += 1;
+    }
+    assert!(n == YARN_REAL_PARAMETERS);
+};
+
+/// The per-yarn outputs of yarn `i`: `yarn[i].left.x`, `.left.y`,
+/// `.right.x`, `.right.y`.
+pub fn yarn_outputs(i: usize) -> impl Iterator<Item = Variable> {
+    [
+        (0, "left", "x"),
+        (1, "left", "y"),
+        (2, "right", "x"),
+        (3, "right", "y"),
+    ]
+    .into_iter()
+    .map(move |(k, end, axis)| Variable {
+        name: format!("yarn[{i}].{end}.{axis}"),
+        vr: VR_YARN_BASE + 4 * i as u32 + k,
+        ty: VarType::Real,
+        causality: "output",
+        variability: "continuous",
+        unit: Some("m"),
+        start: None,
+        description: format!("Yarn {i}, {end} end, {axis}"),
+    })
+}
+
+/// Every variable of the FMU for this scene, in `ModelVariables` order:
+/// [`YARN_VARIABLES`], [`COMMON_VARIABLES`], then the yarn ends.
+pub fn variables(scene: &YarnScene) -> Vec<Variable> {
+    let mut v: Vec<Variable> = YARN_VARIABLES.iter().map(|s| s.variable(scene)).collect();
+    v.extend(common_variables());
+    for i in 0..num_yarns(scene) {
+        v.extend(yarn_outputs(i));
     }
     v
 }
@@ -413,6 +488,58 @@ pub struct Description {
     /// `DefaultExperiment` stop time and step size in s.
     pub stop_time: f64,
     pub step_size: f64,
+    /// What each output depends on ([`Dependency`]); an output without an
+    /// entry depends on nothing (`dependencies=""`).
+    pub dependencies: Vec<Dependency>,
+}
+
+/// The `ModelStructure` dependencies of one output, by value reference.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Dependency {
+    pub output: u32,
+    /// Inputs that change the output at the same instant, without a step
+    /// (`<Outputs>`).
+    pub step: Vec<u32>,
+    /// Inputs and parameters its value after initialization depends on
+    /// (`<InitialUnknowns>`).
+    pub initial: Vec<u32>,
+}
+
+/// `generationDateAndTime` when `SOURCE_DATE_EPOCH` is not set: the date of
+/// the interface version (fixed, so the same sources give the same XML).
+pub const GENERATION_DATE_AND_TIME: &str = "2026-12-01T00:00:00Z";
+
+/// `generationDateAndTime`: `SOURCE_DATE_EPOCH` (seconds since 1970, the
+/// reproducible-builds convention) when set to an integer, else
+/// [`GENERATION_DATE_AND_TIME`].
+pub fn generation_date_and_time() -> String {
+    std::env::var("SOURCE_DATE_EPOCH")
+        .ok()
+        .and_then(|v| v.trim().parse::<i64>().ok())
+        .map(utc_date_time)
+        .unwrap_or_else(|| GENERATION_DATE_AND_TIME.to_string())
+}
+
+/// ISO 8601 UTC of a Unix time (proleptic Gregorian calendar).
+pub fn utc_date_time(secs: i64) -> String {
+    let days = secs.div_euclid(86_400);
+    let sod = secs.rem_euclid(86_400);
+    // Days to civil date (H. Hinnant's algorithm).
+    let z = days + 719_468;
+    let era = z.div_euclid(146_097);
+    let doe = z.rem_euclid(146_097);
+    let yoe = (doe - doe / 1460 + doe / 36_524 - doe / 146_096) / 365;
+    let doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
+    let mp = (5 * doy + 2) / 153;
+    let d = doy - (153 * mp + 2) / 5 + 1;
+    let m = if mp < 10 { mp + 3 } else { mp - 9 };
+    let y = yoe + era * 400 + i64::from(m <= 2);
+    format!(
+        "{y:04}-{m:02}-{d:02}T{:02}:{:02}:{:02}Z",
+        sod / 3600,
+        sod / 60 % 60,
+        sod % 60
+    )
 }
 
 /// The description of the YarnBundle FMU for this scene.
@@ -432,7 +559,35 @@ pub fn description(scene: &YarnScene) -> Description {
         variables: variables(scene),
         stop_time: default_stop_time(scene),
         step_size: scene.time.frame_dt,
+        dependencies: yarn_dependencies(scene),
     }
+}
+
+/// The yarn bundle's outputs depend on no input at the same instant (the
+/// inputs act through the substeps). After initialization (`<InitialUnknowns>`)
+/// the yarn ends and the largest stretch depend on the `scene` parameter;
+/// the kinetic energy on the scene and the density (the scene's initial
+/// velocities); the elastic energy on the scene and the stiffnesses;
+/// `substeps` on nothing. `dt`, `friction`, `plasticity` and the execution
+/// parameters act only through the substeps.
+pub fn yarn_dependencies(scene: &YarnScene) -> Vec<Dependency> {
+    let dep = |output: u32, initial: &[u32]| Dependency {
+        output,
+        step: Vec::new(),
+        initial: initial.to_vec(),
+    };
+    let mut d = vec![
+        dep(VR_KINETIC_ENERGY, &[VR_DENSITY, VR_SCENE]),
+        dep(
+            VR_ELASTIC_ENERGY,
+            &[VR_K, VR_GAMMA, VR_YOUNGS_MODULUS, VR_BENDING, VR_SCENE],
+        ),
+        dep(VR_MAX_STRETCH, &[VR_SCENE]),
+    ];
+    for k in 0..4 * num_yarns(scene) as u32 {
+        d.push(dep(VR_YARN_BASE + k, &[VR_SCENE]));
+    }
+    d
 }
 
 /// Writes `modelDescription.xml`; only the units the variables use are defined.
@@ -443,10 +598,11 @@ pub fn write_model_description(d: &Description) -> String {
     x.push_str("<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n");
     let _ = writeln!(
         x,
-        "<fmiModelDescription fmiVersion=\"2.0\" modelName=\"{ident}\" guid=\"{}\" description=\"{}\" generationTool=\"yarnsim-fmu {}\" variableNamingConvention=\"structured\" numberOfEventIndicators=\"0\">",
+        "<fmiModelDescription fmiVersion=\"2.0\" modelName=\"{ident}\" guid=\"{}\" description=\"{}\" generationTool=\"yarnsim-fmu {}\" generationDateAndTime=\"{}\" variableNamingConvention=\"structured\" numberOfEventIndicators=\"0\">",
         d.guid,
         xml_escape(&d.description),
         env!("CARGO_PKG_VERSION"),
+        generation_date_and_time(),
     );
     let _ = writeln!(
         x,
@@ -514,12 +670,44 @@ pub fn write_model_description(d: &Description) -> String {
         .filter(|(_, v)| v.causality == "output")
         .map(|(i, _)| i + 1)
         .collect();
-    for i in &outputs {
-        let _ = writeln!(x, "      <Unknown index=\"{i}\"/>");
+    // 1-based indices of value references, ascending.
+    let indices = |vrs: &[u32]| -> String {
+        let mut ix: Vec<usize> = vrs
+            .iter()
+            .map(|vr| {
+                1 + vars
+                    .iter()
+                    .position(|v| v.vr == *vr)
+                    .unwrap_or_else(|| panic!("dependency on unknown value reference {vr}"))
+            })
+            .collect();
+        ix.sort_unstable();
+        ix.iter()
+            .map(|i| i.to_string())
+            .collect::<Vec<_>>()
+            .join(" ")
+    };
+    let deps_of = |i: usize, initial: bool| -> String {
+        d.dependencies
+            .iter()
+            .find(|dep| dep.output == vars[i - 1].vr)
+            .map(|dep| indices(if initial { &dep.initial } else { &dep.step }))
+            .unwrap_or_default()
+    };
+    for &i in &outputs {
+        let _ = writeln!(
+            x,
+            "      <Unknown index=\"{i}\" dependencies=\"{}\"/>",
+            deps_of(i, false)
+        );
     }
     x.push_str("    </Outputs>\n    <InitialUnknowns>\n");
-    for i in &outputs {
-        let _ = writeln!(x, "      <Unknown index=\"{i}\"/>");
+    for &i in &outputs {
+        let _ = writeln!(
+            x,
+            "      <Unknown index=\"{i}\" dependencies=\"{}\"/>",
+            deps_of(i, true)
+        );
     }
     x.push_str("    </InitialUnknowns>\n  </ModelStructure>\n</fmiModelDescription>\n");
     x

@@ -2,15 +2,17 @@
 //! overrides, the [`YarnSim`] they build, the values of its variables
 //! ([`crate::model`] lists them) and its part of a serialized FMU state.
 
-use std::ffi::c_int;
 use std::path::Path;
 
 use yarnsim::math::Vec2;
 use yarnsim::mpm::{Attractor, Diagnostics, SimError, YarnSim};
 use yarnsim::scene::YarnScene;
 
-use crate::instance::{error, ParamCheck, Reader, Res, StepFailure, Writer};
+use crate::fmu_model::{
+    refuse, Checkpoint, FmuModel, ModelError, ModelResult, ParamCheck, SetContext, StepFailure,
+};
 use crate::model::*;
+use crate::state_bytes::{Reader, Writer};
 
 /// Values of the inputs.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -32,7 +34,7 @@ impl Inputs {
     }
 
     /// Checks the inputs the way the library does, then hands them to `sim`.
-    fn apply(&self, sim: &mut YarnSim) -> Res {
+    fn apply(&self, sim: &mut YarnSim) -> ModelResult {
         sim.set_gravity(Vec2::from(self.gravity))
             .and_then(|_| {
                 sim.set_attractor(Attractor {
@@ -41,27 +43,27 @@ impl Inputs {
                     active: self.active,
                 })
             })
-            .or_else(|e| error(e.to_string()))
+            .or_else(|e| refuse(e.to_string()))
     }
 
     /// The library's input limits, without a simulation at hand.
-    fn check(&self) -> Res {
+    fn check(&self) -> ModelResult {
         let g = Vec2::from(self.gravity);
         if g.norm() > 1e6 {
-            return error(format!(
-                "fmi2SetReal: gravity ({}, {}) is absurd (|g| above 1e6 m/s2)",
+            return refuse(format!(
+                "gravity ({}, {}) is absurd (|g| above 1e6 m/s2)",
                 g.x, g.y
             ));
         }
         if !(0.0..=1e6).contains(&self.strength) {
-            return error(format!(
-                "fmi2SetReal: attractor strength {} must be in [0, 1e6] m/s2",
+            return refuse(format!(
+                "attractor strength {} must be in [0, 1e6] m/s2",
                 self.strength
             ));
         }
         if self.attractor.iter().any(|c| c.abs() > 1e6) {
-            return error(format!(
-                "fmi2SetReal: attractor position ({}, {}) is absurd (beyond 1e6 m)",
+            return refuse(format!(
+                "attractor position ({}, {}) is absurd (beyond 1e6 m)",
                 self.attractor[0], self.attractor[1]
             ));
         }
@@ -73,8 +75,8 @@ impl Inputs {
 #[derive(Clone, Debug, PartialEq)]
 pub struct Config {
     pub scene_path: String,
-    /// Overrides of [`REAL_PARAMETERS`], in that order.
-    pub reals: [Option<f64>; 7],
+    /// Overrides of [`yarn_real_parameters`], in that order.
+    pub reals: [Option<f64>; YARN_REAL_PARAMETERS],
     pub plasticity: Option<bool>,
 }
 
@@ -82,50 +84,27 @@ impl Default for Config {
     fn default() -> Self {
         Config {
             scene_path: SCENE_FILE.to_string(),
-            reals: [None; 7],
+            reals: [None; YARN_REAL_PARAMETERS],
             plasticity: None,
         }
     }
 }
 
-fn real_param_index(vr: u32) -> Option<usize> {
-    REAL_PARAMETERS.iter().position(|&p| p == vr)
-}
-
-fn scene_real(scene: &YarnScene, vr: u32) -> f64 {
-    let m = &scene.material;
-    match vr {
-        VR_K => m.k,
-        VR_GAMMA => m.gamma,
-        VR_YOUNGS_MODULUS => m.youngs_modulus,
-        VR_FRICTION => m.friction,
-        VR_BENDING => m.bending,
-        VR_DENSITY => m.density,
-        VR_DT => scene.time.dt,
-        _ => unreachable!("not a real parameter: {vr}"),
-    }
-}
-
-fn set_scene_real(scene: &mut YarnScene, vr: u32, v: f64) {
-    let m = &mut scene.material;
-    match vr {
-        VR_K => m.k = v,
-        VR_GAMMA => m.gamma = v,
-        VR_YOUNGS_MODULUS => m.youngs_modulus = v,
-        VR_FRICTION => m.friction = v,
-        VR_BENDING => m.bending = v,
-        VR_DENSITY => m.density = v,
-        VR_DT => scene.time.dt = v,
-        _ => unreachable!("not a real parameter: {vr}"),
-    }
+/// Index of the Real parameter `vr` in [`yarn_real_parameters`] and its
+/// scene field.
+fn real_param(vr: u32) -> Option<(usize, SceneField)> {
+    yarn_real_parameters()
+        .enumerate()
+        .find(|(_, (p, _))| *p == vr)
+        .map(|(i, (_, f))| (i, f))
 }
 
 /// The base scene with the parameter overrides applied.
 fn effective_scene(base: &YarnScene, config: &Config) -> YarnScene {
     let mut s = base.clone();
-    for (k, &vr) in REAL_PARAMETERS.iter().enumerate() {
+    for (k, (_, field)) in yarn_real_parameters().enumerate() {
         if let Some(v) = config.reals[k] {
-            set_scene_real(&mut s, vr, v);
+            (field.set)(&mut s, v);
         }
     }
     if let Some(p) = config.plasticity {
@@ -135,8 +114,7 @@ fn effective_scene(base: &YarnScene, config: &Config) -> YarnScene {
 }
 
 fn read_scene(path: &Path) -> Result<YarnScene, String> {
-    let text = std::fs::read_to_string(path)
-        .map_err(|e| format!("cannot read scene file {}: {e}", path.display()))?;
+    let text = read_scene_text(path)?;
     YarnScene::from_toml_str(&text).map_err(|e| format!("scene file {}: {e}", path.display()))
 }
 
@@ -153,8 +131,8 @@ pub struct YarnModel {
 }
 
 impl YarnModel {
-    pub fn new(base: YarnScene) -> Res<Self> {
-        let sim = YarnSim::new(&base).or_else(|e| error(format!("scene: {e}")))?;
+    pub fn new(base: YarnScene) -> ModelResult<Self> {
+        let sim = YarnSim::new(&base).or_else(|e| refuse(format!("scene: {e}")))?;
         Ok(YarnModel {
             config: Config::default(),
             inputs: Inputs::from_scene(&base),
@@ -165,11 +143,11 @@ impl YarnModel {
     }
 
     /// Rebuilds the simulation from the scene and the parameters.
-    pub fn rebuild(&mut self, yarns: usize) -> Res {
+    pub fn rebuild(&mut self, yarns: usize) -> ModelResult {
         let scene = effective_scene(&self.base, &self.config);
-        let mut sim = YarnSim::new(&scene).or_else(|e| error(format!("parameters: {e}")))?;
+        let mut sim = YarnSim::new(&scene).or_else(|e| refuse(format!("parameters: {e}")))?;
         if sim.num_yarns() != yarns {
-            return error(format!(
+            return refuse(format!(
                 "scene {:?} creates {} yarns, but this FMU has outputs for {yarns}",
                 self.config.scene_path,
                 sim.num_yarns()
@@ -197,13 +175,19 @@ impl YarnModel {
         })
     }
 
-    /// Every output is finite (the library reports divergence itself; this
-    /// makes sure no step ends OK with a non-finite output).
-    pub fn outputs_finite(&self) -> bool {
-        (0..self.count()).all(|y| {
-            let (l, r) = self.sim.yarn_endpoints(y);
-            l.x.is_finite() && l.y.is_finite() && r.x.is_finite() && r.y.is_finite()
-        })
+    /// Every Real output is finite: the yarn ends, the energies and the
+    /// largest stretch (the library reports divergence itself; this makes
+    /// sure no step ends OK with a non-finite output). The diagnostics it
+    /// computes are cached for the `fmi2GetReal` calls that follow.
+    pub fn outputs_finite(&mut self) -> bool {
+        let d = self.diagnostics();
+        d.kinetic_energy.is_finite()
+            && d.elastic_energy.is_finite()
+            && d.max_stretch.is_finite()
+            && (0..self.count()).all(|y| {
+                let (l, r) = self.sim.yarn_endpoints(y);
+                l.x.is_finite() && l.y.is_finite() && r.x.is_finite() && r.y.is_finite()
+            })
     }
 
     fn diagnostics(&mut self) -> Diagnostics {
@@ -224,9 +208,9 @@ impl YarnModel {
             VR_ATTRACTOR_STRENGTH => self.inputs.strength,
             VR_GRAVITY_X => self.inputs.gravity[0],
             VR_GRAVITY_Y => self.inputs.gravity[1],
-            _ if real_param_index(vr).is_some() => {
-                let i = real_param_index(vr).unwrap();
-                self.config.reals[i].unwrap_or_else(|| scene_real(&self.base, vr))
+            _ if real_param(vr).is_some() => {
+                let (i, field) = real_param(vr).unwrap();
+                self.config.reals[i].unwrap_or_else(|| (field.get)(&self.base))
             }
             VR_KINETIC_ENERGY => self.diagnostics().kinetic_energy,
             VR_ELASTIC_ENERGY => self.diagnostics().elastic_energy,
@@ -240,13 +224,13 @@ impl YarnModel {
         })
     }
 
-    pub fn get_boolean(&self, vr: u32) -> Option<c_int> {
+    pub fn get_boolean(&self, vr: u32) -> Option<bool> {
         match vr {
-            VR_ATTRACTOR_ACTIVE => Some(self.inputs.active as c_int),
+            VR_ATTRACTOR_ACTIVE => Some(self.inputs.active),
             VR_PLASTICITY => Some(
                 self.config
                     .plasticity
-                    .unwrap_or(self.base.material.plasticity) as c_int,
+                    .unwrap_or(self.base.material.plasticity),
             ),
             _ => None,
         }
@@ -258,7 +242,12 @@ impl YarnModel {
 
     /// Sets Real inputs and parameters; true when a parameter changed (the
     /// simulation must be rebuilt). A rejected call changes nothing.
-    pub fn set_real(&mut self, vrs: &[u32], vals: &[f64], param_ok: ParamCheck) -> Res<bool> {
+    pub fn set_real(
+        &mut self,
+        vrs: &[u32],
+        vals: &[f64],
+        param_ok: ParamCheck,
+    ) -> ModelResult<bool> {
         let mut inputs = self.inputs;
         let mut reals = self.config.reals;
         for (&vr, &v) in vrs.iter().zip(vals) {
@@ -268,22 +257,20 @@ impl YarnModel {
                 VR_ATTRACTOR_STRENGTH => inputs.strength = v,
                 VR_GRAVITY_X => inputs.gravity[0] = v,
                 VR_GRAVITY_Y => inputs.gravity[1] = v,
-                _ if real_param_index(vr).is_some() => {
-                    param_ok("fmi2SetReal", vr)?;
-                    let ok = match vr {
-                        VR_DENSITY | VR_DT => v > 0.0,
-                        _ => v >= 0.0,
-                    } && v <= 1e12;
+                _ if real_param(vr).is_some() => {
+                    param_ok(vr)?;
+                    let (i, field) = real_param(vr).unwrap();
+                    let ok = if field.positive { v > 0.0 } else { v >= 0.0 } && v <= 1e12;
                     if !ok {
-                        return error(format!(
-                            "fmi2SetReal: parameter value reference {vr} = {v} is out of range"
+                        return refuse(format!(
+                            "parameter value reference {vr} = {v} is out of range"
                         ));
                     }
-                    reals[real_param_index(vr).unwrap()] = Some(v);
+                    reals[i] = Some(v);
                 }
                 _ => {
-                    return error(format!(
-                        "fmi2SetReal: value reference {vr} is not a Real input or parameter"
+                    return refuse(format!(
+                        "value reference {vr} is not a Real input or parameter"
                     ))
                 }
             }
@@ -299,19 +286,24 @@ impl YarnModel {
     }
 
     /// Sets Boolean inputs and parameters; true when a parameter changed.
-    pub fn set_boolean(&mut self, vrs: &[u32], vals: &[c_int], param_ok: ParamCheck) -> Res<bool> {
+    pub fn set_boolean(
+        &mut self,
+        vrs: &[u32],
+        vals: &[bool],
+        param_ok: ParamCheck,
+    ) -> ModelResult<bool> {
         let mut active = self.inputs.active;
         let mut plasticity = self.config.plasticity;
         for (&vr, &v) in vrs.iter().zip(vals) {
             match vr {
-                VR_ATTRACTOR_ACTIVE => active = v != 0,
+                VR_ATTRACTOR_ACTIVE => active = v,
                 VR_PLASTICITY => {
-                    param_ok("fmi2SetBoolean", vr)?;
-                    plasticity = Some(v != 0);
+                    param_ok(vr)?;
+                    plasticity = Some(v);
                 }
                 _ => {
-                    return error(format!(
-                        "fmi2SetBoolean: value reference {vr} is not a Boolean input or parameter"
+                    return refuse(format!(
+                        "value reference {vr} is not a Boolean input or parameter"
                     ))
                 }
             }
@@ -335,27 +327,25 @@ impl YarnModel {
         param_ok: ParamCheck,
         resources: &Path,
         bundled: &YarnScene,
-    ) -> Res<bool> {
+    ) -> ModelResult<bool> {
         let mut changed = false;
         for (&vr, v) in vrs.iter().zip(vals) {
             if vr != VR_SCENE {
-                return error(format!(
-                    "fmi2SetString: value reference {vr} is not a String parameter"
-                ));
+                return refuse(format!("value reference {vr} is not a String parameter"));
             }
-            param_ok("fmi2SetString", vr)?;
+            param_ok(vr)?;
             let Some(v) = v else {
-                return error("fmi2SetString: the scene file name is a null pointer");
+                return refuse("the scene file name is a null pointer");
             };
             let base = if v == SCENE_FILE {
                 bundled.clone()
             } else {
-                read_scene(&resources.join(v)).or_else(error)?
+                read_scene(&resources.join(v)).or_else(refuse)?
             };
             let yarns = num_yarns(&base);
             if yarns != num_yarns(bundled) {
-                return error(format!(
-                    "fmi2SetString: scene {v:?} creates {yarns} yarns, but this FMU has outputs for {}",
+                return refuse(format!(
+                    "scene {v:?} creates {yarns} yarns, but this FMU has outputs for {}",
                     num_yarns(bundled)
                 ));
             }
@@ -402,9 +392,9 @@ impl YarnModel {
             active: r.bool()?,
             gravity: [r.f64()?, r.f64()?],
         };
-        inputs.check().map_err(|f| f.msg)?;
+        inputs.check().map_err(|e| e.0)?;
         let scene_path = r.string()?;
-        let mut reals = [None; 7];
+        let mut reals = [None; YARN_REAL_PARAMETERS];
         for v in &mut reals {
             *v = r.opt_f64()?;
         }
@@ -443,5 +433,82 @@ impl YarnModel {
             inputs,
             diag: None,
         })
+    }
+}
+
+impl FmuModel for YarnModel {
+    fn state_magic(&self) -> &'static [u8; 8] {
+        crate::state_bytes::YARN_STATE_MAGIC
+    }
+    fn count(&self) -> usize {
+        YarnModel::count(self)
+    }
+    fn dt(&self) -> f64 {
+        YarnModel::dt(self)
+    }
+    fn stable_dt(&self) -> Option<f64> {
+        Some(self.sim.stable_dt())
+    }
+    fn rebuild(&mut self, count: usize) -> ModelResult {
+        YarnModel::rebuild(self, count)
+    }
+    fn substep(&mut self, _k: u64) -> Result<(), StepFailure> {
+        YarnModel::substep(self)
+    }
+    fn outputs_finite(&mut self) -> bool {
+        YarnModel::outputs_finite(self)
+    }
+    /// The library's state bytes: a clone of the whole `YarnSim` with its
+    /// grid costs far more than its particles.
+    fn checkpoint(&self) -> Checkpoint {
+        Box::new(self.sim.save_state())
+    }
+    fn restore(&mut self, c: Checkpoint) {
+        let bytes = c
+            .downcast::<Vec<u8>>()
+            .expect("a checkpoint of a yarn model");
+        self.sim
+            .load_state(&bytes)
+            .expect("the simulation's own state bytes load");
+        self.diag = None;
+    }
+    fn is_state_output(&self, vr: u32) -> bool {
+        YarnModel::is_state_output(self, vr)
+    }
+    fn get_real(&mut self, vr: u32) -> Option<f64> {
+        YarnModel::get_real(self, vr)
+    }
+    fn get_boolean(&self, vr: u32) -> Option<bool> {
+        YarnModel::get_boolean(self, vr)
+    }
+    fn get_string(&self, vr: u32) -> Option<&str> {
+        YarnModel::get_string(self, vr)
+    }
+    fn set_real(&mut self, vrs: &[u32], vals: &[f64], check: ParamCheck) -> ModelResult<bool> {
+        YarnModel::set_real(self, vrs, vals, check)
+    }
+    fn set_boolean(&mut self, vrs: &[u32], vals: &[bool], check: ParamCheck) -> ModelResult<bool> {
+        YarnModel::set_boolean(self, vrs, vals, check)
+    }
+    fn set_string(
+        &mut self,
+        vrs: &[u32],
+        vals: &[Option<String>],
+        check: ParamCheck,
+        ctx: &SetContext,
+    ) -> ModelResult<bool> {
+        let crate::model::FmuScene::Yarn(bundled) = ctx.bundled else {
+            return Err(ModelError("a yarn model with a mass-spring scene".into()));
+        };
+        YarnModel::set_string(self, vrs, vals, check, ctx.resources, bundled)
+    }
+    fn write(&self, w: &mut Writer) {
+        YarnModel::write(self, w)
+    }
+    fn read(&self, r: &mut Reader, built: bool, count: usize) -> Result<Box<dyn FmuModel>, String> {
+        Ok(Box::new(YarnModel::read(r, self, built, count)?))
+    }
+    fn box_clone(&self) -> Box<dyn FmuModel> {
+        Box::new(self.clone())
     }
 }

@@ -46,7 +46,7 @@ fn shared_library_loads_and_runs_like_the_rlib() {
     unsafe {
         let lib = libc::dlopen(cpath.as_ptr(), libc::RTLD_NOW | libc::RTLD_LOCAL);
         assert!(!lib.is_null(), "dlopen {} failed", path.display());
-        for f in YarnBundle::package::FMI2_FUNCTIONS {
+        for f in YarnBundle::ffi::FMI2_FUNCTIONS {
             let n = CString::new(f).unwrap();
             assert!(!libc::dlsym(lib, n.as_ptr()).is_null(), "{f}");
         }

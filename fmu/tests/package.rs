@@ -1,51 +1,12 @@
-//! The packaged artefacts: the shared library's exports and dependencies,
-//! the generated modelDescription.xml and the .fmu archive.
+//! The generated modelDescription.xml (checked-in copies, structure, GUID)
+//! and the unsafe-code rules of the C ABI. The archive and the shared
+//! library's ELF check are tested in `fmu-pack/tests/pack.rs`.
 
 mod common;
-
-use std::path::PathBuf;
 
 use yarnsim::scene::builtin::yarn_reference;
 use yarnsim::scene::YarnScene;
 use YarnBundle::model::*;
-use YarnBundle::package::*;
-
-fn cdylib() -> PathBuf {
-    common::cdylib_path()
-}
-
-#[test]
-fn shared_library_exports_all_34_functions_and_needs_only_libc() {
-    let path = cdylib();
-    let so = std::fs::read(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-    let info = elf_info(&so).unwrap();
-    let mut fmi: Vec<&str> = info
-        .exported
-        .iter()
-        .map(|s| s.as_str())
-        .filter(|s| s.starts_with("fmi2"))
-        .collect();
-    fmi.sort();
-    fmi.dedup();
-    let mut expected = FMI2_FUNCTIONS.to_vec();
-    expected.sort();
-    assert_eq!(fmi, expected);
-    assert_eq!(fmi.len(), 34);
-    // libc and libm (plus the loader and libgcc_s, which Rust's unwinder
-    // needs for catch_unwind); nothing else.
-    assert!(
-        info.needed.iter().any(|n| n == "libc.so.6"),
-        "{:?}",
-        info.needed
-    );
-    for n in &info.needed {
-        assert!(
-            ALLOWED_NEEDED.contains(&n.as_str()),
-            "unexpected dependency {n}"
-        );
-    }
-    check_library(&so).unwrap();
-}
 
 #[test]
 fn checked_in_model_description_is_current() {
@@ -53,7 +14,7 @@ fn checked_in_model_description_is_current() {
     let generated = model_description(&yarn_reference());
     assert!(
         checked_in == generated,
-        "modelDescription/YarnBundle.xml drifted from the generator; refresh it with\n  cargo run --release -p yarnsim-fmu --bin build-fmu -- --model-description modelDescription/YarnBundle.xml"
+        "modelDescription/YarnBundle.xml drifted from the generator; refresh it with\n  cargo run --release -p yarnsim-fmu-pack --bin build-fmu -- --model-description modelDescription/YarnBundle.xml"
     );
 }
 
@@ -74,8 +35,17 @@ fn model_description_structure() {
         .collect();
     assert_eq!(outputs.len(), 4 * yarns + 4);
     for i in &outputs {
-        assert_eq!(xml.matches(&format!("<Unknown index=\"{i}\"/>")).count(), 2);
+        // Listed in <Outputs> and <InitialUnknowns>, always with dependencies.
+        assert_eq!(
+            xml.matches(&format!("<Unknown index=\"{i}\" dependencies=\""))
+                .count(),
+            2
+        );
     }
+    assert_eq!(
+        xml.matches("<Unknown ").count(),
+        xml.matches("dependencies=").count()
+    );
     let mut vrs: Vec<(u32, String)> = vars.iter().map(|v| (v.vr, format!("{:?}", v.ty))).collect();
     vrs.sort();
     vrs.dedup();
@@ -121,37 +91,47 @@ fn guid_follows_the_scene_and_survives_the_scene_file() {
     assert_ne!(guid(&yarn_reference()), guid(&scene));
 }
 
+/// `ffi.rs` (the C ABI) has a SAFETY comment above every `unsafe` block;
+/// `#![deny(unsafe_op_in_unsafe_fn)]` in lib.rs makes every unsafe operation
+/// in an `unsafe fn` take such a block.
 #[test]
-fn fmu_archive_layout_and_contents() {
-    let scene = common::small_scene();
-    let so = b"\x7fELF not really".to_vec();
-    let zip = build_fmu(&scene.clone().into(), &so).unwrap();
-    let entries = zip_entries(&zip).unwrap();
-    let names: Vec<&str> = entries.iter().map(|(n, _)| n.as_str()).collect();
-    assert_eq!(
-        names,
-        [
-            "modelDescription.xml",
-            "binaries/linux64/YarnBundle.so",
-            "resources/scene.toml",
-            "documentation/index.html"
-        ]
-    );
-    assert_eq!(entries[0].1, model_description(&scene).into_bytes());
-    assert_eq!(entries[1].1, so);
-    let packed = YarnScene::from_toml_str(std::str::from_utf8(&entries[2].1).unwrap()).unwrap();
-    assert_eq!(guid(&packed), guid(&scene));
-    // Reproducible: the same inputs give the same bytes.
-    assert_eq!(build_fmu(&scene.clone().into(), &so).unwrap(), zip);
-    // A corrupted archive is detected.
-    let mut bad = zip.clone();
-    let at = zip.windows(4).position(|w| w == b"kind").unwrap();
-    bad[at] ^= 1;
-    assert!(zip_entries(&bad).is_err());
-}
-
-#[test]
-fn crc32_known_value() {
-    assert_eq!(crc32(b"123456789"), 0xCBF4_3926);
-    assert_eq!(crc32(b""), 0);
+fn every_unsafe_block_in_ffi_has_a_safety_comment() {
+    for file in ["src/ffi.rs", "src/instance.rs"] {
+        let text =
+            std::fs::read_to_string(std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(file))
+                .unwrap();
+        let lines: Vec<&str> = text.lines().collect();
+        let mut blocks = 0;
+        for (i, line) in lines.iter().enumerate() {
+            let code = line.split("//").next().unwrap();
+            if !code.contains("unsafe {") {
+                continue;
+            }
+            blocks += 1;
+            // The comment lines right above this statement (or above the
+            // statement this line continues).
+            let mut j = i;
+            let mut found = false;
+            while j > 0 {
+                j -= 1;
+                let l = lines[j].trim_start();
+                if l.starts_with("//") {
+                    if l.contains("SAFETY:") {
+                        found = true;
+                        break;
+                    }
+                } else if l.ends_with(';') || l.ends_with('{') || l.ends_with('}') || l.is_empty() {
+                    break;
+                }
+            }
+            assert!(
+                found,
+                "{file}:{}: unsafe block without a SAFETY comment",
+                i + 1
+            );
+        }
+        assert!(blocks > 0, "{file}");
+    }
+    let lib = include_str!("../src/lib.rs");
+    assert!(lib.contains("#![deny(unsafe_op_in_unsafe_fn)]"));
 }

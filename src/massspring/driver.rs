@@ -357,6 +357,23 @@ impl Simulation {
     pub fn stability(&self) -> Option<StabilityInfo> {
         self.stability
     }
+    /// The largest step this integrator runs stably on this system, in s
+    /// (linearised at the initial configuration, [`StabilityInfo`]):
+    /// forward Euler's and symplectic Euler's bounds; for the trapezoidal
+    /// rule `2 / w_max`, beyond which the linearised step pumps energy into
+    /// the stiff modes (the bound its default step uses). `None` for the
+    /// A-stable schemes (backward Euler, Chebyshev-Jacobi, PBD) and when
+    /// there are no springs.
+    pub fn stable_dt(&self) -> Option<f64> {
+        let st = self.stability?;
+        let bound = match self.integrator {
+            Integrator::ForwardEuler => st.forward_euler,
+            Integrator::SymplecticEuler => st.symplectic_euler,
+            Integrator::Trapezoidal if st.omega_max_sq > 0.0 => 2.0 / st.omega_max_sq.sqrt(),
+            _ => return None,
+        };
+        bound.is_finite().then_some(bound)
+    }
     /// Statistics of the last step.
     pub fn last_step(&self) -> StepStats {
         self.last

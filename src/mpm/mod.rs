@@ -16,6 +16,7 @@
 //! * [`simd`]: AVX2 + FMA / portable kernel dispatch and the fixed chunking.
 //! * [`sim`]: [`YarnSim`], which runs the passes a scene needs.
 //! * [`state`]: byte serialization of the dynamic state.
+//! * [`timestep`]: the stable substep bound (CFL / elastic waves).
 
 pub mod constitutive;
 pub mod contact;
@@ -29,6 +30,7 @@ pub mod sim;
 pub mod simd;
 pub mod spin;
 pub mod state;
+pub mod timestep;
 pub mod transfer;
 pub mod vertex_forces;
 

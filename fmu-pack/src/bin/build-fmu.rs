@@ -1,7 +1,7 @@
 //! Packs the YarnBundle FMU, or a MassSpring FMU for a mass-spring scene.
 //!
 //! ```text
-//! cargo run --release -p yarnsim-fmu --bin build-fmu -- [--scene NAME_OR_FILE] [-o OUT.fmu]
+//! cargo run --release -p yarnsim-fmu-pack --bin build-fmu -- [--scene NAME_OR_FILE] [-o OUT.fmu]
 //!     [--lib libYarnBundle.so | --no-build] [--model-description FILE]
 //! ```
 //!
@@ -18,7 +18,7 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use yarnsim::scene::{Scene, DEFAULT_SCENE};
-use YarnBundle::package::{build_fmu, check_library, zip_entries};
+use yarnsim_fmu_pack::{build_fmu, check_library, zip_entries};
 use YarnBundle::{FmuScene, MODEL_IDENTIFIER};
 
 const USAGE: &str = "usage: build-fmu [--scene NAME_OR_FILE] [-o OUT.fmu] [--lib libYarnBundle.so | --no-build] [--model-description FILE]";
@@ -54,7 +54,7 @@ fn run() -> Result<(), String> {
             .map_err(|e| e.to_string()),
         FmuScene::MassSpring(l) => YarnBundle::massspring::MsModel::new(l.clone())
             .map(|_| ())
-            .map_err(|f| f.msg),
+            .map_err(|e| e.0),
     }
     .map_err(|e| format!("{name}: {e}"))?;
     let xml = scene.model_description()?;

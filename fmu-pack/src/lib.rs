@@ -1,3 +1,6 @@
+//! The FMU packager (`build-fmu`), a crate of its own so that the FMU's
+//! shared library does not carry it.
+//!
 //! Packaging: the `.fmu` zip archive (written here, "stored" entries with a
 //! fixed timestamp, so the same inputs give the same bytes), the generated
 //! documentation page and a small ELF reader that checks the shared library
@@ -5,7 +8,8 @@
 
 use std::fmt::Write as _;
 
-use crate::model::{xml_escape, FmuScene, SCENE_FILE};
+pub use YarnBundle::ffi::FMI2_FUNCTIONS;
+use YarnBundle::model::{xml_escape, FmuScene, SCENE_FILE};
 
 /// CRC-32 (IEEE 802.3, reflected, as zip uses it).
 pub fn crc32(data: &[u8]) -> u32 {
@@ -158,7 +162,7 @@ pub fn documentation_html(scene: &FmuScene) -> Result<String, String> {
                 "{}, frame time {} s, default integrator {}",
                 scene.summary(),
                 l.time.frame_time,
-                crate::massspring::DEFAULT_INTEGRATOR
+                YarnBundle::massspring::DEFAULT_INTEGRATOR
             ),
         ),
     };
@@ -295,44 +299,6 @@ pub fn elf_info(b: &[u8]) -> Result<ElfInfo, String> {
     }
     Ok(info)
 }
-
-/// The 34 functions of FMI 2.0 Co-Simulation (25 common, 9 co-simulation).
-pub const FMI2_FUNCTIONS: [&str; 34] = [
-    "fmi2GetTypesPlatform",
-    "fmi2GetVersion",
-    "fmi2SetDebugLogging",
-    "fmi2Instantiate",
-    "fmi2FreeInstance",
-    "fmi2SetupExperiment",
-    "fmi2EnterInitializationMode",
-    "fmi2ExitInitializationMode",
-    "fmi2Terminate",
-    "fmi2Reset",
-    "fmi2GetReal",
-    "fmi2GetInteger",
-    "fmi2GetBoolean",
-    "fmi2GetString",
-    "fmi2SetReal",
-    "fmi2SetInteger",
-    "fmi2SetBoolean",
-    "fmi2SetString",
-    "fmi2GetFMUstate",
-    "fmi2SetFMUstate",
-    "fmi2FreeFMUstate",
-    "fmi2SerializedFMUstateSize",
-    "fmi2SerializeFMUstate",
-    "fmi2DeSerializeFMUstate",
-    "fmi2GetDirectionalDerivative",
-    "fmi2SetRealInputDerivatives",
-    "fmi2GetRealOutputDerivatives",
-    "fmi2DoStep",
-    "fmi2CancelStep",
-    "fmi2GetStatus",
-    "fmi2GetRealStatus",
-    "fmi2GetIntegerStatus",
-    "fmi2GetBooleanStatus",
-    "fmi2GetStringStatus",
-];
 
 /// Shared libraries the FMU binary may depend on: the C library (with the
 /// parts older glibc versions split out), libm, the dynamic loader, and

@@ -1,0 +1,116 @@
+//! The packager: the .fmu archive (layout, reproducible bytes, corruption
+//! detected), the zip CRC and the ELF check of the FMU's shared library
+//! (all 34 `fmi2*` exports, only libc/libm/libgcc_s/loader needed).
+
+use std::path::PathBuf;
+
+use yarnsim::massspring::scenes::wire;
+use yarnsim::scene::YarnScene;
+use yarnsim_fmu_pack::*;
+use YarnBundle::model::*;
+
+/// The FMU library cargo built as this crate's dependency:
+/// `deps/libYarnBundle.so` next to the test executable (or one folder up).
+fn cdylib_path() -> PathBuf {
+    let exe = std::env::current_exe().unwrap();
+    let deps = exe.parent().unwrap();
+    let name = format!("lib{}.so", YarnBundle::MODEL_IDENTIFIER);
+    [deps.join(&name), deps.parent().unwrap().join(&name)]
+        .into_iter()
+        .find(|p| p.exists())
+        .unwrap_or_else(|| panic!("{name} was not built next to {}", deps.display()))
+}
+
+fn small_scene() -> YarnScene {
+    YarnScene::from_toml_str(include_str!("../../fmu/scenes/small.toml")).unwrap()
+}
+
+#[test]
+fn shared_library_exports_all_34_functions_and_needs_only_libc() {
+    let path = cdylib_path();
+    let so = std::fs::read(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let info = elf_info(&so).unwrap();
+    let mut fmi: Vec<&str> = info
+        .exported
+        .iter()
+        .map(|s| s.as_str())
+        .filter(|s| s.starts_with("fmi2"))
+        .collect();
+    fmi.sort();
+    fmi.dedup();
+    let mut expected = FMI2_FUNCTIONS.to_vec();
+    expected.sort();
+    assert_eq!(fmi, expected);
+    assert_eq!(fmi.len(), 34);
+    // libc and libm (plus the loader and libgcc_s, which Rust's unwinder
+    // needs for catch_unwind); nothing else.
+    assert!(
+        info.needed.iter().any(|n| n == "libc.so.6"),
+        "{:?}",
+        info.needed
+    );
+    for n in &info.needed {
+        assert!(
+            ALLOWED_NEEDED.contains(&n.as_str()),
+            "unexpected dependency {n}"
+        );
+    }
+    check_library(&so).unwrap();
+}
+
+#[test]
+fn fmu_archive_layout_and_contents() {
+    let scene = small_scene();
+    let so = b"\x7fELF not really".to_vec();
+    let zip = build_fmu(&scene.clone().into(), &so).unwrap();
+    let entries = zip_entries(&zip).unwrap();
+    let names: Vec<&str> = entries.iter().map(|(n, _)| n.as_str()).collect();
+    assert_eq!(
+        names,
+        [
+            "modelDescription.xml",
+            "binaries/linux64/YarnBundle.so",
+            "resources/scene.toml",
+            "documentation/index.html"
+        ]
+    );
+    assert_eq!(entries[0].1, model_description(&scene).into_bytes());
+    assert_eq!(entries[1].1, so);
+    let packed = YarnScene::from_toml_str(std::str::from_utf8(&entries[2].1).unwrap()).unwrap();
+    assert_eq!(guid(&packed), guid(&scene));
+    // Reproducible: the same inputs give the same bytes.
+    assert_eq!(build_fmu(&scene.clone().into(), &so).unwrap(), zip);
+    // A corrupted archive is detected.
+    let mut bad = zip.clone();
+    let at = zip.windows(4).position(|w| w == b"kind").unwrap();
+    bad[at] ^= 1;
+    assert!(zip_entries(&bad).is_err());
+}
+
+#[test]
+fn crc32_known_value() {
+    assert_eq!(crc32(b"123456789"), 0xCBF4_3926);
+    assert_eq!(crc32(b""), 0);
+}
+
+#[test]
+fn mass_spring_archive_layout() {
+    let scene = FmuScene::MassSpring(wire());
+    let so = b"\x7fELF not really".to_vec();
+    let zip = build_fmu(&scene, &so).unwrap();
+    let entries = zip_entries(&zip).unwrap();
+    let names: Vec<&str> = entries.iter().map(|(n, _)| n.as_str()).collect();
+    assert_eq!(
+        names,
+        [
+            "modelDescription.xml",
+            "binaries/linux64/MassSpring.so",
+            "resources/scene.toml",
+            "documentation/index.html"
+        ]
+    );
+    let packed = FmuScene::from_toml_str(std::str::from_utf8(&entries[2].1).unwrap()).unwrap();
+    assert_eq!(packed.guid(), scene.guid());
+    let doc = String::from_utf8(entries[3].1.clone()).unwrap();
+    assert!(doc.contains("particle[10].x") && doc.contains("mass-spring"));
+}

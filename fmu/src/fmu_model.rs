@@ -1,0 +1,131 @@
+//! The interface between the FMI front end ([`crate::instance`],
+//! [`crate::ffi`]) and the models it runs: [`FmuModel`], implemented by the
+//! yarn bundle ([`crate::yarn::YarnModel`]) and the mass-spring system
+//! ([`crate::massspring::MsModel`]). The models know nothing of FMI
+//! statuses, function names or C types: they answer with typed errors
+//! ([`ModelError`], [`StepFailure`]) and Rust values, and the front end turns
+//! them into fmi2 statuses and log lines. An FMI 3.0 front end could drive
+//! the same models.
+
+use std::any::Any;
+use std::fmt;
+use std::path::Path;
+
+use crate::massspring::MsModel;
+use crate::model::FmuScene;
+use crate::state_bytes::{Reader, Writer};
+use crate::yarn::YarnModel;
+
+/// A model refused a call: a value out of range, an unknown variable, a
+/// scene or parameter set it cannot build. The front end answers fmi2Error
+/// and logs the message (prefixed with the FMI function's name).
+#[derive(Clone, Debug, PartialEq)]
+pub struct ModelError(pub String);
+
+impl fmt::Display for ModelError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(&self.0)
+    }
+}
+
+impl std::error::Error for ModelError {}
+
+/// What the models' calls return.
+pub type ModelResult<T = ()> = Result<T, ModelError>;
+
+/// Refuses a call with `msg`.
+pub fn refuse<T>(msg: impl Into<String>) -> ModelResult<T> {
+    Err(ModelError(msg.into()))
+}
+
+/// A substep that failed: the message, and whether the simulation is lost
+/// (non-finite state) rather than refused an input.
+#[derive(Clone, Debug, PartialEq)]
+pub struct StepFailure {
+    pub terminal: bool,
+    pub msg: String,
+}
+
+/// Checks that the parameter with this value reference may be set now
+/// (fixed parameters: only before the end of initialization).
+pub type ParamCheck<'a> = &'a dyn Fn(u32) -> ModelResult;
+
+/// What the setter of String variables may need besides the values.
+pub struct SetContext<'a> {
+    /// The FMU's `resources/` folder (relative scene paths).
+    pub resources: &'a Path,
+    /// The scene bundled in `resources/`.
+    pub bundled: &'a FmuScene,
+}
+
+/// The state a failed communication step goes back to
+/// ([`FmuModel::checkpoint`]); only the model that made it reads it.
+pub type Checkpoint = Box<dyn Any + Send>;
+
+/// A model behind the FMU: its outputs, inputs and parameters by value
+/// reference, its substeps and its part of the FMU state.
+pub trait FmuModel: fmt::Debug + Send {
+    /// First bytes of a serialized FMU state of this model.
+    fn state_magic(&self) -> &'static [u8; 8];
+    /// Yarns or particles: the objects the outputs describe.
+    fn count(&self) -> usize;
+    /// The substep size in s.
+    fn dt(&self) -> f64;
+    /// The library's stability bound on the substep in s (`None`: none).
+    fn stable_dt(&self) -> Option<f64>;
+    /// Rebuilds the simulation from the scene and the parameters; it must
+    /// have `count` output objects.
+    fn rebuild(&mut self, count: usize) -> ModelResult;
+    /// Substep number `k` (0-based since initialization).
+    fn substep(&mut self, k: u64) -> Result<(), StepFailure>;
+    /// Every Real output is finite.
+    fn outputs_finite(&mut self) -> bool;
+    /// A copy of the simulated state to go back to.
+    fn checkpoint(&self) -> Checkpoint;
+    /// Puts back a [`Self::checkpoint`] of this model.
+    fn restore(&mut self, c: Checkpoint);
+    /// Whether the Real variable `vr` depends on the simulated state.
+    fn is_state_output(&self, vr: u32) -> bool;
+    /// The value of the Real variable `vr`, `None` if there is none.
+    fn get_real(&mut self, vr: u32) -> Option<f64>;
+    /// The value of the Boolean variable `vr`, `None` if there is none.
+    fn get_boolean(&self, vr: u32) -> Option<bool>;
+    /// The value of the String variable `vr`, `None` if there is none.
+    fn get_string(&self, vr: u32) -> Option<&str>;
+    /// Sets Real inputs and parameters; true when a parameter changed (the
+    /// simulation must be rebuilt). A rejected call changes nothing.
+    fn set_real(&mut self, vrs: &[u32], vals: &[f64], check: ParamCheck) -> ModelResult<bool>;
+    /// Sets Boolean inputs and parameters; true when a parameter changed.
+    fn set_boolean(&mut self, vrs: &[u32], vals: &[bool], check: ParamCheck) -> ModelResult<bool>;
+    /// Sets String parameters (`None`: a null pointer); true when one
+    /// changed.
+    fn set_string(
+        &mut self,
+        vrs: &[u32],
+        vals: &[Option<String>],
+        check: ParamCheck,
+        ctx: &SetContext,
+    ) -> ModelResult<bool>;
+    /// This model's part of a serialized FMU state.
+    fn write(&self, w: &mut Writer);
+    /// Reads what [`Self::write`] wrote into a model of the same kind;
+    /// `self` (with `built`: its simulation matches its scene and
+    /// parameters) is reused where the stored scene and parameters match.
+    fn read(&self, r: &mut Reader, built: bool, count: usize) -> Result<Box<dyn FmuModel>, String>;
+    /// A boxed copy (FMU state snapshots).
+    fn box_clone(&self) -> Box<dyn FmuModel>;
+}
+
+impl Clone for Box<dyn FmuModel> {
+    fn clone(&self) -> Self {
+        self.box_clone()
+    }
+}
+
+/// The model an FMU's bundled scene makes.
+pub fn new_model(scene: &FmuScene) -> ModelResult<Box<dyn FmuModel>> {
+    Ok(match scene {
+        FmuScene::Yarn(s) => Box::new(YarnModel::new(s.clone())?),
+        FmuScene::MassSpring(l) => Box::new(MsModel::new(l.clone())?),
+    })
+}

@@ -1,0 +1,238 @@
+//! FMU states: the snapshots `fmi2GetFMUstate` hands out and their bytes
+//! (`fmi2SerializeFMUstate`): header, checksum, the wrapper's clock and the
+//! model's part, with a bounds-checked reader.
+
+use std::ffi::c_void;
+
+use yarnsim::mpm::state::fnv1a;
+
+use crate::instance::Model;
+use crate::state_machine::Phase;
+
+/// A saved FMU state (`fmi2FMUstate`).
+pub struct Snapshot {
+    pub(crate) magic: u64,
+    pub(crate) phase: Phase,
+    pub(crate) model: Model,
+    /// Serialized form, made on first request.
+    pub(crate) bytes: Option<Vec<u8>>,
+}
+
+pub(crate) const SNAPSHOT_MAGIC: u64 = 0x5942_534e_4150_5348;
+
+impl Snapshot {
+    /// Validates a pointer handed back by the environment.
+    ///
+    /// # Safety
+    /// `p` must be null or a pointer this FMU returned and has not freed.
+    pub unsafe fn from_ptr<'a>(p: *mut c_void) -> Option<&'a mut Snapshot> {
+        // SAFETY: null, or a live `Snapshot` this FMU handed out (the caller's
+        // contract); the magic number below rejects most foreign pointers.
+        let s = unsafe { (p as *mut Snapshot).as_mut() }?;
+        (s.magic == SNAPSHOT_MAGIC).then_some(s)
+    }
+}
+
+impl Drop for Snapshot {
+    fn drop(&mut self) {
+        self.magic = 0;
+    }
+}
+
+/// First bytes of a serialized FMU state of a yarn bundle.
+pub const YARN_STATE_MAGIC: &[u8; 8] = b"YBFMUST\0";
+
+/// First bytes of a serialized FMU state of a mass-spring system.
+pub const MASS_SPRING_STATE_MAGIC: &[u8; 8] = b"MSFMUST\0";
+
+/// Every state magic this library writes.
+pub const STATE_MAGICS: [&[u8; 8]; 2] = [YARN_STATE_MAGIC, MASS_SPRING_STATE_MAGIC];
+
+/// Format version of the serialized FMU state.
+pub const STATE_VERSION: u32 = 1;
+
+const STATE_HEADER: usize = 8 + 4 + 8 + 8;
+
+/// Little-endian writer of a serialized FMU state.
+pub struct Writer(Vec<u8>);
+
+impl Writer {
+    pub fn u8(&mut self, v: u8) {
+        self.0.push(v);
+    }
+    pub fn u64(&mut self, v: u64) {
+        self.0.extend_from_slice(&v.to_le_bytes());
+    }
+    pub fn f64(&mut self, v: f64) {
+        self.0.extend_from_slice(&v.to_le_bytes());
+    }
+    pub fn opt_f64(&mut self, v: Option<f64>) {
+        self.u8(v.is_some() as u8);
+        self.f64(v.unwrap_or(0.0));
+    }
+    pub fn bytes(&mut self, b: &[u8]) {
+        self.u64(b.len() as u64);
+        self.0.extend_from_slice(b);
+    }
+}
+
+/// Reader of a serialized FMU state; every read is bounds-checked and
+/// non-finite numbers are refused.
+pub struct Reader<'a> {
+    b: &'a [u8],
+    at: usize,
+}
+
+impl<'a> Reader<'a> {
+    fn take(&mut self, n: usize) -> Result<&'a [u8], String> {
+        if self.b.len() - self.at < n {
+            return Err(format!(
+                "state is truncated: {} more bytes needed at offset {}",
+                n, self.at
+            ));
+        }
+        let s = &self.b[self.at..self.at + n];
+        self.at += n;
+        Ok(s)
+    }
+    pub fn u8(&mut self) -> Result<u8, String> {
+        Ok(self.take(1)?[0])
+    }
+    pub fn bool(&mut self) -> Result<bool, String> {
+        match self.u8()? {
+            0 => Ok(false),
+            1 => Ok(true),
+            b => Err(format!("bad flag byte {b}")),
+        }
+    }
+    pub fn u64(&mut self) -> Result<u64, String> {
+        Ok(u64::from_le_bytes(self.take(8)?.try_into().unwrap()))
+    }
+    pub fn f64(&mut self) -> Result<f64, String> {
+        let v = f64::from_le_bytes(self.take(8)?.try_into().unwrap());
+        if v.is_finite() {
+            Ok(v)
+        } else {
+            Err("state contains a non-finite number".into())
+        }
+    }
+    pub fn opt_f64(&mut self) -> Result<Option<f64>, String> {
+        let some = self.bool()?;
+        let v = self.f64()?;
+        Ok(some.then_some(v))
+    }
+    pub fn bytes(&mut self) -> Result<&'a [u8], String> {
+        let n = self.u64()?;
+        let n = usize::try_from(n).map_err(|_| "bad length".to_string())?;
+        self.take(n)
+    }
+    pub fn string(&mut self) -> Result<String, String> {
+        String::from_utf8(self.bytes()?.to_vec()).map_err(|_| "string is not UTF-8".to_string())
+    }
+    /// Fails unless every byte was read.
+    pub fn finish(&self) -> Result<(), String> {
+        if self.at == self.b.len() {
+            Ok(())
+        } else {
+            Err(format!(
+                "state has {} unexpected trailing bytes",
+                self.b.len() - self.at
+            ))
+        }
+    }
+}
+
+/// The FMU state as bytes: magic (one per model), version, body length,
+/// FNV-1a checksum of the body; the body holds the state machine state and
+/// the wrapper's time keeping, then the model's part ([`YarnModel::write`],
+/// [`MsModel::write`]). No pointers.
+pub fn serialize(phase: Phase, m: &Model) -> Vec<u8> {
+    let mut w = Writer(Vec::new());
+    w.u8(phase.code());
+    w.u8(m.terminated as u8);
+    w.u8(m.dirty as u8);
+    w.f64(m.start_time);
+    w.opt_f64(m.stop_time);
+    w.f64(m.time);
+    w.f64(m.last_successful_time);
+    w.u64(m.substeps);
+    m.physics.write(&mut w);
+    let body = w.0;
+    let mut out = Vec::with_capacity(STATE_HEADER + body.len());
+    out.extend_from_slice(m.physics.state_magic());
+    out.extend_from_slice(&STATE_VERSION.to_le_bytes());
+    out.extend_from_slice(&(body.len() as u64).to_le_bytes());
+    out.extend_from_slice(&fnv1a(&body).to_le_bytes());
+    out.extend_from_slice(&body);
+    out
+}
+
+/// Reads bytes written by [`serialize`] for an FMU of the same model with
+/// `count` outputs objects; `current`'s simulation is reused when its scene
+/// and parameters match, else it is rebuilt from the stored scene.
+pub fn deserialize(bytes: &[u8], current: &Model, count: usize) -> Result<(Phase, Model), String> {
+    if bytes.len() < STATE_HEADER {
+        return Err(format!(
+            "state has {} bytes, at least {STATE_HEADER} needed",
+            bytes.len()
+        ));
+    }
+    let magic = current.physics.state_magic();
+    if &bytes[..8] != magic {
+        let what = if STATE_MAGICS.iter().any(|m| &bytes[..8] == *m) {
+            "is the state of the other kind of FMU"
+        } else {
+            "does not start with a yarnsim FMU state magic"
+        };
+        return Err(format!(
+            "state {what} (expected {:?})",
+            String::from_utf8_lossy(&magic[..7])
+        ));
+    }
+    let version = u32::from_le_bytes(bytes[8..12].try_into().unwrap());
+    if version != STATE_VERSION {
+        return Err(format!(
+            "state format version {version} is not {STATE_VERSION}"
+        ));
+    }
+    let len = u64::from_le_bytes(bytes[12..20].try_into().unwrap());
+    let sum = u64::from_le_bytes(bytes[20..28].try_into().unwrap());
+    let body = &bytes[STATE_HEADER..];
+    if len != body.len() as u64 {
+        return Err(format!(
+            "state declares {len} body bytes but has {}",
+            body.len()
+        ));
+    }
+    if fnv1a(body) != sum {
+        return Err("state checksum does not match: the bytes are corrupt".into());
+    }
+    let mut r = Reader { b: body, at: 0 };
+    let phase = Phase::from_code(r.u8()?).ok_or("bad state machine state")?;
+    if matches!(phase, Phase::Error | Phase::Fatal) {
+        return Err("state was saved in an error state".into());
+    }
+    let terminated = r.bool()?;
+    let dirty = r.bool()?;
+    let start_time = r.f64()?;
+    let stop_time = r.opt_f64()?;
+    let time = r.f64()?;
+    let last_successful_time = r.f64()?;
+    let substeps = r.u64()?;
+    let built = !current.dirty;
+    let physics = current.physics.read(&mut r, built, count)?;
+    Ok((
+        phase,
+        Model {
+            physics,
+            dirty,
+            start_time,
+            stop_time,
+            time,
+            last_successful_time,
+            substeps,
+            terminated,
+            outputs_checked: false,
+        },
+    ))
+}

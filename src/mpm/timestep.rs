@@ -1,0 +1,90 @@
+//! The yarn MPM's stable substep: the CFL / elastic-wave bound that the
+//! library, the CLI, the FMU and the stability evidence share.
+//!
+//! The substep is explicit: grid velocities are updated from the elastic
+//! forces and then carried back to the particles. Two limits apply.
+//!
+//! * **Elastic waves.** The energy density `psi` (Pa, per unit area of the
+//!   2D cross-section, unit thickness) has the stiffnesses `k` (fiber
+//!   stretch), `gamma` (fiber shear) and `2 mu + lambda = 1.4 E` (normal
+//!   compression, [`YarnEnergy::normal`]); the mass per unit area is the line
+//!   density `rho` (kg/m per unit thickness, see [`super::particles`]: a
+//!   segment of rest length `l0` has mass `rho l0` and volume `l0`). The
+//!   fastest wave runs at `c = sqrt(max(k, gamma, 2 mu + lambda) / rho)`.
+//!   A wave must not cross more than one grid cell `dx` per substep (the
+//!   grid couples only neighbouring nodes), which gives `dt <= dx / c`.
+//! * **Advection.** A particle must not move more than one cell per substep
+//!   (the check in the vertex gather that reports divergence):
+//!   `dt <= dx / |v|`.
+//!
+//! Together (Courant number 1): `dt <= dx / (c + |v|max)`. The bound is
+//! conservative where it was measured (`yarnsim bench stress`, README
+//! "Stability stress"): on yarn-small the largest stable substep is 1.5 to
+//! 1.8 times the bound when `k` or `E` change by 100x, and it scales as
+//! `1/sqrt(k)` and `1/sqrt(E)` as the bound does; a stiffer `gamma` hardly
+//! lowers the real limit (the return mapping caps the shear stress), so
+//! there the bound is pessimistic (up to 10x).
+//! * **Bending.** The bending energy `B/2 kappa^2` (discrete elastic rods,
+//!   [`super::vertex_forces`]) gives flexural waves with `omega = sqrt(B / rho) q^2`;
+//!   at the grid's shortest wavelength (`q = 2 / dx`) an explicit step needs
+//!   `dt <= 2 / omega = dx^2 sqrt(rho / B) / 2`. It is far above the
+//!   elastic bound at the built-in values (B = 1e-3 N m on 256^2: 7.6e-3 s
+//!   against 1.6e-4 s) but decides for stiff rods on fine grids.
+//!
+//! Velocities the run will reach later (gravity, attractor,
+//! impacts) are not known in advance: [`YarnSim::stable_dt`] uses the
+//! current largest particle speed, so at initialization it is the elastic
+//! bound of a scene at rest, a necessary condition, not a guarantee.
+
+use super::constitutive::YarnEnergy;
+use super::YarnSim;
+use crate::scene::Material;
+
+/// Courant number of [`stable_dt`]: 1, the cell-crossing limit itself (the
+/// measured limits lie above it, see the module docs).
+pub const COURANT: f64 = 1.0;
+
+/// The fastest elastic wave speed `c = sqrt(max(k, gamma, 2 mu + lambda) / rho)`
+/// of a material, in m/s.
+pub fn wave_speed(m: &Material) -> f64 {
+    let e = YarnEnergy::from_material(m);
+    (e.k.max(e.gamma).max(e.normal) / m.density).sqrt()
+}
+
+/// The largest stable substep in s for a grid spacing `dx` (m) and a largest
+/// particle speed `v_max` (m/s): `COURANT dx / (c + v_max)`, and with
+/// bending also `dx^2 sqrt(rho / B) / 2`.
+pub fn stable_dt(m: &Material, dx: f64, v_max: f64) -> f64 {
+    let elastic = COURANT * dx / (wave_speed(m) + v_max.abs());
+    if m.bending > 0.0 {
+        elastic.min(0.5 * dx * dx * (m.density / m.bending).sqrt())
+    } else {
+        elastic
+    }
+}
+
+impl YarnSim {
+    /// The largest particle speed now, in m/s (vertices and quadrature
+    /// particles).
+    pub fn max_speed(&self) -> f64 {
+        let p = self.particles();
+        p.vert
+            .v
+            .iter()
+            .chain(&p.quad.v)
+            .map(|v| v.norm())
+            .fold(0.0, f64::max)
+    }
+
+    /// The stable substep bound of the current state
+    /// ([`stable_dt`] with this scene's material, grid and the current
+    /// largest particle speed). The simulation's own `dt()` should not
+    /// exceed it.
+    pub fn stable_dt(&self) -> f64 {
+        stable_dt(
+            &self.scene().material,
+            self.grid_geom().dx,
+            self.max_speed(),
+        )
+    }
+}
