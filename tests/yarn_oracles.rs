@@ -7,8 +7,9 @@
 mod common;
 
 use common::scene;
-use yarnsim::math::Vec2;
-use yarnsim::scene::YarnScene;
+use yarnsim::math::{perp, Mat2, Vec2};
+use yarnsim::scene::builtin::small_yarn_scene;
+use yarnsim::scene::{SceneError, TransferScheme, WallMode, YarnScene};
 use yarnsim::YarnSim;
 
 // ---- capstan ---------------------------------------------------------------
@@ -208,4 +209,216 @@ fn capstan_yarn_slides_below_and_holds_above_the_heavy_rope_threshold() {
         }
     }
     assert!(failures.is_empty(), "{failures:?}");
+}
+
+// ---- cantilever -------------------------------------------------------------
+
+/// Cantilever: length 0.5 m from (0.25, 0.5) along +x, first two vertices
+/// pinned: the clamp acts at the middle of the pinned segment (the bending
+/// energy of the second vertex covers its Voronoi length, half of it
+/// inside the clamp), so the free length is `L_f = L - l / 2` with `l` the
+/// vertex spacing (measured against the full L: -2.0 % at 100 vertices,
+/// -1.0 % at 200, -0.2 % at 400, i.e. (1 - l / (2 L))^4), B = 1 N m, line density 1 kg/m,
+/// k = 1e4 (axial strain ~1e-7), no cross-section energy (gamma = E = 0),
+/// gravity q / rho = 0.08 B / L^3 so the tip sags about 1 % of L. Grid 64^2
+/// (dx = 0.0156 m), dt 5e-5 s (the bending limit is ~ dx^2 sqrt(rho / B)).
+/// Returns (tip deflection averaged over two periods of the first mode,
+/// Euler-Bernoulli q L_f^4 / (8 B), the same with the full length L).
+fn cantilever(vertices: u32) -> (f64, f64, f64) {
+    let (len, b, rho): (f64, f64, f64) = (0.5, 1.0, 1.0);
+    let g = 0.08 * b / (rho * len * len * len);
+    let s = scene(&format!(
+        r#"
+gravity = [0.0, -{g}]
+[grid]
+resolution = 64
+[time]
+dt = 5e-5
+[material]
+k = 1e4
+gamma = 0.0
+youngs_modulus = 0.0
+friction = 0.0
+bending = {b}
+density = {rho}
+plasticity = false
+[walls]
+mode = "none"
+[[yarns]]
+start = [0.25, 0.5]
+end = [{}, 0.5]
+vertices = {vertices}
+[[pins]]
+yarn = 0
+end = "start"
+count = 2
+"#,
+        0.25 + len
+    ));
+    let mut sim = YarnSim::new(&s).unwrap();
+    let q = rho * g;
+    let free = len - 0.5 * len / (vertices - 1) as f64;
+    let oracle = q * free.powi(4) / (8.0 * b);
+    let oracle_full = q * len.powi(4) / (8.0 * b);
+    // The default FLIP transfer does not dissipate: the suddenly loaded
+    // beam oscillates about its static shape (deflection ~ delta (1 - cos
+    // omega_1 t)), so the tip deflection is averaged over two whole
+    // periods of the first mode, as measured: between the first and third
+    // upward crossing of the deflection through its mean over 2.5 periods of
+    // omega_1 = 1.8751^2 sqrt(B / (rho L^4)). (Averaging over the oracle's
+    // period instead errs by the relative period error, a few %; higher
+    // modes, omega_2 = 6.27 omega_1, average out to well below 0.1 %.)
+    let omega1 = 1.8751f64.powi(2) * (b / (rho * free.powi(4))).sqrt();
+    let period = 2.0 * std::f64::consts::PI / omega1;
+    let steps = (2.5 * period / sim.dt()).round() as u64;
+    let y0 = sim.yarn_endpoints(0).1.y;
+    let mut d = Vec::with_capacity(steps as usize);
+    for _ in 0..steps {
+        sim.step().unwrap();
+        d.push(y0 - sim.yarn_endpoints(0).1.y);
+    }
+    let m0 = d.iter().sum::<f64>() / d.len() as f64;
+    let up: Vec<usize> = (1..d.len())
+        .filter(|&k| d[k - 1] < m0 && d[k] >= m0)
+        .collect();
+    assert!(up.len() >= 3, "{vertices} vertices: crossings {up:?}");
+    let (a, e) = (up[0], up[2]);
+    let measured_period = (e - a) as f64 * sim.dt() / 2.0;
+    eprintln!(
+        "cantilever {vertices} vertices: first-mode period {measured_period:.4} s (Euler-Bernoulli {period:.4} s)"
+    );
+    (
+        d[a..e].iter().sum::<f64>() / (e - a) as f64,
+        oracle,
+        oracle_full,
+    )
+}
+
+#[test]
+#[cfg_attr(debug_assertions, ignore = "release-mode test (cargo test --release)")]
+fn cantilever_tip_deflection_matches_euler_bernoulli_at_every_resolution() {
+    let mut tips = Vec::new();
+    for n in [100, 200, 400] {
+        let (tip, oracle, oracle_full) = cantilever(n);
+        let err = (tip - oracle) / oracle;
+        eprintln!(
+            "cantilever {n} vertices (64^2, dt 5e-5, FLIP, mean over 2 measured periods): tip {tip:.5e} m, \
+             Euler-Bernoulli q L_f^4 / (8 B) {oracle:.5e} m, error {:+.2} % (against the full L: {:+.2} %)",
+            100.0 * err,
+            100.0 * (tip - oracle_full) / oracle_full
+        );
+        // and within 5 % of the full-length formula as well
+        assert!(((tip - oracle_full) / oracle_full).abs() < 0.05);
+        // tolerance 5 % against q L_f^4 / (8 B)
+        assert!(err.abs() < 0.05, "{n} vertices: error {err:+.4}");
+        tips.push(tip);
+    }
+    let spread = tips.iter().cloned().fold(f64::MIN, f64::max)
+        / tips.iter().cloned().fold(f64::MAX, f64::min)
+        - 1.0;
+    eprintln!(
+        "cantilever spread of the tip deflection over 100, 200, 400 vertices: {:.2} %",
+        100.0 * spread
+    );
+    // tolerance 2 % between resolutions
+    assert!(spread < 0.02, "spread {spread:.4}");
+}
+
+// ---- hanging chain ----------------------------------------------------------
+
+/// Bessel J0 by its power series (|x| < 3 here: 30 terms are exact to round-off).
+fn bessel_j0(x: f64) -> f64 {
+    let (mut term, mut sum) = (1.0, 1.0);
+    let q = -x * x / 4.0;
+    for k in 1..30 {
+        term *= q / (k * k) as f64;
+        sum += term;
+    }
+    sum
+}
+
+#[test]
+#[cfg_attr(debug_assertions, ignore = "release-mode test (cargo test --release)")]
+fn hanging_chain_swings_at_its_first_mode_and_its_pin_carries_its_weight() {
+    // L = 0.8 m pinned at (0.5, 0.9), 100 vertices, 64^2 grid, dt 1e-4,
+    // bending 0, k = 2000 (static strain at the top g L rho / k = 0.4 %),
+    // no cross-section energy; default FLIP.
+    let (len, g, j01) = (0.8, 9.8, 2.404825557695773);
+    assert!(bessel_j0(j01).abs() < 1e-12);
+    let amp = 0.02;
+    let n = 200;
+    let points = (0..=n)
+        .map(|i| {
+            let z = len * (n - i) as f64 / n as f64; // from the top down
+            let u = amp * bessel_j0(j01 * (z / len).sqrt());
+            format!("[{:.12}, {:.12}]", 0.5 + u, 0.1 + z)
+        })
+        .collect::<Vec<_>>()
+        .join(", ");
+    let s = scene(&format!(
+        r#"
+gravity = [0.0, -{g}]
+[grid]
+resolution = 64
+[time]
+dt = 1e-4
+[material]
+k = 2000.0
+gamma = 0.0
+youngs_modulus = 0.0
+friction = 0.0
+bending = 0.0
+plasticity = false
+[walls]
+mode = "none"
+[[yarns]]
+points = [{points}]
+vertices = 100
+[[pins]]
+yarn = 0
+end = "start"
+"#
+    ));
+    let mut sim = YarnSim::new(&s).unwrap();
+    let omega = j01 / 2.0 * (g / len).sqrt();
+    let period = 2.0 * std::f64::consts::PI / omega;
+    let weight = sim.diagnostics().total_mass * g;
+    let mut crossings = Vec::new();
+    let mut prev = sim.yarn_endpoints(0).1.x - 0.5;
+    let mut reaction = Vec::new();
+    while crossings.len() < 5 {
+        sim.step().unwrap();
+        let u = sim.yarn_endpoints(0).1.x - 0.5;
+        reaction.push(sim.pin_reactions()[0]);
+        if prev * u < 0.0 {
+            let t = sim.time() - sim.dt() * u / (u - prev);
+            crossings.push((t, reaction.len()));
+        }
+        prev = u;
+        assert!(sim.time() < 4.0 * period, "no 5 zero crossings");
+    }
+    let (t0, k0) = crossings[0];
+    let (t4, k4) = crossings[4];
+    let measured = 2.0 * (t4 - t0) / 4.0;
+    let err = (measured - period) / period;
+    eprintln!(
+        "hanging chain (100 vertices, 64^2, dt 1e-4, FLIP): period {measured:.5} s, \
+         oracle 2 pi / (1.2024 sqrt(g/L)) = {period:.5} s, error {:+.2} %",
+        100.0 * err
+    );
+    // tolerance 3 % on omega_1
+    assert!(err.abs() < 0.03, "period error {err:+.4}");
+    // the pin's force on the yarn, averaged over the two periods between
+    // the crossings, carries the yarn's weight
+    let mean: Vec2 = reaction[k0..k4].iter().sum::<Vec2>() / (k4 - k0) as f64;
+    let werr = (mean.y - weight) / weight;
+    eprintln!(
+        "hanging chain pin reaction mean ({:.4e}, {:.4e}) N, weight {weight:.4e} N, error {:+.2} %",
+        mean.x,
+        mean.y,
+        100.0 * werr
+    );
+    // tolerance 2 % on the vertical, 1 % of the weight sideways
+    assert!(werr.abs() < 0.02, "weight error {werr:+.4}");
+    assert!(mean.x.abs() < 0.01 * weight, "sideways {}", mean.x);
 }
