@@ -1,11 +1,22 @@
 //! Pinned and driven yarn vertices: each pin holds some vertices on a
-//! prescribed path (fixed, a line, a circle). After every grid-to-particle
-//! pass the pinned vertices get exactly their prescribed position and
-//! velocity; the momentum this takes, per substep, is the pin's reaction
-//! force on the yarn.
+//! prescribed path (fixed, a line, a circle).
+//!
+//! A pin acts on the grid, as a constraint: after the grid update,
+//! [`constrain_grid`] adds to the nodes of each pinned vertex's stencil the
+//! impulse (spread with the vertex's weights, like any force on it) that
+//! makes the grid velocity interpolated at the vertex equal its prescribed
+//! velocity, so the yarn around the pin feels the pin's force in the same
+//! substep. (Resetting only the pinned particles lets the grid near the pin
+//! fall freely: the pull of the pinned vertex on its neighbour and theirs
+//! on it cancel on the shared nodes, the first segment stretches without
+//! bound, and a hanging yarn diverges within 0.02 s.) After every
+//! grid-to-particle pass the pinned vertices get exactly their prescribed
+//! position and velocity ([`apply`]); the constraint impulse plus what this
+//! takes, per substep, is the pin's reaction force on the yarn.
 
+use super::grid::{Grid, DVX, DVY, M, VX, VY};
 use super::particles::{Particles, Vertices};
-use crate::math::{perp, Vec2};
+use crate::math::{perp, Mat2, Vec2};
 use crate::scene::{PinMotionKind, SceneError, YarnScene};
 
 /// How a pin moves its vertices.
@@ -48,6 +59,18 @@ impl Pin {
     }
 }
 
+impl Pin {
+    /// Prescribed velocity gradient (the affine matrix `C`) of the pin's
+    /// vertices: zero for a fixed or translating pin, the rigid rotation
+    /// `[[0, -omega], [omega, 0]]` for a circle.
+    pub fn velocity_gradient(&self) -> Mat2 {
+        match self.motion {
+            PinMotion::Fixed | PinMotion::Line { .. } => Mat2::zeros(),
+            PinMotion::Circle { omega, .. } => Mat2::new(0.0, -omega, omega, 0.0),
+        }
+    }
+}
+
 /// The pins of a scene over its particles (validated).
 pub fn pins_of_scene(scene: &YarnScene, p: &Particles) -> Result<Vec<Pin>, SceneError> {
     let ranges = scene.pin_ranges()?;
@@ -79,21 +102,125 @@ pub fn pins_of_scene(scene: &YarnScene, p: &Particles) -> Result<Vec<Pin>, Scene
         .collect())
 }
 
-/// Puts every pinned vertex at its target at time `t` and returns, per pin,
-/// the force the pin exerted on the yarn over the last substep of length
-/// `dt`: `sum m (v_target - v) / dt` over its vertices, with `v` the
-/// velocity the vertex had from the grid.
-pub fn apply(pins: &[Pin], vert: &mut Vertices, t: f64, dt: f64, reactions: &mut Vec<Vec2>) {
-    reactions.clear();
-    for pin in pins {
+/// Most Gauss-Seidel sweeps of [`constrain_grid`] (pins whose stencils
+/// overlap couple; the sweeps stop once every pinned vertex's interpolated
+/// velocity is its target to round-off).
+const PIN_SWEEPS: usize = 200;
+
+/// Pin constraint on the grid after the grid update of the substep ending
+/// at time `t`: for each pinned vertex (stencil `st` of its start-of-step
+/// position, weights `w_i`, node masses `m_i`) the impulse
+/// `J = (v_target - sum w_i v_i) / sum (w_i^2 / m_i)` is added to its nodes
+/// as `w_i J / m_i` (to the velocity and, for FLIP, to its change), in
+/// Gauss-Seidel sweeps over all pinned vertices. Sets `forces[k]` to
+/// `sum J / dt` of pin `k`.
+pub fn constrain_grid(
+    pins: &[Pin],
+    vert: &Vertices,
+    grid: &mut Grid,
+    t: f64,
+    dt: f64,
+    forces: &mut Vec<Vec2>,
+) {
+    struct Entry {
+        pin: usize,
+        idx: [usize; 9],
+        w: [f64; 9],
+        /// `w_i / m_i` (0 where the node has no mass).
+        w_inv_m: [f64; 9],
+        denom: f64,
+        target: Vec2,
+    }
+    let geom = grid.geom;
+    let mut entries = Vec::new();
+    for (k, pin) in pins.iter().enumerate() {
+        for (j, &i) in pin.vertices.iter().enumerate() {
+            let st = &vert.stencil[i];
+            let (bi, bj) = (st.base[0] as usize, st.base[1] as usize);
+            let mut e = Entry {
+                pin: k,
+                idx: [0; 9],
+                w: [0.0; 9],
+                w_inv_m: [0.0; 9],
+                denom: 0.0,
+                target: pin.target(j, t).1,
+            };
+            for a in 0..3 {
+                for b in 0..3 {
+                    let n = 3 * a + b;
+                    let (ni, nj) = (bi + a, bj + b);
+                    let idx = geom.index(ni, nj);
+                    let blk = geom.block_of(ni, nj);
+                    let m: f64 = grid
+                        .buffers
+                        .iter()
+                        .filter(|s| s.touched[blk])
+                        .map(|s| s.node[idx][M])
+                        .sum();
+                    let w = st.weight(a, b);
+                    e.idx[n] = idx;
+                    e.w[n] = w;
+                    if m > 0.0 {
+                        e.w_inv_m[n] = w / m;
+                        e.denom += w * w / m;
+                    }
+                }
+            }
+            if e.denom > 0.0 {
+                entries.push(e);
+            }
+        }
+    }
+    forces.clear();
+    forces.resize(pins.len(), Vec2::zeros());
+    for _ in 0..PIN_SWEEPS {
+        let mut worst: f64 = 0.0;
+        let mut scale: f64 = 0.0;
+        for e in &entries {
+            let mut v = Vec2::zeros();
+            for n in 0..9 {
+                let node = &grid.node[e.idx[n]];
+                v += Vec2::new(node[VX], node[VY]) * e.w[n];
+            }
+            let r = e.target - v;
+            worst = worst.max(r.norm());
+            scale = scale.max(v.norm()).max(e.target.norm());
+            let j = r / e.denom;
+            for n in 0..9 {
+                let dv = j * e.w_inv_m[n];
+                let node = &mut grid.node[e.idx[n]];
+                node[VX] += dv.x;
+                node[VY] += dv.y;
+                node[DVX] += dv.x;
+                node[DVY] += dv.y;
+            }
+            forces[e.pin] += j / dt;
+        }
+        if worst <= 1e-13 * scale.max(1e-300) || worst == 0.0 {
+            break;
+        }
+    }
+}
+
+/// Puts every pinned vertex at its target at time `t` (position, velocity
+/// and the prescribed velocity gradient as its affine matrix: a FLIP
+/// vertex would otherwise keep adding the grid's change of `C` to a `C`
+/// that nothing resets, which diverges within 0.02 s at a pinned yarn end)
+/// and adds to `reactions[k]`, per pin, the force this exerted on the yarn
+/// over the last substep of length `dt`: `sum m (v_target - v) / dt` over
+/// its vertices, with `v` the velocity the vertex had from the grid.
+pub fn apply(pins: &[Pin], vert: &mut Vertices, t: f64, dt: f64, reactions: &mut [Vec2]) {
+    for (pin, reaction) in pins.iter().zip(reactions.iter_mut()) {
         let mut force = Vec2::zeros();
+        let c = pin.velocity_gradient();
         for (k, &i) in pin.vertices.iter().enumerate() {
             let (x, v) = pin.target(k, t);
             force += (v - vert.v[i]) * (vert.m[i] / dt);
             vert.x[i] = x;
             vert.v[i] = v;
+            vert.c[i] = c;
         }
-        reactions.push(force);
+        *reaction += force;
     }
 }
 
@@ -101,10 +228,12 @@ pub fn apply(pins: &[Pin], vert: &mut Vertices, t: f64, dt: f64, reactions: &mut
 /// a reaction (at the start, or after the state was set from outside).
 pub fn place(pins: &[Pin], vert: &mut Vertices, t: f64) {
     for pin in pins {
+        let c = pin.velocity_gradient();
         for (k, &i) in pin.vertices.iter().enumerate() {
             let (x, v) = pin.target(k, t);
             vert.x[i] = x;
             vert.v[i] = v;
+            vert.c[i] = c;
         }
     }
 }

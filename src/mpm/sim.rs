@@ -378,6 +378,16 @@ impl YarnSim {
             wall_cells: self.scene.walls.cells as usize,
         };
         grid_update::grid_update(&mut self.grid, dt, &ext, flip);
+        if !self.pins.is_empty() {
+            pins::constrain_grid(
+                &self.pins,
+                &self.particles.vert,
+                &mut self.grid,
+                self.time + dt,
+                dt,
+                &mut self.pin_reactions,
+            );
+        }
         let t3 = Instant::now();
         let gather = VertexGather {
             grid: &self.grid,
