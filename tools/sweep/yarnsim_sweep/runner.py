@@ -138,11 +138,15 @@ def _run(sweep, client, todo, writer, quiet, on_result):
     from distributed import as_completed
 
     # workers of an external cluster need fmpy and distributed, not this package
-    cloudpickle.register_pickle_by_value(task)
+    if not os.environ.get("YARNSIM_SWEEP_BY_REF"):
+        cloudpickle.register_pickle_by_value(task)
     with open(sweep.fmu, "rb") as fh:
         fmu_bytes = fh.read()
     name = "yarnsim-sweep-fmu-" + hashlib.sha256(fmu_bytes).hexdigest()[:16]
-    client.register_plugin(task.FMUPlugin(name, fmu_bytes))
+    # once per cluster: a second sweep of the same FMU reuses the extraction
+    has = client.run(lambda dask_worker, name=name: name in dask_worker.plugins)
+    if not has or not all(has.values()):
+        client.register_plugin(task.FMUPlugin(name, fmu_bytes))
     info = client.scheduler_info()
     nworkers = len(info.get("workers", {}))
     if not quiet:
@@ -157,9 +161,12 @@ def _run(sweep, client, todo, writer, quiet, on_result):
     progress = Progress(len(futures), quiet)
     last = time.perf_counter()
     try:
-        for fut in as_completed(futures, loop=client.loop):
+        # with_results: the results come in batches, not one round trip each
+        for fut, res in as_completed(futures, loop=client.loop, with_results=True, raise_errors=False):
             try:
-                row, series = fut.result()
+                if fut.status == "error" or isinstance(res, BaseException):
+                    raise res if isinstance(res, BaseException) else RuntimeError(str(res))
+                row, series = res
             except Exception as exc:
                 # the task itself failed (e.g. KilledWorker after repeated
                 # worker deaths): still a row
@@ -193,7 +200,7 @@ class Writer:
         self.pending = []
         self.columns = (["index", "point"] + list(sweep.varied)
                         + [f"{n}:{r}" for n, reds in sweep.outputs for r in reds if r != "series"]
-                        + ["status", "message", "last_message", "t_end", "wall_s", "worker", "pid"])
+                        + ["status", "message", "last_message", "t_end", "wall_s", "started", "worker", "pid"])
         self.series_names = [n for n, reds in sweep.outputs if "series" in reds]
 
     def add(self, row, series):

@@ -106,6 +106,7 @@ def run_point(plugin_name, run, key, values):
     Failures are data: an FMU that returns Discard/Error, an exception in
     fmpy, a run that stops early or a non-finite kept output give a row with
     status and the FMU's messages."""
+    started = time.time()
     t0 = time.perf_counter()
     worker = get_worker()
     plugin = worker.plugins[plugin_name]
@@ -149,6 +150,7 @@ def run_point(plugin_name, run, key, values):
     if row["status"] != "ok":
         series = None
     row["wall_s"] = time.perf_counter() - t0
+    row["started"] = started
     row["worker"] = worker.address
     row["pid"] = os.getpid()
     return row, series
