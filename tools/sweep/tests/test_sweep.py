@@ -300,3 +300,52 @@ def test_cli_reports_bad_input_with_exit_code_2(wire_fmu, write_sweep, capsys):
     p = write_sweep(HEAD.format(fmu=wire_fmu) + '[parameters]\ndt = [0.001, 0.002]\n', "ok.toml")
     assert main([p, "--dry-run"]) == 0
     assert "2 points (factorial)" in capsys.readouterr().out
+
+
+def free_port():
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+def test_existing_cluster_whose_workers_lack_the_package(wire_fmu, write_sweep, tmp_path):
+    """`dask scheduler` + `dask worker` processes as on other machines; the
+    workers' Python cannot import yarnsim_sweep (site-packages on PYTHONPATH
+    with -S, so the editable install's .pth is not read): the worker code
+    travels by value. Same rows as the LocalCluster run."""
+    import subprocess
+    import sys
+    import sysconfig
+
+    port = free_port()
+    addr = f"tcp://127.0.0.1:{port}"
+    env = {**os.environ, "PYTHONPATH": sysconfig.get_paths()["purelib"], "RAYON_NUM_THREADS": "1"}
+    sched = subprocess.Popen([sys.executable, "-S", "-c",
+                              f"import sys; sys.argv=['dask-scheduler', '--port', '{port}', '--dashboard-address', ':0'];"
+                              "from distributed.cli.dask_scheduler import main; main()"],
+                             cwd=tmp_path, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    work = subprocess.Popen([sys.executable, "-S", "-c",
+                             "import importlib.util, sys; assert importlib.util.find_spec('yarnsim_sweep') is None;"
+                             f"sys.argv=['dask-worker', '{addr}', '--nworkers', '2', '--nthreads', '1'];"
+                             "from distributed.cli.dask_worker import main; main()"],
+                            cwd=tmp_path, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    try:
+        sweep = Sweep(write_sweep(WIRE.format(fmu=wire_fmu)))
+        c = connect(addr, timeout=30.0)
+        try:
+            c.wait_for_workers(2, timeout=60)
+            s = run_sweep(sweep, str(tmp_path / "ext"), client=c, quiet=True, plot=False)
+        finally:
+            c.close()
+        assert s["rows"] == 6 and s["failed"] == 0 and s["workers"] == 2
+        df = pd.read_parquet(str(tmp_path / "ext" / "results.parquet"))
+        series = pd.read_parquet(str(tmp_path / "ext" / "series.parquet"))
+        check_rows_equal_serial(df, series, wire_fmu, ["integrator", "gravity.x"],
+                                {"time": [0.0, 0.5, 1.0], "gravity.z": [0.0, 3.0, -2.0]}, sweep.outputs, 1.0, 0.05)
+    finally:
+        for p in (work, sched):
+            p.terminate()
+            try:
+                p.wait(timeout=20)
+            except subprocess.TimeoutExpired:
+                p.kill()

@@ -23,6 +23,26 @@ from .spec import SweepError
 FLUSH_S = 2.0
 
 
+_WORKER_TASK = None
+
+
+def worker_task_module():
+    """task.py loaded once more as a module that is not in sys.modules and
+    cannot be imported by name: pickle then fails on its functions and
+    distributed falls back to cloudpickle, which sends them by value (Dask
+    pickles the task spec with plain pickle first, so
+    cloudpickle.register_pickle_by_value alone does not do it)."""
+    global _WORKER_TASK
+    if _WORKER_TASK is None:
+        import importlib.util
+
+        spec = importlib.util.spec_from_file_location("yarnsim_sweep_worker_task", task.__file__)
+        mod = importlib.util.module_from_spec(spec)
+        spec.loader.exec_module(mod)
+        _WORKER_TASK = mod
+    return _WORKER_TASK
+
+
 def connect(scheduler=None, workers=None, timeout=10.0, quiet=False):
     """A distributed Client: an embedded LocalCluster (one single-threaded
     worker process per core, RAYON_NUM_THREADS=1) or an existing scheduler."""
@@ -134,19 +154,18 @@ def run_sweep(sweep, out, client=None, scheduler=None, workers=None, resume=Fals
 
 
 def _run(sweep, client, todo, writer, quiet, on_result):
-    import cloudpickle
     from distributed import as_completed
 
-    # workers of an external cluster need fmpy and distributed, not this package
-    if not os.environ.get("YARNSIM_SWEEP_BY_REF"):
-        cloudpickle.register_pickle_by_value(task)
+    # workers of an external cluster need fmpy and distributed, not this
+    # package: the worker code travels by value
+    wt = worker_task_module()
     with open(sweep.fmu, "rb") as fh:
         fmu_bytes = fh.read()
     name = "yarnsim-sweep-fmu-" + hashlib.sha256(fmu_bytes).hexdigest()[:16]
     # once per cluster: a second sweep of the same FMU reuses the extraction
     has = client.run(lambda dask_worker, name=name: name in dask_worker.plugins)
     if not has or not all(has.values()):
-        client.register_plugin(task.FMUPlugin(name, fmu_bytes))
+            client.register_plugin(wt.FMUPlugin(name, fmu_bytes))
     info = client.scheduler_info()
     nworkers = len(info.get("workers", {}))
     if not quiet:
@@ -155,7 +174,7 @@ def _run(sweep, client, todo, writer, quiet, on_result):
     run = sweep.run_config()
     t0 = time.perf_counter()
     futures = [
-        client.submit(task.run_point, name, run, key, values, key=f"point-{key}", pure=False, retries=0)
+        client.submit(wt.run_point, name, run, key, values, key=f"point-{key}", pure=False, retries=0)
         for key, values in todo
     ]
     progress = Progress(len(futures), quiet)
