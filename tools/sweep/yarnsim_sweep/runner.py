@@ -53,6 +53,9 @@ def connect(scheduler=None, workers=None, timeout=10.0, quiet=False):
             return Client(scheduler, timeout=timeout, set_as_default=False)
         except (OSError, TimeoutError) as exc:
             raise SweepError(f"--scheduler: cannot reach the Dask scheduler at {scheduler} within {timeout:g} s ({type(exc).__name__}: {exc})") from None
+        except Exception as exc:  # something answered, but not a Dask scheduler
+            raise SweepError(f"--scheduler: no Dask scheduler answered at {scheduler} within {timeout:g} s "
+                             f"(is the address right? {type(exc).__name__}: {str(exc)[:200]})") from None
     n = workers or os.cpu_count() or 1
     cluster = LocalCluster(
         n_workers=n,
@@ -121,11 +124,8 @@ def run_sweep(sweep, out, client=None, scheduler=None, workers=None, resume=Fals
             done_rows = prev_rows.to_dict("records")
             if prev_series is not None:
                 done_series = [prev_series[prev_series["point"].isin(set(prev_rows["point"]))]]
-    else:
-        for f in ("results.parquet", "results.csv", "series.parquet"):
-            p = os.path.join(out, f)
-            if os.path.exists(p):
-                os.remove(p)
+    # without --resume the files of an earlier run are replaced at the first
+    # flush (after the cluster answered), not removed up front
     done = {r["point"] for r in done_rows}
     todo = [(k, v) for k, v in sweep.points if k not in done]
     own_client = client is None
@@ -256,6 +256,8 @@ class Writer:
             s = s.assign(_o=order).sort_values(["_o", "time"], kind="stable").drop(columns="_o").reset_index(drop=True)
             self.series = [s]
             _atomic(s.to_parquet, os.path.join(self.out, "series.parquet"), index=False)
+        elif os.path.exists(os.path.join(self.out, "series.parquet")):
+            os.remove(os.path.join(self.out, "series.parquet"))  # an earlier run's
 
 
 def _atomic(write, path, **kw):
