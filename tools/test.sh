@@ -7,3 +7,7 @@ cargo test --workspace --release
 if [ -f tools/fmu_check.sh ]; then
     bash tools/fmu_check.sh
 fi
+# parameter sweeps of the FMUs on Dask (tools/sweep, pytest on 2-worker LocalClusters)
+if [ -f tools/sweep_check.sh ]; then
+    bash tools/sweep_check.sh
+fi
