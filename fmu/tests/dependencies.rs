@@ -44,6 +44,7 @@ fn change_of(v: &Variable, alt_scene: &str) -> Option<Change> {
                 "dt" if x == 0.0 => 0.01,
                 "dt" => x / 2.0,
                 "material.friction" => x + 0.1,
+                "transfer.flip_ratio" => x / 2.0,
                 _ if x == 0.0 => 1.0,
                 _ => 1.5 * x,
             })
@@ -51,6 +52,9 @@ fn change_of(v: &Variable, alt_scene: &str) -> Option<Change> {
         VarType::Boolean => Change::Bool(start != "true"),
         VarType::Integer => Change::Int(if v.name == "threads" { 1 } else { 7 }),
         VarType::String if v.vr == VR_SCENE => Change::Str(alt_scene.to_string()),
+        VarType::String if v.name == "transfer.scheme" => {
+            Change::Str(if start == "flip" { "apic" } else { "flip" }.into())
+        }
         VarType::String => Change::Str("symplectic-euler".into()),
     })
 }
