@@ -276,10 +276,10 @@ impl YarnSim {
     /// Sets the target of the `motion = "input"` pin `pin`:
     /// `x(t) = position + velocity (t - since)` for the first vertex (`t`
     /// on the simulation's clock, which starts at 0), velocity `velocity`.
-    /// The vertices reach it at the end of the next substep (the state
-    /// does not change now). Rejects pins that do not exist or are not
-    /// input pins, non-finite values, positions beyond 1e6 m and speeds
-    /// above 1e6 m/s.
+    /// The pin's vertices take the velocity now (the momentum they carry
+    /// to the grid in the next substep) and the position at the end of the
+    /// next substep. Rejects pins that do not exist or are not input pins,
+    /// non-finite values, positions beyond 1e6 m and speeds above 1e6 m/s.
     pub fn set_pin_target_at(
         &mut self,
         pin: usize,
@@ -313,7 +313,17 @@ impl YarnSim {
             velocity,
             since,
         };
+        for &i in &p.vertices {
+            self.particles.vert.v[i] = velocity;
+            self.particles.vert.c[i] = nalgebra::Matrix2::zeros();
+        }
         Ok(())
+    }
+
+    /// Sets an input pin's motion as stored in a state (no checks, no
+    /// change of the particles).
+    pub(crate) fn restore_pin_target(&mut self, pin: usize, motion: super::PinMotion) {
+        self.pins[pin].motion = motion;
     }
 
     /// Sets gravity; rejects non-finite or absurd values (|g| > 1e6 m/s^2).

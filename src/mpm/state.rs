@@ -276,8 +276,14 @@ impl YarnSim {
             return Err(StateError::NonFinite);
         }
         for (k, position, velocity, since) in targets {
-            self.set_pin_target_at(k, position, velocity, since)
-                .expect("an input pin with a checked target");
+            self.restore_pin_target(
+                k,
+                PinMotion::Input {
+                    position,
+                    velocity,
+                    since,
+                },
+            );
         }
         self.time = time;
         self.steps = steps;
