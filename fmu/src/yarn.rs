@@ -314,8 +314,7 @@ impl YarnModel {
     /// Whether the Real variable `vr` depends on the simulated state.
     pub fn is_state_output(&self, vr: u32) -> bool {
         matches!(vr, VR_KINETIC_ENERGY | VR_ELASTIC_ENERGY | VR_MAX_STRETCH)
-            || (vr >= VR_YARN_BASE
-                && vr < VR_PIN_BASE
+            || ((VR_YARN_BASE..VR_PIN_BASE).contains(&vr)
                 && ((vr - VR_YARN_BASE) / 4) < self.count() as u32)
             || matches!(self.pin_vr(vr), Some((_, k)) if k == PIN_FORCE || k == PIN_FORCE + 1)
     }
@@ -605,7 +604,7 @@ impl YarnModel {
         };
         if let Some((i, v)) = reals.iter().enumerate().find_map(|(i, v)| {
             let (_, f) = yarn_real_parameters().nth(i).unwrap();
-            v.filter(|&v| !(v >= 0.0 && v <= f.max)).map(|v| (i, v))
+            v.filter(|v| !(0.0..=f.max).contains(v)).map(|v| (i, v))
         }) {
             return Err(format!("stored parameter {i} = {v} is out of range"));
         }
