@@ -397,7 +397,7 @@ pub static YARN_VARIABLES: [VarSpec; 20] = [
     parameter("material.plasticity", VR_PLASTICITY, Boolean, None, Start::Bool(|s| s.material.plasticity), "Mohr-Coulomb return mapping on or off"),
     parameter("transfer.scheme", VR_TRANSFER_SCHEME, VarType::String, None, Start::Name(|s| scheme_name(s.transfer.scheme)), "Particle velocity update of grid-to-particle: flip (FLIP/APIC blend by transfer.flip_ratio) or apic"),
     parameter("transfer.flip_ratio", VR_FLIP_RATIO, Real, None, Start::Scene(SceneField { get: |s| s.transfer.flip_ratio, set: |s, v| s.transfer.flip_ratio = v, positive: false, max: 1.0 }), "FLIP ratio in [0, 1] of the flip scheme (1: pure FLIP; ignored by apic)"),
-    parameter("scene", VR_SCENE, VarType::String, None, Start::Text(SCENE_FILE), "Scene file: a path relative to the FMU's resources folder, or absolute; it must create as many yarns as the bundled scene"),
+    parameter("scene", VR_SCENE, VarType::String, None, Start::Text(SCENE_FILE), "Scene file: a path relative to the FMU's resources folder, or absolute; it must create as many yarns as the bundled scene and have its pins (same number, same input pins)"),
     output("kinetic_energy", VR_KINETIC_ENERGY, Some("J"), "Kinetic energy (per unit depth)"),
     output("elastic_energy", VR_ELASTIC_ENERGY, Some("J"), "Elastic energy (per unit depth)"),
     output("max_stretch", VR_MAX_STRETCH, None, "Largest segment stretch |x_r - x_l| / l0"),
