@@ -442,3 +442,25 @@ motion = "input"
     assert!(err.abs() < 0.03, "{err}");
     assert!(mean.x.abs() < 0.01 * weight, "{mean:?}");
 }
+
+/// The `scene` parameter must keep the bundled scene's pins: the pin
+/// variables are fixed by the bundled scene.
+#[test]
+fn scene_parameter_must_keep_the_pins() {
+    let s = pinned_scene("motion = \"input\"");
+    let f = Fmu::new(&s);
+    let fixed = pinned_scene("");
+    std::fs::write(f.dir.join("fixed.toml"), fixed.to_toml_string()).unwrap();
+    assert_eq!(set_string(&f, VR_SCENE, "fixed.toml"), fmi2Error);
+    assert!(f.last_error().contains("other pins"), "{}", f.last_error());
+    unsafe { assert_eq!(fmi2Reset(f.c), fmi2OK) };
+    let mut moved = s.clone();
+    moved.gravity = [0.0, -5.0];
+    std::fs::write(f.dir.join("moved.toml"), moved.to_toml_string()).unwrap();
+    assert_eq!(
+        set_string(&f, VR_SCENE, "moved.toml"),
+        fmi2OK,
+        "{:?}",
+        f.lines()
+    );
+}
