@@ -1,6 +1,6 @@
 """fmpy checks of the YarnBundle and MassSpring FMUs (run by tools/fmu_check.sh).
 
-usage: fmu_check.py SMALL.fmu REFERENCE_SCENE.fmu WORKDIR REPLAY_EXE SMALL_SCENE WIRE.fmu
+usage: fmu_check.py SMALL.fmu REFERENCE_SCENE.fmu WORKDIR REPLAY_EXE SMALL_SCENE WIRE.fmu DRIVEN.fmu DRIVEN_SCENE
 
 1. fmpy's validation of both FMUs (schema, structure, start values, units).
 2. fmpy.simulate_fmu of SMALL.fmu with an input signal (attractor on a
@@ -12,6 +12,12 @@ usage: fmu_check.py SMALL.fmu REFERENCE_SCENE.fmu WORKDIR REPLAY_EXE SMALL_SCENE
 5. The MassSpring FMU of the wire scene: fmpy validation; simulate_fmu
    with a gravity signal under two integrators (the `integrator` string
    parameter), compared bit for bit with fmu-replay; an FMU state round trip.
+6. The DRIVEN.fmu (a scene with a `motion = "input"` pin and a fixed one):
+   simulate_fmu with an input table that waves the driven yarn end
+   (pin[0].x, .y, .vx, .vy), compared bit for bit with fmu-replay (yarn
+   ends, energies, pin forces); the driven end is at
+   x_in + v_in (t - t_c) after every step; the pin forces are finite and
+   the held pin carries a downward force.
 Exits non-zero on any problem.
 """
 import csv
@@ -24,7 +30,7 @@ from fmpy import read_model_description, simulate_fmu, extract
 from fmpy.fmi2 import FMU2Slave
 from fmpy.validation import validate_fmu
 
-small_fmu, ref_fmu, work, replay, small_scene, wire_fmu = sys.argv[1:7]
+small_fmu, ref_fmu, work, replay, small_scene, wire_fmu, driven_fmu, driven_scene = sys.argv[1:9]
 failures = []
 
 
@@ -185,6 +191,70 @@ for integrator in ("backward-euler", "symplectic-euler"):
     compare(f"MassSpring (wire, {integrator})", result, out_csv, outputs)
 vrs = [v.valueReference for v in md.modelVariables if v.causality == "output" and v.type == "Real"]
 state_round_trip("MassSpring (wire)", wire_fmu, HW, vrs)
+
+# 6. a driven yarn end from an input table
+problems = validate_fmu(driven_fmu)
+if problems:
+    failures.append(f"{driven_fmu}: fmpy validation: {problems}")
+print(f"validate {driven_fmu}: {len(problems)} problems")
+HD, STOPD = 0.01, 0.3
+n = int(round(STOPD / HD)) + 1
+t = np.array([k * HD for k in range(n)])
+w = 2 * math.pi / 0.3
+cols = [
+    ("time", t),
+    ("attractor.x", np.full(n, 0.5)),
+    ("attractor.y", np.full(n, 0.5)),
+    ("attractor.strength", np.full(n, 20.0)),
+    ("attractor.active", np.zeros(n, dtype=bool)),
+    ("gravity.x", np.zeros(n)),
+    ("gravity.y", np.full(n, -9.8)),
+    ("pin[0].x", 0.25 + 0.05 * np.sin(w * t)),
+    ("pin[0].y", 0.65 + 0.1 * t),
+    ("pin[0].vx", 0.05 * w * np.cos(w * t)),
+    ("pin[0].vy", np.full(n, 0.1)),
+]
+dtype = [(name, np.bool_ if name == "attractor.active" else np.double) for name, _ in cols]
+signals = np.array(list(zip(*[c for _, c in cols])), dtype=dtype)
+in_csv = f"{work}/driven_inputs.csv"
+write_inputs(in_csv, cols)
+md = read_model_description(driven_fmu)
+outputs = [v.name for v in md.modelVariables if v.causality == "output"]
+for name in ("pin[0].force.x", "pin[0].force.y", "pin[1].force.x", "pin[1].force.y"):
+    if name not in outputs:
+        failures.append(f"driven FMU: no output {name}")
+result = simulate_fmu(
+    driven_fmu,
+    start_time=0.0,
+    stop_time=STOPD,
+    output_interval=HD,
+    input=signals,
+    output=outputs,
+    validate=True,
+)
+out_csv = f"{work}/driven_rust.csv"
+subprocess.run(
+    [replay, "--scene", driven_scene, "--inputs", in_csv, "--step", repr(HD), "--stop", repr(STOPD), "-o", out_csv],
+    check=True,
+)
+compare("YarnBundle (driven)", result, out_csv, outputs)
+follow = 0.0
+for k in range(1, len(result)):
+    tc, te = result[k - 1]["time"], result[k]["time"]
+    i = int(round(tc / HD))
+    x = cols[7][1][i] + cols[9][1][i] * (te - tc)
+    y = cols[8][1][i] + cols[10][1][i] * (te - tc)
+    follow = max(follow, abs(result[k]["yarn[0].left.x"] - x), abs(result[k]["yarn[0].left.y"] - y))
+print(f"driven end vs x_in + v_in (t - t_c): max |diff| = {follow:.2e} m over {len(result) - 1} steps")
+if not follow < 1e-9:
+    failures.append(f"the driven end is {follow} m from its input")
+forces = np.array([[row[name] for name in outputs if name.startswith("pin")] for row in result])
+if not np.all(np.isfinite(forces)):
+    failures.append("driven FMU: non-finite pin forces")
+held = np.mean([row["pin[1].force.y"] for row in result[10:]])
+print(f"driven FMU: mean force on the held pin (t >= 0.1 s) {held:.4f} N/m (y), on the driven one {np.mean([row['pin[0].force.y'] for row in result[10:]]):.4f} N/m")
+if not held < 0.0:
+    failures.append(f"the held pin is not pulled down ({held} N/m)")
 
 if failures:
     print(f"FMU check FAILED ({len(failures)} problems):")

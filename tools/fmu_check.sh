@@ -24,8 +24,10 @@ target=$(cargo metadata --format-version 1 --no-deps | "$venv/bin/python" -c 'im
 "$target/release/build-fmu" --no-build
 "$target/release/build-fmu" --no-build --scene fmu/scenes/small.toml -o "$target/fmu/YarnBundle-small.fmu"
 "$target/release/build-fmu" --no-build --scene wire
+"$target/release/build-fmu" --no-build --scene fmu/scenes/driven.toml -o "$target/fmu/YarnBundle-driven.fmu"
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 "$venv/bin/python" tools/fmu_check.py "$target/fmu/YarnBundle-small.fmu" "$target/fmu/YarnBundle.fmu" \
-    "$work" "$target/release/fmu-replay" fmu/scenes/small.toml "$target/fmu/MassSpring-wire.fmu"
+    "$work" "$target/release/fmu-replay" fmu/scenes/small.toml "$target/fmu/MassSpring-wire.fmu" \
+    "$target/fmu/YarnBundle-driven.fmu" fmu/scenes/driven.toml
 "$venv/bin/python" tools/cosim_check.py "$target/fmu/YarnBundle-small.fmu" "$target/fmu/MassSpring-wire.fmu"

@@ -76,6 +76,13 @@ pub trait FmuModel: fmt::Debug + Send {
     /// Rebuilds the simulation from the scene and the parameters; it must
     /// have `count` output objects.
     fn rebuild(&mut self, count: usize) -> ModelResult;
+    /// A communication step that runs substeps begins at `since_start`
+    /// seconds after the start time (after the checkpoint of the step): the
+    /// model latches its inputs for the step. A failure refuses the step.
+    fn begin_step(&mut self, since_start: f64) -> Result<(), StepFailure> {
+        let _ = since_start;
+        Ok(())
+    }
     /// Substep number `k` (0-based since initialization).
     fn substep(&mut self, k: u64) -> Result<(), StepFailure>;
     /// Every Real output is finite.

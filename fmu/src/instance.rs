@@ -393,7 +393,11 @@ impl Instance {
                 m.substeps = start_substeps;
             }
         };
+        let since_start = t - m.start_time;
         let run = |m: &mut Model| -> Result<(), StepFailure> {
+            if m.substeps < target {
+                m.physics.begin_step(since_start)?;
+            }
             while m.substeps < target {
                 m.physics.substep(m.substeps)?;
                 m.substeps += 1;

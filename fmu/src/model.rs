@@ -10,13 +10,13 @@
 use std::fmt::Write as _;
 
 use yarnsim::mpm::state::fnv1a;
-use yarnsim::scene::{Scene, YarnScene};
+use yarnsim::scene::{PinMotionKind, Scene, TransferScheme, YarnScene};
 
 /// The FMI model identifier: the shared library's and the C symbols' name.
 pub const MODEL_IDENTIFIER: &str = "YarnBundle";
 
 /// Bumped whenever the variable layout changes; part of the GUID.
-pub const INTERFACE_VERSION: u32 = 2;
+pub const INTERFACE_VERSION: u32 = 3;
 
 /// Name of the scene file inside the FMU's `resources/` folder.
 pub const SCENE_FILE: &str = "scene.toml";
@@ -36,6 +36,8 @@ pub const VR_BENDING: u32 = 14;
 pub const VR_DENSITY: u32 = 15;
 pub const VR_DT: u32 = 16;
 pub const VR_PLASTICITY: u32 = 17; // Boolean
+/// `transfer.flip_ratio` (Real parameter in [0, 1]).
+pub const VR_FLIP_RATIO: u32 = 18;
 pub const VR_KINETIC_ENERGY: u32 = 100;
 pub const VR_ELASTIC_ENERGY: u32 = 101;
 pub const VR_MAX_STRETCH: u32 = 102;
@@ -45,8 +47,18 @@ pub const VR_MAX_SUBSTEPS: u32 = 201;
 /// `threads` (Integer parameter of every model).
 pub const VR_THREADS: u32 = 202;
 pub const VR_SCENE: u32 = 300; // String
+/// `transfer.scheme` (String parameter, `"flip"` or `"apic"`).
+pub const VR_TRANSFER_SCHEME: u32 = 301;
 /// `yarn[i].left.x` has `VR_YARN_BASE + 4 i`, then `left.y`, `right.x`, `right.y`.
 pub const VR_YARN_BASE: u32 = 1000;
+/// Pin `i` (`[[pins]]` order) has `VR_PIN_BASE + 8 i + k`: k = 0..3 the
+/// inputs `pin[i].x`, `.y`, `.vx`, `.vy` (only `motion = "input"` pins),
+/// k = 4, 5 the outputs `pin[i].force.x`, `.force.y` (every pin).
+pub const VR_PIN_BASE: u32 = 2000;
+/// Offset of `pin[i].force.x` within a pin's block of 8.
+pub const PIN_FORCE: u32 = 4;
+/// Most pins an FMU serves (value references 2000 to 2000 + 8 * 1024 - 1).
+pub const MAX_FMU_PINS: usize = 1024;
 
 /// Largest scene file the FMU reads (the bundled one and the `scene`
 /// parameter): 1 MiB. The built-in scenes are below 4 KiB.
@@ -214,6 +226,8 @@ pub struct SceneField {
     pub set: fn(&mut YarnScene, f64),
     /// Must be > 0 (else >= 0).
     pub positive: bool,
+    /// Largest accepted value.
+    pub max: f64,
 }
 
 /// Where a variable's start value comes from.
@@ -229,6 +243,8 @@ pub enum Start {
     Bool(fn(&YarnScene) -> bool),
     /// A fixed text.
     Text(&'static str),
+    /// A name read from the scene.
+    Name(fn(&YarnScene) -> &'static str),
 }
 
 /// One row of a model's variable table.
@@ -260,6 +276,7 @@ impl VarSpec {
                 Start::Real(f) => Some(real(f(scene))),
                 Start::Bool(f) => Some(boolean(f(scene))),
                 Start::Text(t) => Some(t.to_string()),
+                Start::Name(f) => Some(f(scene).to_string()),
             },
             description: self.description.to_string(),
         }
@@ -332,7 +349,29 @@ const fn material(
     set: fn(&mut YarnScene, f64),
     positive: bool,
 ) -> Start {
-    Start::Scene(SceneField { get, set, positive })
+    Start::Scene(SceneField {
+        get,
+        set,
+        positive,
+        max: 1e12,
+    })
+}
+
+/// The name of a transfer scheme as the scene and `transfer.scheme` write it.
+pub fn scheme_name(s: TransferScheme) -> &'static str {
+    match s {
+        TransferScheme::Flip => "flip",
+        TransferScheme::Apic => "apic",
+    }
+}
+
+/// The transfer scheme of a `transfer.scheme` value.
+pub fn parse_scheme(s: &str) -> Option<TransferScheme> {
+    match s {
+        "flip" => Some(TransferScheme::Flip),
+        "apic" => Some(TransferScheme::Apic),
+        _ => None,
+    }
 }
 
 use VarType::{Boolean, Real};
@@ -341,7 +380,7 @@ use VarType::{Boolean, Real};
 /// ([`COMMON_VARIABLES`]) and the per-yarn outputs ([`yarn_outputs`]), in
 /// `ModelVariables` order. The Real parameters read and override the scene
 /// through their [`SceneField`].
-pub static YARN_VARIABLES: [VarSpec; 18] = [
+pub static YARN_VARIABLES: [VarSpec; 20] = [
     input("attractor.x", VR_ATTRACTOR_X, Real, Some("m"), Start::Real(|s| s.attractor.position[0]), "Attractor position x"),
     input("attractor.y", VR_ATTRACTOR_Y, Real, Some("m"), Start::Real(|s| s.attractor.position[1]), "Attractor position y"),
     input("attractor.strength", VR_ATTRACTOR_STRENGTH, Real, Some("m/s2"), Start::Real(|s| s.attractor.strength), "Attractor acceleration magnitude, 0 to 1e6"),
@@ -356,7 +395,9 @@ pub static YARN_VARIABLES: [VarSpec; 18] = [
     parameter("material.density", VR_DENSITY, Real, Some("kg/m"), material(|s| s.material.density, |s, v| s.material.density = v, true), "Line density"),
     parameter("dt", VR_DT, Real, Some("s"), material(|s| s.time.dt, |s, v| s.time.dt = v, true), "Substep size; a communication step runs an integer number of substeps"),
     parameter("material.plasticity", VR_PLASTICITY, Boolean, None, Start::Bool(|s| s.material.plasticity), "Mohr-Coulomb return mapping on or off"),
-    parameter("scene", VR_SCENE, VarType::String, None, Start::Text(SCENE_FILE), "Scene file: a path relative to the FMU's resources folder, or absolute; it must create as many yarns as the bundled scene"),
+    parameter("transfer.scheme", VR_TRANSFER_SCHEME, VarType::String, None, Start::Name(|s| scheme_name(s.transfer.scheme)), "Particle velocity update of grid-to-particle: flip (FLIP/APIC blend by transfer.flip_ratio) or apic"),
+    parameter("transfer.flip_ratio", VR_FLIP_RATIO, Real, None, Start::Scene(SceneField { get: |s| s.transfer.flip_ratio, set: |s, v| s.transfer.flip_ratio = v, positive: false, max: 1.0 }), "FLIP ratio in [0, 1] of the flip scheme (1: pure FLIP; ignored by apic)"),
+    parameter("scene", VR_SCENE, VarType::String, None, Start::Text(SCENE_FILE), "Scene file: a path relative to the FMU's resources folder, or absolute; it must create as many yarns as the bundled scene and have its pins (same number, same input pins)"),
     output("kinetic_energy", VR_KINETIC_ENERGY, Some("J"), "Kinetic energy (per unit depth)"),
     output("elastic_energy", VR_ELASTIC_ENERGY, Some("J"), "Elastic energy (per unit depth)"),
     output("max_stretch", VR_MAX_STRETCH, None, "Largest segment stretch |x_r - x_l| / l0"),
@@ -372,7 +413,7 @@ pub fn yarn_real_parameters() -> impl Iterator<Item = (u32, SceneField)> {
 }
 
 /// Number of [`yarn_real_parameters`].
-pub const YARN_REAL_PARAMETERS: usize = 7;
+pub const YARN_REAL_PARAMETERS: usize = 8;
 const _: () = {
     let mut n = 0;
     let mut i = 0;
@@ -407,13 +448,104 @@ pub fn yarn_outputs(i: usize) -> impl Iterator<Item = Variable> {
     })
 }
 
+/// One `[[pins]]` entry as the FMU sees it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FmuPin {
+    /// `motion = "input"`: the pin has the inputs `pin[i].x` ... `.vy`.
+    pub input: bool,
+    /// Start position of its first vertex (the start of `pin[i].x`, `.y`).
+    pub start: [f64; 2],
+}
+
+/// The pins of a (validated) scene, in `[[pins]]` order.
+pub fn fmu_pins(scene: &YarnScene) -> Vec<FmuPin> {
+    let curves = scene.curves();
+    scene
+        .pin_ranges()
+        .expect("a validated scene")
+        .into_iter()
+        .zip(&scene.pins)
+        .map(|((yarn, r), spec)| {
+            let x = curves[yarn][r.start];
+            FmuPin {
+                input: spec.motion == PinMotionKind::Input,
+                start: [x.x, x.y],
+            }
+        })
+        .collect()
+}
+
+/// The variables of pin `i`: for an input pin the inputs `pin[i].x`,
+/// `.y`, `.vx`, `.vy`, then (every pin) the outputs `pin[i].force.x`,
+/// `.force.y`.
+pub fn pin_variables(i: usize, pin: &FmuPin) -> Vec<Variable> {
+    let base = VR_PIN_BASE + 8 * i as u32;
+    let mut v = Vec::new();
+    if pin.input {
+        for (k, name, unit, start, what) in [
+            (0, "x", "m", pin.start[0], "position x of its first vertex; the pin's vertices are at x + vx (t - t_c) during the communication step from t_c"),
+            (1, "y", "m", pin.start[1], "position y of its first vertex (as x)"),
+            (2, "vx", "m/s", 0.0, "velocity x given to its vertices in every substep of the communication step"),
+            (3, "vy", "m/s", 0.0, "velocity y (as vx)"),
+        ] {
+            v.push(Variable {
+                name: format!("pin[{i}].{name}"),
+                vr: base + k,
+                ty: VarType::Real,
+                causality: "input",
+                variability: "continuous",
+                unit: Some(unit),
+                start: Some(real(start)),
+                description: format!("Driven pin {i}: {what}"),
+            });
+        }
+    }
+    for (k, axis) in [(0, "x"), (1, "y")] {
+        v.push(Variable {
+            name: format!("pin[{i}].force.{axis}"),
+            vr: base + PIN_FORCE + k,
+            ty: VarType::Real,
+            causality: "output",
+            variability: "continuous",
+            unit: Some("N/m"),
+            start: None,
+            description: format!(
+                "Pin {i}: force {axis} the yarn exerts on the pin, per m of depth, averaged over the substeps of the last communication step (0 before the first)"
+            ),
+        });
+    }
+    v
+}
+
+/// The per-yarn and per-pin value references do not collide: at most
+/// [`MAX_FMU_PINS`] pins, and with pins at most 250 yarns (whose outputs
+/// end below [`VR_PIN_BASE`]).
+pub fn check_value_references(scene: &YarnScene) -> Result<(), String> {
+    let (yarns, pins) = (num_yarns(scene), scene.pins.len());
+    if pins > MAX_FMU_PINS {
+        return Err(format!(
+            "the scene has {pins} pins; an FMU serves at most {MAX_FMU_PINS}"
+        ));
+    }
+    if pins > 0 && VR_YARN_BASE as usize + 4 * yarns > VR_PIN_BASE as usize {
+        return Err(format!(
+            "the scene has {yarns} yarns and pins; an FMU with pins serves at most 250 yarns"
+        ));
+    }
+    Ok(())
+}
+
 /// Every variable of the FMU for this scene, in `ModelVariables` order:
-/// [`YARN_VARIABLES`], [`COMMON_VARIABLES`], then the yarn ends.
+/// [`YARN_VARIABLES`], [`COMMON_VARIABLES`], the yarn ends, then the pins'
+/// inputs and outputs ([`pin_variables`]).
 pub fn variables(scene: &YarnScene) -> Vec<Variable> {
     let mut v: Vec<Variable> = YARN_VARIABLES.iter().map(|s| s.variable(scene)).collect();
     v.extend(common_variables());
     for i in 0..num_yarns(scene) {
         v.extend(yarn_outputs(i));
+    }
+    for (i, pin) in fmu_pins(scene).iter().enumerate() {
+        v.extend(pin_variables(i, pin));
     }
     v
 }
@@ -459,8 +591,10 @@ pub fn xml_escape(s: &str) -> String {
 }
 
 /// Units used by the variables with their SI base-unit exponents.
-const UNITS: [(&str, &str); 6] = [
+const UNITS: [(&str, &str); 8] = [
     ("J", r#"kg="1" m="2" s="-2""#),
+    ("N/m", r#"kg="1" s="-2""#),
+    ("m/s", r#"m="1" s="-1""#),
     ("Pa", r#"kg="1" m="-1" s="-2""#),
     ("kg/m", r#"kg="1" m="-1""#),
     ("m", r#"m="1""#),
@@ -586,6 +720,13 @@ pub fn yarn_dependencies(scene: &YarnScene) -> Vec<Dependency> {
     ];
     for k in 0..4 * num_yarns(scene) as u32 {
         d.push(dep(VR_YARN_BASE + k, &[VR_SCENE]));
+    }
+    // The pin forces are 0 until a step ran; the pin inputs act through
+    // the substeps (a target set now moves the vertices in the next one).
+    for i in 0..scene.pins.len() as u32 {
+        for k in [PIN_FORCE, PIN_FORCE + 1] {
+            d.push(dep(VR_PIN_BASE + 8 * i + k, &[]));
+        }
     }
     d
 }
@@ -779,7 +920,7 @@ impl FmuScene {
     /// that does not build.
     pub fn description(&self) -> Result<Description, String> {
         match self {
-            FmuScene::Yarn(s) => Ok(description(s)),
+            FmuScene::Yarn(s) => check_value_references(s).map(|_| description(s)),
             FmuScene::MassSpring(l) => crate::massspring::description(l),
         }
     }

@@ -49,7 +49,9 @@ pub const MASS_SPRING_STATE_MAGIC: &[u8; 8] = b"MSFMUST\0";
 pub const STATE_MAGICS: [&[u8; 8]; 2] = [YARN_STATE_MAGIC, MASS_SPRING_STATE_MAGIC];
 
 /// Format version of the serialized FMU state.
-pub const STATE_VERSION: u32 = 1;
+/// Version 2: the YarnBundle part holds the transfer scheme, the
+/// `transfer.flip_ratio` override, the pin inputs and the pin force sums.
+pub const STATE_VERSION: u32 = 2;
 
 const STATE_HEADER: usize = 8 + 4 + 8 + 8;
 

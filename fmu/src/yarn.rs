@@ -6,7 +6,7 @@ use std::path::Path;
 
 use yarnsim::math::Vec2;
 use yarnsim::mpm::{Attractor, Diagnostics, SimError, YarnSim};
-use yarnsim::scene::YarnScene;
+use yarnsim::scene::{TransferScheme, YarnScene};
 
 use crate::fmu_model::{
     refuse, Checkpoint, FmuModel, ModelError, ModelResult, ParamCheck, SetContext, StepFailure,
@@ -14,13 +14,26 @@ use crate::fmu_model::{
 use crate::model::*;
 use crate::state_bytes::{Reader, Writer};
 
-/// Values of the inputs.
+/// The inputs of one `motion = "input"` pin.
 #[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PinInput {
+    /// Index in `[[pins]]`.
+    pub pin: usize,
+    /// `pin[i].x`, `.y`: position of the pin's first vertex, m.
+    pub position: [f64; 2],
+    /// `pin[i].vx`, `.vy`: velocity of its vertices, m/s.
+    pub velocity: [f64; 2],
+}
+
+/// Values of the inputs.
+#[derive(Clone, Debug, PartialEq)]
 pub struct Inputs {
     pub attractor: [f64; 2],
     pub strength: f64,
     pub active: bool,
     pub gravity: [f64; 2],
+    /// The driven pins, in `[[pins]]` order.
+    pub pins: Vec<PinInput>,
 }
 
 impl Inputs {
@@ -30,7 +43,32 @@ impl Inputs {
             strength: s.attractor.strength,
             active: s.attractor.active,
             gravity: s.gravity,
+            pins: fmu_pins(s)
+                .iter()
+                .enumerate()
+                .filter(|(_, p)| p.input)
+                .map(|(pin, p)| PinInput {
+                    pin,
+                    position: p.start,
+                    velocity: [0.0; 2],
+                })
+                .collect(),
         }
+    }
+
+    /// The driven pin `pin`'s inputs.
+    fn pin_mut(&mut self, pin: usize) -> Option<&mut PinInput> {
+        self.pins.iter_mut().find(|p| p.pin == pin)
+    }
+
+    /// Hands the pin targets to `sim`, for the communication step that
+    /// starts at `since` on the simulation's clock.
+    fn latch_pins(&self, sim: &mut YarnSim, since: f64) -> ModelResult {
+        for p in &self.pins {
+            sim.set_pin_target_at(p.pin, Vec2::from(p.position), Vec2::from(p.velocity), since)
+                .or_else(|e| refuse(e.to_string()))?;
+        }
+        Ok(())
     }
 
     /// Checks the inputs the way the library does, then hands them to `sim`.
@@ -67,6 +105,16 @@ impl Inputs {
                 self.attractor[0], self.attractor[1]
             ));
         }
+        for p in &self.pins {
+            let x = Vec2::from(p.position);
+            let v = Vec2::from(p.velocity);
+            if x.norm() > 1e6 || v.norm() > 1e6 {
+                return refuse(format!(
+                    "pin[{}] position ({}, {}) m or velocity ({}, {}) m/s is absurd (beyond 1e6)",
+                    p.pin, x.x, x.y, v.x, v.y
+                ));
+            }
+        }
         Ok(())
     }
 }
@@ -78,6 +126,8 @@ pub struct Config {
     /// Overrides of [`yarn_real_parameters`], in that order.
     pub reals: [Option<f64>; YARN_REAL_PARAMETERS],
     pub plasticity: Option<bool>,
+    /// `transfer.scheme`.
+    pub scheme: Option<TransferScheme>,
 }
 
 impl Default for Config {
@@ -86,6 +136,7 @@ impl Default for Config {
             scene_path: SCENE_FILE.to_string(),
             reals: [None; YARN_REAL_PARAMETERS],
             plasticity: None,
+            scheme: None,
         }
     }
 }
@@ -110,6 +161,9 @@ fn effective_scene(base: &YarnScene, config: &Config) -> YarnScene {
     if let Some(p) = config.plasticity {
         s.material.plasticity = p;
     }
+    if let Some(t) = config.scheme {
+        s.transfer.scheme = t;
+    }
     s
 }
 
@@ -128,14 +182,46 @@ pub struct YarnModel {
     pub inputs: Inputs,
     /// Diagnostics of the current state, computed on first use.
     pub diag: Option<Diagnostics>,
+    /// Per pin: the force the yarn exerted on it, summed over the substeps
+    /// of the current (or last) communication step, and their number.
+    pub forces: PinForces,
+}
+
+/// The pins' forces on the yarn summed over the substeps of a
+/// communication step.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PinForces {
+    /// Per pin, the sum of the yarn's force on it, N/m.
+    pub sum: Vec<Vec2>,
+    pub substeps: u64,
+}
+
+impl PinForces {
+    fn new(pins: usize) -> Self {
+        PinForces {
+            sum: vec![Vec2::zeros(); pins],
+            substeps: 0,
+        }
+    }
+
+    /// The mean force on pin `i` (0 before any substep).
+    pub fn mean(&self, i: usize) -> Vec2 {
+        if self.substeps == 0 {
+            Vec2::zeros()
+        } else {
+            self.sum[i] / self.substeps as f64
+        }
+    }
 }
 
 impl YarnModel {
     pub fn new(base: YarnScene) -> ModelResult<Self> {
+        check_value_references(&base).or_else(|e| refuse(format!("scene: {e}")))?;
         let sim = YarnSim::new(&base).or_else(|e| refuse(format!("scene: {e}")))?;
         Ok(YarnModel {
             config: Config::default(),
             inputs: Inputs::from_scene(&base),
+            forces: PinForces::new(base.pins.len()),
             base,
             sim,
             diag: None,
@@ -156,6 +242,7 @@ impl YarnModel {
         self.inputs.apply(&mut sim)?;
         self.sim = sim;
         self.diag = None;
+        self.forces = PinForces::new(self.base.pins.len());
         Ok(())
     }
 
@@ -167,12 +254,32 @@ impl YarnModel {
         self.sim.dt()
     }
 
+    /// A communication step from `since` (on the simulation's clock)
+    /// begins: the pin inputs become the targets of the driven pins and
+    /// the force sums restart.
+    pub fn begin_step(&mut self, since: f64) -> Result<(), StepFailure> {
+        self.inputs
+            .latch_pins(&mut self.sim, since)
+            .map_err(|e| StepFailure {
+                terminal: false,
+                msg: e.0,
+            })?;
+        self.forces = PinForces::new(self.forces.sum.len());
+        Ok(())
+    }
+
     pub fn substep(&mut self) -> Result<(), StepFailure> {
         self.diag = None;
         self.sim.step().map_err(|e| StepFailure {
             terminal: matches!(e, SimError::NonFinite { .. }),
             msg: e.to_string(),
-        })
+        })?;
+        // The yarn pulls on each pin with the opposite of the pin's force.
+        for (s, r) in self.forces.sum.iter_mut().zip(self.sim.pin_reactions()) {
+            *s -= *r;
+        }
+        self.forces.substeps += 1;
+        Ok(())
     }
 
     /// Every Real output is finite: the yarn ends, the energies and the
@@ -188,6 +295,16 @@ impl YarnModel {
                 let (l, r) = self.sim.yarn_endpoints(y);
                 l.x.is_finite() && l.y.is_finite() && r.x.is_finite() && r.y.is_finite()
             })
+            && (0..self.forces.sum.len()).all(|i| {
+                let f = self.forces.mean(i);
+                f.x.is_finite() && f.y.is_finite()
+            })
+    }
+
+    /// Pin `i` and offset `k` of a pin value reference.
+    fn pin_vr(&self, vr: u32) -> Option<(usize, u32)> {
+        let i = (vr.checked_sub(VR_PIN_BASE)? / 8) as usize;
+        (i < self.forces.sum.len()).then_some((i, (vr - VR_PIN_BASE) % 8))
     }
 
     fn diagnostics(&mut self) -> Diagnostics {
@@ -197,7 +314,9 @@ impl YarnModel {
     /// Whether the Real variable `vr` depends on the simulated state.
     pub fn is_state_output(&self, vr: u32) -> bool {
         matches!(vr, VR_KINETIC_ENERGY | VR_ELASTIC_ENERGY | VR_MAX_STRETCH)
-            || (vr >= VR_YARN_BASE && ((vr - VR_YARN_BASE) / 4) < self.count() as u32)
+            || ((VR_YARN_BASE..VR_PIN_BASE).contains(&vr)
+                && ((vr - VR_YARN_BASE) / 4) < self.count() as u32)
+            || matches!(self.pin_vr(vr), Some((_, k)) if k == PIN_FORCE || k == PIN_FORCE + 1)
     }
 
     /// The value of the Real variable `vr`, `None` if there is none.
@@ -215,6 +334,18 @@ impl YarnModel {
             VR_KINETIC_ENERGY => self.diagnostics().kinetic_energy,
             VR_ELASTIC_ENERGY => self.diagnostics().elastic_energy,
             VR_MAX_STRETCH => self.diagnostics().max_stretch,
+            _ if self.pin_vr(vr).is_some() => {
+                let (i, k) = self.pin_vr(vr).unwrap();
+                match k {
+                    0..=3 => {
+                        let p = self.inputs.pins.iter().find(|p| p.pin == i)?;
+                        [p.position[0], p.position[1], p.velocity[0], p.velocity[1]][k as usize]
+                    }
+                    PIN_FORCE => self.forces.mean(i).x,
+                    5 => self.forces.mean(i).y,
+                    _ => return None,
+                }
+            }
             _ if self.is_state_output(vr) => {
                 let i = (vr - VR_YARN_BASE) as usize;
                 let (l, r) = self.sim.yarn_endpoints(i / 4);
@@ -237,7 +368,13 @@ impl YarnModel {
     }
 
     pub fn get_string(&self, vr: u32) -> Option<&str> {
-        (vr == VR_SCENE).then_some(self.config.scene_path.as_str())
+        match vr {
+            VR_SCENE => Some(self.config.scene_path.as_str()),
+            VR_TRANSFER_SCHEME => Some(scheme_name(
+                self.config.scheme.unwrap_or(self.base.transfer.scheme),
+            )),
+            _ => None,
+        }
     }
 
     /// Sets Real inputs and parameters; true when a parameter changed (the
@@ -248,10 +385,24 @@ impl YarnModel {
         vals: &[f64],
         param_ok: ParamCheck,
     ) -> ModelResult<bool> {
-        let mut inputs = self.inputs;
+        let mut inputs = self.inputs.clone();
         let mut reals = self.config.reals;
         for (&vr, &v) in vrs.iter().zip(vals) {
             match vr {
+                _ if matches!(self.pin_vr(vr), Some((_, 0..=3))) => {
+                    let (i, k) = self.pin_vr(vr).unwrap();
+                    let Some(p) = inputs.pin_mut(i) else {
+                        return refuse(format!(
+                            "value reference {vr} (pin {i}) is not an input: pin {i} is not a motion = \"input\" pin"
+                        ));
+                    };
+                    match k {
+                        0 => p.position[0] = v,
+                        1 => p.position[1] = v,
+                        2 => p.velocity[0] = v,
+                        _ => p.velocity[1] = v,
+                    }
+                }
                 VR_ATTRACTOR_X => inputs.attractor[0] = v,
                 VR_ATTRACTOR_Y => inputs.attractor[1] = v,
                 VR_ATTRACTOR_STRENGTH => inputs.strength = v,
@@ -260,10 +411,12 @@ impl YarnModel {
                 _ if real_param(vr).is_some() => {
                     param_ok(vr)?;
                     let (i, field) = real_param(vr).unwrap();
-                    let ok = if field.positive { v > 0.0 } else { v >= 0.0 } && v <= 1e12;
+                    let ok = if field.positive { v > 0.0 } else { v >= 0.0 } && v <= field.max;
                     if !ok {
+                        let range = if field.positive { "> 0" } else { ">= 0" };
                         return refuse(format!(
-                            "parameter value reference {vr} = {v} is out of range"
+                            "parameter value reference {vr} = {v} is out of range (must be {range} and at most {})",
+                            field.max
                         ));
                     }
                     reals[i] = Some(v);
@@ -277,8 +430,8 @@ impl YarnModel {
         }
         inputs.check()?;
         if inputs != self.inputs {
-            self.inputs = inputs;
             inputs.apply(&mut self.sim)?;
+            self.inputs = inputs;
         }
         let changed = reals != self.config.reals;
         self.config.reals = reals;
@@ -310,8 +463,7 @@ impl YarnModel {
         }
         if active != self.inputs.active {
             self.inputs.active = active;
-            let inputs = self.inputs;
-            inputs.apply(&mut self.sim)?;
+            self.inputs.apply(&mut self.sim)?;
         }
         let changed = plasticity != self.config.plasticity;
         self.config.plasticity = plasticity;
@@ -330,10 +482,23 @@ impl YarnModel {
     ) -> ModelResult<bool> {
         let mut changed = false;
         for (&vr, v) in vrs.iter().zip(vals) {
-            if vr != VR_SCENE {
+            if vr != VR_SCENE && vr != VR_TRANSFER_SCHEME {
                 return refuse(format!("value reference {vr} is not a String parameter"));
             }
             param_ok(vr)?;
+            if vr == VR_TRANSFER_SCHEME {
+                let Some(v) = v else {
+                    return refuse("transfer.scheme is a null pointer");
+                };
+                let Some(scheme) = parse_scheme(v) else {
+                    return refuse(format!(
+                        "transfer.scheme = {v:?} is not a transfer scheme: use \"flip\" or \"apic\""
+                    ));
+                };
+                changed |= self.config.scheme != Some(scheme);
+                self.config.scheme = Some(scheme);
+                continue;
+            }
             let Some(v) = v else {
                 return refuse("the scene file name is a null pointer");
             };
@@ -347,6 +512,15 @@ impl YarnModel {
                 return refuse(format!(
                     "scene {v:?} creates {yarns} yarns, but this FMU has outputs for {}",
                     num_yarns(bundled)
+                ));
+            }
+            let inputs = |s: &YarnScene| fmu_pins(s).iter().map(|p| p.input).collect::<Vec<_>>();
+            if inputs(&base) != inputs(bundled) {
+                return refuse(format!(
+                    "scene {v:?} has other pins than the bundled scene ({} pins, driven: {:?}); this FMU's pin variables are the bundled scene's ({:?})",
+                    base.pins.len(),
+                    inputs(&base),
+                    inputs(bundled)
                 ));
             }
             self.config.scene_path = v.clone();
@@ -367,12 +541,28 @@ impl YarnModel {
         w.u8(i.active as u8);
         w.f64(i.gravity[0]);
         w.f64(i.gravity[1]);
+        for p in &i.pins {
+            w.f64(p.position[0]);
+            w.f64(p.position[1]);
+            w.f64(p.velocity[0]);
+            w.f64(p.velocity[1]);
+        }
         w.bytes(self.config.scene_path.as_bytes());
         for v in self.config.reals {
             w.opt_f64(v);
         }
         w.u8(self.config.plasticity.is_some() as u8);
         w.u8(self.config.plasticity.unwrap_or(false) as u8);
+        w.u8(match self.config.scheme {
+            None => 0,
+            Some(TransferScheme::Flip) => 1,
+            Some(TransferScheme::Apic) => 2,
+        });
+        w.u64(self.forces.substeps);
+        for f in &self.forces.sum {
+            w.f64(f.x);
+            w.f64(f.y);
+        }
         w.bytes(self.base.to_toml_string().as_bytes());
         w.bytes(&self.sim.save_state());
     }
@@ -386,12 +576,18 @@ impl YarnModel {
         current_built: bool,
         yarns: usize,
     ) -> Result<YarnModel, String> {
-        let inputs = Inputs {
+        let mut inputs = Inputs {
             attractor: [r.f64()?, r.f64()?],
             strength: r.f64()?,
             active: r.bool()?,
             gravity: [r.f64()?, r.f64()?],
+            pins: current.inputs.pins.clone(),
         };
+        // The pins are the bundled scene's (the `scene` parameter keeps them).
+        for p in &mut inputs.pins {
+            p.position = [r.f64()?, r.f64()?];
+            p.velocity = [r.f64()?, r.f64()?];
+        }
         inputs.check().map_err(|e| e.0)?;
         let scene_path = r.string()?;
         let mut reals = [None; YARN_REAL_PARAMETERS];
@@ -400,11 +596,30 @@ impl YarnModel {
         }
         let has_p = r.bool()?;
         let p = r.bool()?;
+        let scheme = match r.u8()? {
+            0 => None,
+            1 => Some(TransferScheme::Flip),
+            2 => Some(TransferScheme::Apic),
+            b => return Err(format!("bad transfer scheme byte {b}")),
+        };
+        if let Some((i, v)) = reals.iter().enumerate().find_map(|(i, v)| {
+            let (_, f) = yarn_real_parameters().nth(i).unwrap();
+            v.filter(|v| !(0.0..=f.max).contains(v)).map(|v| (i, v))
+        }) {
+            return Err(format!("stored parameter {i} = {v} is out of range"));
+        }
         let config = Config {
             scene_path,
             reals,
             plasticity: has_p.then_some(p),
+            scheme,
         };
+        let substeps = r.u64()?;
+        let mut sum = Vec::with_capacity(current.forces.sum.len());
+        for _ in 0..current.forces.sum.len() {
+            sum.push(Vec2::new(r.f64()?, r.f64()?));
+        }
+        let forces = PinForces { sum, substeps };
         let scene_text = r.string()?;
         let sim_bytes = r.bytes()?;
         r.finish()?;
@@ -432,6 +647,7 @@ impl YarnModel {
             sim,
             inputs,
             diag: None,
+            forces,
         })
     }
 }
@@ -452,6 +668,9 @@ impl FmuModel for YarnModel {
     fn rebuild(&mut self, count: usize) -> ModelResult {
         YarnModel::rebuild(self, count)
     }
+    fn begin_step(&mut self, since_start: f64) -> Result<(), StepFailure> {
+        YarnModel::begin_step(self, since_start)
+    }
     fn substep(&mut self, _k: u64) -> Result<(), StepFailure> {
         YarnModel::substep(self)
     }
@@ -461,15 +680,16 @@ impl FmuModel for YarnModel {
     /// The library's state bytes: a clone of the whole `YarnSim` with its
     /// grid costs far more than its particles.
     fn checkpoint(&self) -> Checkpoint {
-        Box::new(self.sim.save_state())
+        Box::new((self.sim.save_state(), self.forces.clone()))
     }
     fn restore(&mut self, c: Checkpoint) {
-        let bytes = c
-            .downcast::<Vec<u8>>()
+        let (bytes, forces) = *c
+            .downcast::<(Vec<u8>, PinForces)>()
             .expect("a checkpoint of a yarn model");
         self.sim
             .load_state(&bytes)
             .expect("the simulation's own state bytes load");
+        self.forces = forces;
         self.diag = None;
     }
     fn is_state_output(&self, vr: u32) -> bool {

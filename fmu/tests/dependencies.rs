@@ -44,6 +44,7 @@ fn change_of(v: &Variable, alt_scene: &str) -> Option<Change> {
                 "dt" if x == 0.0 => 0.01,
                 "dt" => x / 2.0,
                 "material.friction" => x + 0.1,
+                "transfer.flip_ratio" => x / 2.0,
                 _ if x == 0.0 => 1.0,
                 _ => 1.5 * x,
             })
@@ -51,6 +52,9 @@ fn change_of(v: &Variable, alt_scene: &str) -> Option<Change> {
         VarType::Boolean => Change::Bool(start != "true"),
         VarType::Integer => Change::Int(if v.name == "threads" { 1 } else { 7 }),
         VarType::String if v.vr == VR_SCENE => Change::Str(alt_scene.to_string()),
+        VarType::String if v.name == "transfer.scheme" => {
+            Change::Str(if start == "flip" { "apic" } else { "flip" }.into())
+        }
         VarType::String => Change::Str("symplectic-euler".into()),
     })
 }
@@ -113,6 +117,15 @@ fn check_outputs(new: &dyn Fn() -> Fmu, d: &model::Description, h: f64) -> usize
 /// outputs read there with those of an untouched instance: an output that
 /// changes must declare the variable among its initial dependencies.
 fn check_initial(new: &dyn Fn() -> Fmu, d: &model::Description, alt_scene: &str) -> usize {
+    check_initial_with(new, d, alt_scene, &alt_scene_text())
+}
+
+fn check_initial_with(
+    new: &dyn Fn() -> Fmu,
+    d: &model::Description,
+    alt_scene: &str,
+    alt_text: &str,
+) -> usize {
     let outs = real_outputs(&d.variables);
     let enter = |f: &Fmu| {
         assert_eq!(f.setup(0.0, None), fmi2OK);
@@ -129,7 +142,7 @@ fn check_initial(new: &dyn Fn() -> Fmu, d: &model::Description, alt_scene: &str)
     {
         let g = new();
         if v.vr == VR_SCENE {
-            std::fs::write(g.dir.join(alt_scene), alt_scene_text()).unwrap();
+            std::fs::write(g.dir.join(alt_scene), alt_text).unwrap();
         }
         enter(&g);
         let c = change_of(v, alt_scene).unwrap();
@@ -187,6 +200,29 @@ fn yarn_outputs_depend_on_no_input_and_declare_their_initial_dependencies() {
     // change no other output at initialization).
     let seen = check_initial(&new, &d, "shifted.toml");
     assert!(seen >= 2 * 3, "{seen}");
+}
+
+/// The driven scene: the pin inputs change no output at the same instant
+/// or at initialization, the pin forces depend on nothing.
+#[test]
+fn pin_inputs_feed_through_nothing() {
+    const DRIVEN: &str = include_str!("../scenes/driven.toml");
+    let scene = yarnsim::scene::YarnScene::from_toml_str(DRIVEN).unwrap();
+    let d = model::description(&scene);
+    let pins: Vec<&Variable> = d
+        .variables
+        .iter()
+        .filter(|v| v.name.starts_with("pin["))
+        .collect();
+    assert_eq!(pins.len(), 4 + 2 + 2, "{pins:?}");
+    assert!(d.dependencies.iter().all(|dep| dep.step.is_empty()));
+    let new = || Fmu::new(&scene);
+    assert!(check_outputs(&new, &d, 0.01) > 0);
+    let shifted = DRIVEN.replace("start = [0.25, 0.65]", "start = [0.25, 0.6]");
+    assert_ne!(shifted, DRIVEN);
+    let seen = check_initial_with(&new, &d, "shifted.toml", &shifted);
+    // The shifted start moves both yarns' left ends in y (their right ends stay).
+    assert!(seen >= 2, "{seen}");
 }
 
 #[test]

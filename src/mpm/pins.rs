@@ -1,5 +1,6 @@
 //! Pinned and driven yarn vertices: each pin holds some vertices on a
-//! prescribed path (fixed, a line, a circle).
+//! prescribed path (fixed, a line, a circle) or on a target set at run time
+//! ([`PinMotion::Input`], [`YarnSim::set_pin_target`](super::YarnSim::set_pin_target)).
 //!
 //! A pin acts on the grid, as a constraint: after the grid update,
 //! [`constrain_grid`] adds to the nodes of each pinned vertex's stencil the
@@ -28,6 +29,16 @@ pub enum PinMotion {
     Line { velocity: Vec2 },
     /// Turned rigidly about `center`: `x(t) = center + Rot(omega t) (x(0) - center)`.
     Circle { center: Vec2, omega: f64 },
+    /// Driven from outside: the first vertex at
+    /// `x(t) = position + velocity (t - since)` with velocity `velocity`, the
+    /// others translated rigidly with it (their offsets from the first
+    /// vertex stay those of t = 0). Until a target is set: `position` is the
+    /// first vertex's start, `velocity` zero (a fixed pin).
+    Input {
+        position: Vec2,
+        velocity: Vec2,
+        since: f64,
+    },
 }
 
 /// One pin: its vertices (global indices), where they start, how they move.
@@ -55,20 +66,39 @@ impl Pin {
                 let r = Vec2::new(c * r0.x - s * r0.y, s * r0.x + c * r0.y);
                 (center + r, perp(r) * omega)
             }
+            PinMotion::Input {
+                position,
+                velocity,
+                since,
+            } => {
+                // The first vertex exactly at the input; the others keep
+                // their offset (written so that an input pin set once to a
+                // line's start and velocity gives the `Line` bits).
+                let base = if k == 0 {
+                    position
+                } else {
+                    x0 + (position - self.origin[0])
+                };
+                (base + velocity * (t - since), velocity)
+            }
         }
     }
 }
 
 impl Pin {
     /// Prescribed velocity gradient (the affine matrix `C`) of the pin's
-    /// vertices: zero for a fixed or translating pin, the rigid rotation
+    /// vertices: zero for a fixed, translating or input pin, the rigid rotation
     /// `[[0, -omega], [omega, 0]]` for a circle.
     pub fn velocity_gradient(&self) -> Mat2 {
         match self.motion {
-            PinMotion::Fixed | PinMotion::Line { .. } => Mat2::zeros(),
+            PinMotion::Fixed | PinMotion::Line { .. } | PinMotion::Input { .. } => Mat2::zeros(),
             PinMotion::Circle { omega, .. } => Mat2::new(0.0, -omega, omega, 0.0),
         }
     }
+}
+
+fn origin_first(vertices: &[usize], p: &Particles) -> Vec2 {
+    p.vert.x[vertices[0]]
 }
 
 /// The pins of a scene over its particles (validated).
@@ -90,6 +120,11 @@ pub fn pins_of_scene(scene: &YarnScene, p: &Particles) -> Result<Vec<Pin>, Scene
                 PinMotionKind::Circle => PinMotion::Circle {
                     center: Vec2::from(spec.center.expect("validated")),
                     omega: spec.angular_velocity.expect("validated"),
+                },
+                PinMotionKind::Input => PinMotion::Input {
+                    position: origin_first(&vertices, p),
+                    velocity: Vec2::zeros(),
+                    since: 0.0,
                 },
             };
             Pin {

@@ -258,6 +258,74 @@ impl YarnSim {
         &self.pin_reactions
     }
 
+    /// Sets the target of the `motion = "input"` pin `pin` (index in
+    /// `[[pins]]` order) from now on: its first vertex at
+    /// `x(t) = position + velocity (t - now)` with velocity `velocity` in
+    /// every following substep, its other vertices translated rigidly with
+    /// it; see [`YarnSim::set_pin_target_at`].
+    pub fn set_pin_target(
+        &mut self,
+        pin: usize,
+        position: Vec2,
+        velocity: Vec2,
+    ) -> Result<(), SimError> {
+        let now = self.time;
+        self.set_pin_target_at(pin, position, velocity, now)
+    }
+
+    /// Sets the target of the `motion = "input"` pin `pin`:
+    /// `x(t) = position + velocity (t - since)` for the first vertex (`t`
+    /// on the simulation's clock, which starts at 0), velocity `velocity`.
+    /// The pin's vertices take the velocity now (the momentum they carry
+    /// to the grid in the next substep) and the position at the end of the
+    /// next substep. Rejects pins that do not exist or are not input pins,
+    /// non-finite values, positions beyond 1e6 m and speeds above 1e6 m/s.
+    pub fn set_pin_target_at(
+        &mut self,
+        pin: usize,
+        position: Vec2,
+        velocity: Vec2,
+        since: f64,
+    ) -> Result<(), SimError> {
+        let n = self.pins.len();
+        let Some(p) = self.pins.get_mut(pin) else {
+            return Err(SimError::BadInput(format!(
+                "pin {pin} does not exist: the scene has {n} pins"
+            )));
+        };
+        if !matches!(p.motion, super::PinMotion::Input { .. }) {
+            return Err(SimError::BadInput(format!(
+                "pin {pin} has motion {:?}, not \"input\": its path is fixed by the scene",
+                p.motion
+            )));
+        }
+        let finite = [position.x, position.y, velocity.x, velocity.y, since]
+            .iter()
+            .all(|v| v.is_finite());
+        if !finite || position.norm() > 1e6 || velocity.norm() > 1e6 {
+            return Err(SimError::BadInput(format!(
+                "pin {pin} target position ({}, {}) m and velocity ({}, {}) m/s must be finite, within 1e6 m and 1e6 m/s",
+                position.x, position.y, velocity.x, velocity.y
+            )));
+        }
+        p.motion = super::PinMotion::Input {
+            position,
+            velocity,
+            since,
+        };
+        for &i in &p.vertices {
+            self.particles.vert.v[i] = velocity;
+            self.particles.vert.c[i] = nalgebra::Matrix2::zeros();
+        }
+        Ok(())
+    }
+
+    /// Sets an input pin's motion as stored in a state (no checks, no
+    /// change of the particles).
+    pub(crate) fn restore_pin_target(&mut self, pin: usize, motion: super::PinMotion) {
+        self.pins[pin].motion = motion;
+    }
+
     /// Sets gravity; rejects non-finite or absurd values (|g| > 1e6 m/s^2).
     pub fn set_gravity(&mut self, g: Vec2) -> Result<(), SimError> {
         if !(g.x.is_finite() && g.y.is_finite()) || g.norm() > 1e6 {

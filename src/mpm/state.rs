@@ -4,17 +4,20 @@
 //! version, the `u64` fingerprint of the scene, the vertex and quadrature
 //! counts (`u64` each), the payload length (`u64`) and an FNV-1a checksum of
 //! the payload (`u64`); then the payload of `f64` values: time, step count,
-//! gravity, attractor, and per particle position, velocity, APIC matrix (and
-//! for quadrature particles the frame `d` and `F`). No pointers, no padding:
+//! gravity, attractor, substep, the target of every `motion = "input"` pin
+//! (position, velocity, reference time), and per particle position,
+//! velocity, APIC matrix (and for quadrature particles the frame `d` and
+//! `F`). Version 2 added the input pins' targets. No pointers, no padding:
 //! a state written by one process reads back in another.
 
+use super::pins::PinMotion;
 use super::sim::{Attractor, YarnSim};
 use crate::math::{Mat2, Vec2};
 
 /// First bytes of every serialized state.
 pub const MAGIC: &[u8; 8] = b"YARNSTAT";
 /// Format version.
-pub const VERSION: u32 = 1;
+pub const VERSION: u32 = 2;
 const HEADER: usize = 8 + 4 + 8 * 5;
 
 /// Why a byte string is not a state of this simulation.
@@ -116,7 +119,20 @@ impl YarnSim {
     /// Size in bytes of [`YarnSim::save_state`]'s output.
     pub fn state_size(&self) -> usize {
         let p = self.particles();
-        HEADER + 8 * (2 + 2 + 2 + 2 + 1) + p.vert.x.len() * 8 * 8 + p.quad.x.len() * 8 * 16
+        HEADER
+            + 8 * (2 + 2 + 2 + 2 + 1)
+            + self.input_pins().count() * 8 * 5
+            + p.vert.x.len() * 8 * 8
+            + p.quad.x.len() * 8 * 16
+    }
+
+    /// Index of every `motion = "input"` pin.
+    fn input_pins(&self) -> impl Iterator<Item = usize> + '_ {
+        self.pins()
+            .iter()
+            .enumerate()
+            .filter(|(_, p)| matches!(p.motion, PinMotion::Input { .. }))
+            .map(|(i, _)| i)
     }
 
     /// The dynamic state as bytes.
@@ -130,6 +146,18 @@ impl YarnSim {
         payload.extend_from_slice(&self.attractor.strength.to_le_bytes());
         payload.extend_from_slice(&(self.attractor.active as u64).to_le_bytes());
         payload.extend_from_slice(&self.dt.to_le_bytes());
+        for k in self.input_pins() {
+            if let PinMotion::Input {
+                position,
+                velocity,
+                since,
+            } = self.pins()[k].motion
+            {
+                put_vec(&mut payload, &position);
+                put_vec(&mut payload, &velocity);
+                payload.extend_from_slice(&since.to_le_bytes());
+            }
+        }
         for i in 0..p.vert.x.len() {
             put_vec(&mut payload, &p.vert.x[i]);
             put_vec(&mut payload, &p.vert.v[i]);
@@ -201,6 +229,12 @@ impl YarnSim {
         let astr = r.f64();
         let aact = r.u64() != 0;
         let dt = r.f64();
+        let targets: Vec<(usize, Vec2, Vec2, f64)> = self
+            .input_pins()
+            .collect::<Vec<_>>()
+            .into_iter()
+            .map(|k| (k, r.vec(), r.vec(), r.f64()))
+            .collect();
         let mut vert = (Vec::new(), Vec::new(), Vec::new());
         for _ in 0..nv {
             vert.0.push(r.vec());
@@ -232,8 +266,24 @@ impl YarnSim {
                 .chain(&quad.3)
                 .chain(&quad.4)
                 .all(|m| m.iter().all(|e| e.is_finite()));
+        let finite = finite
+            && targets.iter().all(|(_, x, v, s)| {
+                [x.x, x.y, v.x, v.y, *s].iter().all(|e| e.is_finite())
+                    && x.norm() <= 1e6
+                    && v.norm() <= 1e6
+            });
         if !finite || dt <= 0.0 {
             return Err(StateError::NonFinite);
+        }
+        for (k, position, velocity, since) in targets {
+            self.restore_pin_target(
+                k,
+                PinMotion::Input {
+                    position,
+                    velocity,
+                    since,
+                },
+            );
         }
         self.time = time;
         self.steps = steps;

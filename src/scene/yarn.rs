@@ -98,6 +98,9 @@ pub enum PinMotionKind {
     Line,
     /// Turned rigidly about `center` at `angular_velocity`.
     Circle,
+    /// Driven at run time (`YarnSim::set_pin_target`, the FMU's
+    /// `pin[i].*` inputs): held at the start position until a target is set.
+    Input,
 }
 
 /// Pinned or driven vertices of one yarn (`[[pins]]`): `count` consecutive
@@ -116,7 +119,7 @@ pub struct PinSpec {
     /// How many consecutive vertices (default 1).
     #[serde(default = "one_u32", deserialize_with = "copy_count")]
     pub count: u32,
-    /// `"fixed"` (default), `"line"` or `"circle"`.
+    /// `"fixed"` (default), `"line"`, `"circle"` or `"input"`.
     #[serde(default)]
     pub motion: PinMotionKind,
     /// Velocity `[vx, vy]` in m/s of a `"line"` motion.

@@ -8,9 +8,13 @@
 //!
 //! Yarn scenes (the YarnBundle FMU): `in.csv` has the header
 //! `time,attractor.x,attractor.y,attractor.strength,attractor.active,
-//! gravity.x,gravity.y`; `out.csv` holds `time`, the yarn ends
-//! `yarn[i].left.x` ... `yarn[i].right.y`, `kinetic_energy`,
-//! `elastic_energy`, `max_stretch`, `substeps`.
+//! gravity.x,gravity.y`, then `pin[i].x,pin[i].y,pin[i].vx,pin[i].vy` for
+//! every `motion = "input"` pin in `[[pins]]` order; `out.csv` holds
+//! `time`, the yarn ends `yarn[i].left.x` ... `yarn[i].right.y`,
+//! `kinetic_energy`, `elastic_energy`, `max_stretch`, `substeps`, then
+//! `pin[i].force.x`, `pin[i].force.y` of every pin (the FMU's rule: the
+//! mean of `-pin_reactions()` over the substeps of the step; the pin
+//! targets are set at each communication point, as the FMU latches them).
 //!
 //! Mass-spring scenes (the MassSpring FMU, `--integrator` as its parameter,
 //! default backward-euler): `in.csv` has `time,gravity.x,gravity.y,gravity.z`;
@@ -28,7 +32,7 @@ use std::process::ExitCode;
 use yarnsim::massspring::{Integrator, IntegratorOptions, Layout, Simulation, V3};
 use yarnsim::math::Vec2;
 use yarnsim::mpm::{Attractor, YarnSim};
-use yarnsim::scene::{Scene, YarnScene};
+use yarnsim::scene::{PinMotionKind, Scene, YarnScene};
 
 /// The master's communication points as fmpy computes them: k h up to `stop`.
 fn communication_points(h: f64, stop: f64) -> Vec<f64> {
@@ -91,7 +95,8 @@ fn run() -> Result<(), String> {
             if integrator.is_some() {
                 return Err("--integrator applies to mass-spring scenes only".into());
             }
-            replay_yarn(&s, &read_rows(&inputs, 7)?, h, stop)?
+            let pins = input_pins(&s);
+            replay_yarn(&s, &read_rows(&inputs, 7 + 4 * pins.len())?, h, stop)?
         }
         Scene::MassSpring(l) => {
             let integrator = match integrator {
@@ -105,24 +110,42 @@ fn run() -> Result<(), String> {
     Ok(())
 }
 
+/// Indices of the `motion = "input"` pins.
+fn input_pins(scene: &YarnScene) -> Vec<usize> {
+    scene
+        .pins
+        .iter()
+        .enumerate()
+        .filter(|(_, p)| p.motion == PinMotionKind::Input)
+        .map(|(i, _)| i)
+        .collect()
+}
+
 fn replay_yarn(scene: &YarnScene, rows: &[Vec<f64>], h: f64, stop: f64) -> Result<String, String> {
     let mut sim = YarnSim::new(scene).map_err(|e| e.to_string())?;
     let yarns = sim.num_yarns();
+    let inputs = input_pins(scene);
+    let pins = scene.pins.len();
+    let mut force = vec![Vec2::zeros(); pins];
     let mut csv = String::from("time");
     for i in 0..yarns {
         for c in ["left.x", "left.y", "right.x", "right.y"] {
             let _ = write!(csv, ",yarn[{i}].{c}");
         }
     }
-    csv.push_str(",kinetic_energy,elastic_energy,max_stretch,substeps\n");
-    let record = |csv: &mut String, t: f64, sim: &YarnSim| {
+    csv.push_str(",kinetic_energy,elastic_energy,max_stretch,substeps");
+    for i in 0..pins {
+        let _ = write!(csv, ",pin[{i}].force.x,pin[{i}].force.y");
+    }
+    csv.push('\n');
+    let record = |csv: &mut String, t: f64, sim: &YarnSim, force: &[Vec2]| {
         let _ = write!(csv, "{t:?}");
         for i in 0..yarns {
             let (l, r) = sim.yarn_endpoints(i);
             let _ = write!(csv, ",{:?},{:?},{:?},{:?}", l.x, l.y, r.x, r.y);
         }
         let d = sim.diagnostics();
-        let _ = writeln!(
+        let _ = write!(
             csv,
             ",{:?},{:?},{:?},{}",
             d.kinetic_energy,
@@ -130,8 +153,13 @@ fn replay_yarn(scene: &YarnScene, rows: &[Vec<f64>], h: f64, stop: f64) -> Resul
             d.max_stretch,
             sim.steps()
         );
+        for f in force {
+            let _ = write!(csv, ",{:?},{:?}", f.x, f.y);
+        }
+        csv.push('\n');
     };
-    record(&mut csv, 0.0, &sim);
+    record(&mut csv, 0.0, &sim, &force);
+    let mut now = 0.0;
     for (k, &next) in communication_points(h, stop).iter().enumerate() {
         let row = rows.get(k).unwrap_or(&rows[rows.len() - 1]);
         sim.set_gravity(Vec2::new(row[5], row[6]))
@@ -144,9 +172,27 @@ fn replay_yarn(scene: &YarnScene, rows: &[Vec<f64>], h: f64, stop: f64) -> Resul
         .map_err(|e| e.to_string())?;
         // The FMU's rule: substeps done by time t are round((t - t0) / dt).
         let target = (next / sim.dt()).round() as u64;
-        sim.steps_n(target - sim.steps())
-            .map_err(|e| e.to_string())?;
-        record(&mut csv, next, &sim);
+        if target > sim.steps() {
+            // The FMU latches the pin inputs when a step that runs substeps begins.
+            for (j, &pin) in inputs.iter().enumerate() {
+                let c = &row[7 + 4 * j..11 + 4 * j];
+                sim.set_pin_target_at(pin, Vec2::new(c[0], c[1]), Vec2::new(c[2], c[3]), now)
+                    .map_err(|e| e.to_string())?;
+            }
+            let n = target - sim.steps();
+            let mut sum = vec![Vec2::zeros(); pins];
+            for _ in 0..n {
+                sim.step().map_err(|e| e.to_string())?;
+                for (s, r) in sum.iter_mut().zip(sim.pin_reactions()) {
+                    *s -= *r;
+                }
+            }
+            for (f, s) in force.iter_mut().zip(&sum) {
+                *f = *s / n as f64;
+            }
+        }
+        record(&mut csv, next, &sim, &force);
+        now = next;
     }
     Ok(csv)
 }

@@ -1,0 +1,466 @@
+//! The transfer-scheme parameters and the driven pins of the YarnBundle FMU:
+//! `transfer.scheme` / `transfer.flip_ratio` give the library's bits and
+//! refuse bad values; `pin[i].*` inputs drive a `motion = "input"` pin on a
+//! path the test chooses (compared with the library's `line` and `circle`
+//! pins), and `pin[i].force.*` carries a hanging yarn's weight.
+
+mod common;
+
+use std::ffi::CString;
+
+use common::*;
+use yarnsim::math::Vec2;
+use yarnsim::mpm::YarnSim;
+use yarnsim::scene::{TransferScheme, YarnScene};
+use YarnBundle::ffi::*;
+use YarnBundle::model::*;
+
+const H: f64 = 0.01;
+
+fn set_string(f: &Fmu, vr: u32, v: &str) -> fmi2Status {
+    let s = CString::new(v).unwrap();
+    let p = s.as_ptr();
+    unsafe { fmi2SetString(f.c, &vr, 1, &p) }
+}
+
+fn get_string(f: &Fmu, vr: u32) -> String {
+    let mut p: fmi2String = std::ptr::null();
+    assert_eq!(unsafe { fmi2GetString(f.c, &vr, 1, &mut p) }, fmi2OK);
+    unsafe { std::ffi::CStr::from_ptr(p) }
+        .to_string_lossy()
+        .into_owned()
+}
+
+fn bits(v: &[f64]) -> Vec<u64> {
+    v.iter().map(|x| x.to_bits()).collect()
+}
+
+/// The FMU's yarn ends and energies after 8 steps of `H`.
+fn fmu_run(f: &Fmu) -> Vec<f64> {
+    for k in 0..8 {
+        assert_eq!(f.do_step(k as f64 * H, H), fmi2OK, "{:?}", f.lines());
+    }
+    f.outputs()
+}
+
+/// The same outputs from the library.
+fn library_run(scene: &YarnScene) -> Vec<f64> {
+    let mut sim = YarnSim::new(scene).unwrap();
+    sim.steps_n(8 * 50).unwrap();
+    let mut out = Vec::new();
+    for y in 0..sim.num_yarns() {
+        let (l, r) = sim.yarn_endpoints(y);
+        out.extend([l.x, l.y, r.x, r.y]);
+    }
+    let d = sim.diagnostics();
+    out.extend([d.kinetic_energy, d.elastic_energy, d.max_stretch]);
+    out
+}
+
+#[test]
+fn transfer_parameters_give_the_library_bits() {
+    let scene = small_scene();
+    assert_eq!(scene.transfer.scheme, TransferScheme::Flip);
+    let default = {
+        let f = Fmu::new(&scene);
+        f.init();
+        assert_eq!(get_string(&f, VR_TRANSFER_SCHEME), "flip");
+        assert_eq!(f.get_real(&[VR_FLIP_RATIO]), Ok(vec![1.0]));
+        fmu_run(&f)
+    };
+    assert_eq!(bits(&default), bits(&library_run(&scene)));
+    let mut outs = Vec::new();
+    for (scheme, ratio) in [("apic", None), ("flip", Some(0.9)), ("apic", Some(0.5))] {
+        let f = Fmu::new(&scene);
+        assert_eq!(set_string(&f, VR_TRANSFER_SCHEME, scheme), fmi2OK);
+        if let Some(r) = ratio {
+            assert_eq!(f.set_real(&[VR_FLIP_RATIO], &[r]), fmi2OK);
+        }
+        f.init();
+        assert_eq!(get_string(&f, VR_TRANSFER_SCHEME), scheme);
+        let out = fmu_run(&f);
+        let mut lib = scene.clone();
+        lib.transfer.scheme = if scheme == "apic" {
+            TransferScheme::Apic
+        } else {
+            TransferScheme::Flip
+        };
+        if let Some(r) = ratio {
+            lib.transfer.flip_ratio = r;
+        }
+        assert_eq!(bits(&out), bits(&library_run(&lib)), "{scheme} {ratio:?}");
+        assert_ne!(bits(&out), bits(&default), "{scheme} {ratio:?}");
+        outs.push(out);
+    }
+    // APIC ignores the FLIP ratio.
+    assert_eq!(bits(&outs[0]), bits(&outs[2]));
+}
+
+#[test]
+fn bad_transfer_values_are_refused_with_a_log_line() {
+    let f = Fmu::new(&small_scene());
+    for bad in ["", "FLIP", "asflip", "pic"] {
+        assert_eq!(set_string(&f, VR_TRANSFER_SCHEME, bad), fmi2Error, "{bad}");
+        let e = f.last_error();
+        assert!(
+            e.contains("transfer.scheme") && e.contains("\"flip\" or \"apic\""),
+            "{e}"
+        );
+        unsafe { assert_eq!(fmi2Reset(f.c), fmi2OK) };
+    }
+    for bad in [1.5, -0.1, 1.0 + 1e-12] {
+        assert_eq!(f.set_real(&[VR_FLIP_RATIO], &[bad]), fmi2Error, "{bad}");
+        assert!(f.last_error().contains("at most 1"), "{}", f.last_error());
+        unsafe { assert_eq!(fmi2Reset(f.c), fmi2OK) };
+    }
+    assert_eq!(f.set_real(&[VR_FLIP_RATIO], &[f64::NAN]), fmi2Error);
+    unsafe { assert_eq!(fmi2Reset(f.c), fmi2OK) };
+    // The bounds themselves are accepted.
+    for ok in [0.0, 1.0] {
+        assert_eq!(f.set_real(&[VR_FLIP_RATIO], &[ok]), fmi2OK);
+    }
+    f.init();
+    assert_eq!(get_string(&f, VR_TRANSFER_SCHEME), "flip");
+    assert_eq!(f.get_real(&[VR_FLIP_RATIO]), Ok(vec![1.0]));
+    // Fixed parameters: refused after initialization.
+    assert_eq!(set_string(&f, VR_TRANSFER_SCHEME, "apic"), fmi2Error);
+}
+
+#[test]
+fn transfer_parameters_travel_in_the_fmu_state() {
+    let scene = small_scene();
+    let f = Fmu::new(&scene);
+    assert_eq!(set_string(&f, VR_TRANSFER_SCHEME, "apic"), fmi2OK);
+    f.init();
+    for k in 0..3 {
+        assert_eq!(f.do_step(k as f64 * H, H), fmi2OK);
+    }
+    let s = f.get_state();
+    let bytes = f.serialize(s);
+    f.free_state(s);
+    for k in 3..6 {
+        assert_eq!(f.do_step(k as f64 * H, H), fmi2OK);
+    }
+    let end = f.outputs();
+    // A fresh instance with the default scheme takes the state's.
+    let g = Fmu::new(&scene);
+    g.init();
+    let (st, d) = g.deserialize(&bytes);
+    assert_eq!(st, fmi2OK, "{:?}", g.lines());
+    assert_eq!(unsafe { fmi2SetFMUstate(g.c, d) }, fmi2OK);
+    g.free_state(d);
+    assert_eq!(get_string(&g, VR_TRANSFER_SCHEME), "apic");
+    for k in 3..6 {
+        assert_eq!(g.do_step(k as f64 * H, H), fmi2OK);
+    }
+    assert_eq!(bits(&g.outputs()), bits(&end));
+}
+
+// ---- driven pins -------------------------------------------------------------
+
+/// One yarn of 24 vertices with its start pinned by `motion` (TOML lines),
+/// a second free yarn, gravity, 48^2 grid, dt 2e-4.
+fn pinned_scene(motion: &str) -> YarnScene {
+    let text = SMALL_SCENE.replace(
+        "count = 3\nspacing = [0.0, 0.03]",
+        &format!(
+            "count = 2\nspacing = [0.0, 0.1]\n\n[[pins]]\nyarn = 0\nend = \"start\"\n{motion}\n"
+        ),
+    );
+    assert_ne!(text, SMALL_SCENE);
+    YarnScene::from_toml_str(&text).unwrap()
+}
+
+fn pin_vrs(i: u32) -> [u32; 4] {
+    let b = VR_PIN_BASE + 8 * i;
+    [b, b + 1, b + 2, b + 3]
+}
+
+fn force_vrs(i: u32) -> [u32; 2] {
+    let b = VR_PIN_BASE + 8 * i + PIN_FORCE;
+    [b, b + 1]
+}
+
+/// Everything the FMU serves of the pinned scenes: yarn ends, energies,
+/// the pin force.
+fn pin_outputs(f: &Fmu) -> Vec<f64> {
+    let mut v = f.outputs();
+    v.extend(f.get_real(&force_vrs(0)).unwrap());
+    v
+}
+
+fn library_outputs(sim: &YarnSim, force: Vec2) -> Vec<f64> {
+    let mut out = Vec::new();
+    for y in 0..sim.num_yarns() {
+        let (l, r) = sim.yarn_endpoints(y);
+        out.extend([l.x, l.y, r.x, r.y]);
+    }
+    let d = sim.diagnostics();
+    out.extend([
+        d.kinetic_energy,
+        d.elastic_energy,
+        d.max_stretch,
+        force.x,
+        force.y,
+    ]);
+    out
+}
+
+/// The pin variables exist for this scene, with start values at the
+/// pinned vertex, and bad pin inputs are refused.
+#[test]
+fn pin_variables_follow_the_scene() {
+    let s = pinned_scene("motion = \"input\"");
+    let vars = variables(&s);
+    let names: Vec<&str> = vars
+        .iter()
+        .filter(|v| v.vr >= VR_PIN_BASE)
+        .map(|v| v.name.as_str())
+        .collect();
+    assert_eq!(
+        names,
+        [
+            "pin[0].x",
+            "pin[0].y",
+            "pin[0].vx",
+            "pin[0].vy",
+            "pin[0].force.x",
+            "pin[0].force.y"
+        ]
+    );
+    let f = Fmu::new(&s);
+    let enter = |f: &Fmu| {
+        assert_eq!(f.setup(0.0, None), fmi2OK);
+        assert_eq!(unsafe { fmi2EnterInitializationMode(f.c) }, fmi2OK);
+    };
+    enter(&f);
+    assert_eq!(
+        f.get_real(&pin_vrs(0)),
+        Ok(vec![0.25, 0.65, 0.0, 0.0]),
+        "start values: the pinned vertex at rest"
+    );
+    assert_eq!(f.get_real(&force_vrs(0)), Ok(vec![0.0, 0.0]));
+    for (vals, what) in [
+        ([f64::NAN, 0.5, 0.0, 0.0], "not finite"),
+        ([0.5, 0.5, f64::INFINITY, 0.0], "not finite"),
+        ([2e6, 0.5, 0.0, 0.0], "absurd"),
+        ([0.5, 0.5, 0.0, -3e6], "absurd"),
+    ] {
+        assert_eq!(f.set_real(&pin_vrs(0), &vals), fmi2Error);
+        assert!(f.last_error().contains(what), "{}", f.last_error());
+        unsafe { assert_eq!(fmi2Reset(f.c), fmi2OK) };
+        enter(&f);
+    }
+    assert_eq!(f.get_real(&pin_vrs(0)), Ok(vec![0.25, 0.65, 0.0, 0.0]));
+    // A fixed pin has outputs only.
+    let fixed = pinned_scene("");
+    let vars = variables(&fixed);
+    assert!(vars
+        .iter()
+        .all(|v| !(VR_PIN_BASE..VR_PIN_BASE + 4).contains(&v.vr)));
+    let g = Fmu::new(&fixed);
+    assert_eq!(g.set_real(&[VR_PIN_BASE], &[0.3]), fmi2Error);
+    assert!(
+        g.last_error().contains("not a motion"),
+        "{}",
+        g.last_error()
+    );
+    unsafe { assert_eq!(fmi2Reset(g.c), fmi2OK) };
+    enter(&g);
+    assert_eq!(g.get_real(&force_vrs(0)), Ok(vec![0.0, 0.0]));
+    // The XML declares the pin forces independent of every input.
+    let xml = model_description(&s);
+    assert!(xml.contains("name=\"pin[0].force.y\""));
+    assert!(xml.contains("unit=\"N/m\""));
+}
+
+/// The test drives the input pin on a circle (h = 0.01 s, 50 substeps per
+/// step): the FMU gives the bits of the library run with the same targets
+/// (`set_pin_target_at` at each communication point), the pinned vertex
+/// sits on `x_in + v_in (t - t_c)` exactly, and the pin force output is
+/// the mean of the library's `-pin_reactions()` over the step's substeps.
+#[test]
+fn input_pin_driven_on_a_circle_gives_the_library_bits() {
+    let s = pinned_scene("motion = \"input\"");
+    let (c, r0, w) = (Vec2::new(0.35, 0.65), Vec2::new(-0.1, 0.0), 2.0);
+    let path = |t: f64| {
+        let (sn, cs) = (w * t).sin_cos();
+        let r = Vec2::new(cs * r0.x - sn * r0.y, sn * r0.x + cs * r0.y);
+        (c + r, Vec2::new(-r.y, r.x) * w)
+    };
+    let f = Fmu::new(&s);
+    f.init();
+    let mut sim = YarnSim::new(&s).unwrap();
+    let mut worst_pin: f64 = 0.0;
+    for k in 0..20 {
+        let t = k as f64 * H;
+        let (x, v) = path(t);
+        assert_eq!(f.set_real(&pin_vrs(0), &[x.x, x.y, v.x, v.y]), fmi2OK);
+        assert_eq!(f.do_step(t, H), fmi2OK, "{:?}", f.lines());
+        sim.set_pin_target_at(0, x, v, t).unwrap();
+        let mut sum = Vec2::zeros();
+        for _ in 0..50 {
+            sim.step().unwrap();
+            sum -= sim.pin_reactions()[0];
+        }
+        let out = pin_outputs(&f);
+        assert_eq!(
+            bits(&out),
+            bits(&library_outputs(&sim, sum / 50.0)),
+            "step {k}"
+        );
+        // The pinned end: x_in + v_in (t_end - t_c), to round-off.
+        let end = x + v * (sim.time() - t);
+        worst_pin = worst_pin.max((Vec2::new(out[0], out[1]) - end).norm());
+    }
+    assert!(worst_pin < 1e-15, "{worst_pin}");
+}
+
+/// Inputs on the substep grid (h = dt) reproduce the scene-driven pins:
+/// a `line` pin within round-off everywhere (both prescribe C = 0), and a
+/// `circle` pin exactly at the pinned vertex but not in the rest of the
+/// yarn: the circle pin also prescribes its rotation's velocity gradient
+/// (C = omega J) to the pinned vertex's affine momentum, which an input pin
+/// (a translation) does not; that difference is measured here.
+#[test]
+fn input_pin_on_the_substep_grid_reproduces_line_and_circle_pins() {
+    let input = pinned_scene("motion = \"input\"");
+    let dt = input.time.dt;
+    let steps = 250; // 0.05 s
+    let run_fmu = |target: &dyn Fn(f64) -> (Vec2, Vec2)| {
+        let f = Fmu::new(&input);
+        f.init();
+        let mut rows = Vec::new();
+        for k in 0..steps {
+            let t = k as f64 * dt;
+            // Chosen so that x_in + v_in dt is the path at the substep's end.
+            let (x1, v1) = target(t + dt);
+            let x = x1 - v1 * dt;
+            assert_eq!(f.set_real(&pin_vrs(0), &[x.x, x.y, v1.x, v1.y]), fmi2OK);
+            assert_eq!(f.do_step(t, dt), fmi2OK, "{:?}", f.lines());
+            rows.push(pin_outputs(&f));
+        }
+        rows
+    };
+    let run_lib = |s: &YarnScene| {
+        let mut sim = YarnSim::new(s).unwrap();
+        (0..steps)
+            .map(|_| {
+                sim.step().unwrap();
+                library_outputs(&sim, -sim.pin_reactions()[0])
+            })
+            .collect::<Vec<_>>()
+    };
+    let diff = |a: &[Vec<f64>], b: &[Vec<f64>], cols: std::ops::Range<usize>| {
+        a.iter()
+            .zip(b)
+            .flat_map(|(x, y)| cols.clone().map(move |i| (x[i] - y[i]).abs()))
+            .fold(0.0, f64::max)
+    };
+    // line
+    let vel = Vec2::new(0.3, -0.2);
+    let x0 = Vec2::new(0.25, 0.65);
+    let line = pinned_scene("motion = \"line\"\nvelocity = [0.3, -0.2]");
+    let a = run_fmu(&|t| (x0 + vel * t, vel));
+    let b = run_lib(&line);
+    let ends = diff(&a, &b, 0..8);
+    let pin = diff(&a, &b, 0..2);
+    eprintln!("line: pinned vertex {pin:.2e} m, yarn ends {ends:.2e} m");
+    assert!(pin < 1e-15 && ends < 1e-12, "{pin} {ends}");
+    // circle
+    let circle = pinned_scene("motion = \"circle\"\ncenter = [0.35, 0.65]\nangular_velocity = 2.0");
+    let pinfo = YarnSim::new(&circle).unwrap().pins()[0].clone();
+    let a = run_fmu(&|t| pinfo.target(0, t));
+    let b = run_lib(&circle);
+    let pin = diff(&a, &b, 0..2);
+    let ends = diff(&a, &b, 0..8);
+    let force = diff(&a, &b, 11..13);
+    eprintln!(
+        "circle: pinned vertex {pin:.2e} m, yarn ends {ends:.2e} m, pin force {force:.2e} N/m (C of the circle pin)"
+    );
+    assert!(pin < 1e-15, "{pin}");
+    assert!(ends < 1e-3, "{ends}");
+}
+
+/// A yarn hanging from an input pin held at its start: the mean pin force
+/// is the yarn's weight, pointing down.
+#[test]
+fn hanging_yarn_pulls_its_input_pin_with_its_weight() {
+    let g = 9.8;
+    let s = YarnScene::from_toml_str(&format!(
+        r#"
+kind = "yarn"
+gravity = [0.0, -{g}]
+[grid]
+resolution = 64
+[time]
+dt = 1e-4
+[material]
+k = 2000.0
+gamma = 0.0
+youngs_modulus = 0.0
+friction = 0.0
+bending = 0.0
+plasticity = false
+[walls]
+mode = "none"
+[[yarns]]
+start = [0.5, 0.9]
+end = [0.5, 0.4]
+vertices = 50
+[[pins]]
+yarn = 0
+end = "start"
+motion = "input"
+"#
+    ))
+    .unwrap();
+    let weight = YarnSim::new(&s).unwrap().diagnostics().total_mass * g;
+    let f = Fmu::new(&s);
+    f.init();
+    let h = 0.01;
+    let mut sum = Vec2::zeros();
+    let mut n = 0;
+    for k in 0..60 {
+        let t = k as f64 * h;
+        assert_eq!(f.set_real(&pin_vrs(0), &[0.5, 0.9, 0.0, 0.0]), fmi2OK);
+        assert_eq!(f.do_step(t, h), fmi2OK, "{:?}", f.lines());
+        let fo = f.get_real(&force_vrs(0)).unwrap();
+        if k >= 20 {
+            sum += Vec2::new(fo[0], fo[1]);
+            n += 1;
+        }
+    }
+    let mean = sum / n as f64;
+    let err = (-mean.y - weight) / weight;
+    eprintln!(
+        "hanging yarn: mean pin force ({:.4e}, {:.4e}) N/m over 0.4 s, weight {weight:.4e} N/m, error {:+.2} %",
+        mean.x,
+        mean.y,
+        100.0 * err
+    );
+    assert!(err.abs() < 0.03, "{err}");
+    assert!(mean.x.abs() < 0.01 * weight, "{mean:?}");
+}
+
+/// The `scene` parameter must keep the bundled scene's pins: the pin
+/// variables are fixed by the bundled scene.
+#[test]
+fn scene_parameter_must_keep_the_pins() {
+    let s = pinned_scene("motion = \"input\"");
+    let f = Fmu::new(&s);
+    let fixed = pinned_scene("");
+    std::fs::write(f.dir.join("fixed.toml"), fixed.to_toml_string()).unwrap();
+    assert_eq!(set_string(&f, VR_SCENE, "fixed.toml"), fmi2Error);
+    assert!(f.last_error().contains("other pins"), "{}", f.last_error());
+    unsafe { assert_eq!(fmi2Reset(f.c), fmi2OK) };
+    let mut moved = s.clone();
+    moved.gravity = [0.0, -5.0];
+    std::fs::write(f.dir.join("moved.toml"), moved.to_toml_string()).unwrap();
+    assert_eq!(
+        set_string(&f, VR_SCENE, "moved.toml"),
+        fmi2OK,
+        "{:?}",
+        f.lines()
+    );
+}
