@@ -20,7 +20,7 @@ then
 fi
 target=$(cargo metadata --format-version 1 --no-deps | "$venv/bin/python" -c 'import json,sys; print(json.load(sys.stdin)["target_directory"])')
 if [ ! -f "$target/fmu/YarnBundle-small.fmu" ] || [ ! -f "$target/fmu/MassSpring-wire.fmu" ]; then
-    cargo build --release -p yarnsim-fmu --bins --lib
+    cargo build --release -p yarnsim-fmu -p yarnsim-fmu-pack --bins --lib
     "$target/release/build-fmu" --no-build --scene fmu/scenes/small.toml -o "$target/fmu/YarnBundle-small.fmu"
     "$target/release/build-fmu" --no-build --scene wire
 fi
