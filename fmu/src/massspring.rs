@@ -13,7 +13,7 @@ use yarnsim::massspring::{Integrator, IntegratorOptions, Layout, Simulation, V3}
 use crate::fmu_model::{
     refuse, Checkpoint, FmuModel, ModelResult, ParamCheck, SetContext, StepFailure,
 };
-use crate::model::{real, Description, VarType, Variable};
+use crate::model::{input, output, parameter, Description, Start, VarSpec, VarType, Variable};
 use crate::state_bytes::{Reader, Writer};
 
 /// The FMI model identifier of a mass-spring FMU.
@@ -50,121 +50,66 @@ pub fn num_particles(layout: &Layout) -> Result<usize, String> {
         .map_err(|e| format!("scene {:?}: {e}", layout.name))
 }
 
-/// Every variable of the FMU for this layout, in `ModelVariables` order.
+/// The MassSpring's variables before the ones every model has
+/// ([`crate::model::COMMON_VARIABLES`]) and the per-particle outputs, in
+/// `ModelVariables` order; start values come from the layout.
+pub static MASS_SPRING_VARIABLES: [VarSpec<Layout>; 10] = [
+    input("gravity.x", VR_GRAVITY_X, VarType::Real, Some("m/s2"), Start::Real(|l| l.gravity[0]), "Gravity x, |g| at most 1e6"),
+    input("gravity.y", VR_GRAVITY_Y, VarType::Real, Some("m/s2"), Start::Real(|l| l.gravity[1]), "Gravity y, |g| at most 1e6"),
+    input("gravity.z", VR_GRAVITY_Z, VarType::Real, Some("m/s2"), Start::Real(|l| l.gravity[2]), "Gravity z, |g| at most 1e6"),
+    parameter("dt", VR_DT, VarType::Real, Some("s"), Start::Real(|_| 0.0), "Substep size; 0: the integrator's own (CFL-limited for the explicit schemes, the scene's time_step otherwise). A communication step runs an integer number of substeps"),
+    parameter("integrator", VR_INTEGRATOR, VarType::String, None, Start::Text(DEFAULT_INTEGRATOR_NAME), "Time integrator: one of forward-euler, symplectic-euler, trapezoidal, backward-euler, chebyshev-jacobi, pbd"),
+    output("kinetic_energy", VR_KINETIC_ENERGY, Some("J"), "Kinetic energy"),
+    output("elastic_energy", VR_ELASTIC_ENERGY, Some("J"), "Elastic energy of the springs"),
+    output("gravity_energy", VR_GRAVITY_ENERGY, Some("J"), "Gravitational energy -sum m g.x"),
+    output("total_energy", VR_TOTAL_ENERGY, Some("J"), "Kinetic + elastic + gravitational energy"),
+    output("max_strain", VR_MAX_STRAIN, None, "Largest spring strain |l / l0 - 1|"),
+];
+
+/// Name of [`DEFAULT_INTEGRATOR`] (the `integrator` start value).
+const DEFAULT_INTEGRATOR_NAME: &str = "backward-euler";
+
+/// Every variable of the FMU for this layout, in `ModelVariables` order:
+/// [`MASS_SPRING_VARIABLES`], the common ones, then `particle[i].x/y/z`.
 pub fn variables(layout: &Layout) -> Result<Vec<Variable>, String> {
     let n = num_particles(layout)?;
-    let mut v = Vec::with_capacity(11 + 3 * n);
-    let var = |name: String,
-               vr: u32,
-               ty: VarType,
-               causality: &'static str,
-               variability: &'static str,
-               unit: Option<&'static str>,
-               start: Option<String>,
-               description: String| Variable {
-        name,
-        vr,
-        ty,
-        causality,
-        variability,
-        unit,
-        start,
-        description,
-    };
-    for (k, axis) in ["x", "y", "z"].into_iter().enumerate() {
-        v.push(var(
-            format!("gravity.{axis}"),
-            VR_GRAVITY_X + k as u32,
-            VarType::Real,
-            "input",
-            "continuous",
-            Some("m/s2"),
-            Some(real(layout.gravity[k])),
-            format!("Gravity {axis}, |g| at most 1e6"),
-        ));
-    }
-    v.push(var(
-        "dt".into(),
-        VR_DT,
-        VarType::Real,
-        "parameter",
-        "fixed",
-        Some("s"),
-        Some(real(0.0)),
-        "Substep size; 0: the integrator's own (CFL-limited for the explicit schemes, the scene's time_step otherwise). A communication step runs an integer number of substeps".into(),
-    ));
-    v.push(var(
-        "integrator".into(),
-        VR_INTEGRATOR,
-        VarType::String,
-        "parameter",
-        "fixed",
-        None,
-        Some(DEFAULT_INTEGRATOR.name().into()),
-        format!(
-            "Time integrator: one of {}",
-            Integrator::ALL.map(|i| i.name()).join(", ")
-        ),
-    ));
-    for (vr, name, unit, d) in [
-        (
-            VR_KINETIC_ENERGY,
-            "kinetic_energy",
-            Some("J"),
-            "Kinetic energy",
-        ),
-        (
-            VR_ELASTIC_ENERGY,
-            "elastic_energy",
-            Some("J"),
-            "Elastic energy of the springs",
-        ),
-        (
-            VR_GRAVITY_ENERGY,
-            "gravity_energy",
-            Some("J"),
-            "Gravitational energy -sum m g.x",
-        ),
-        (
-            VR_TOTAL_ENERGY,
-            "total_energy",
-            Some("J"),
-            "Kinetic + elastic + gravitational energy",
-        ),
-        (
-            VR_MAX_STRAIN,
-            "max_strain",
-            None,
-            "Largest spring strain |l / l0 - 1|",
-        ),
-    ] {
-        v.push(var(
-            name.into(),
-            vr,
-            VarType::Real,
-            "output",
-            "continuous",
-            unit,
-            None,
-            d.into(),
-        ));
-    }
+    let mut v: Vec<Variable> = MASS_SPRING_VARIABLES
+        .iter()
+        .map(|s| s.variable(layout))
+        .collect();
     v.extend(crate::model::common_variables());
     for i in 0..n {
         for (k, axis) in ["x", "y", "z"].into_iter().enumerate() {
-            v.push(var(
-                format!("particle[{i}].{axis}"),
-                VR_PARTICLE_BASE + 3 * i as u32 + k as u32,
-                VarType::Real,
-                "output",
-                "continuous",
-                Some("m"),
-                None,
-                format!("Particle {i}, position {axis}"),
-            ));
+            v.push(Variable {
+                name: format!("particle[{i}].{axis}"),
+                vr: VR_PARTICLE_BASE + 3 * i as u32 + k as u32,
+                ty: VarType::Real,
+                causality: "output",
+                variability: "continuous",
+                unit: Some("m"),
+                start: None,
+                description: format!("Particle {i}, position {axis}"),
+            });
         }
     }
     Ok(v)
+}
+
+#[cfg(test)]
+mod table_tests {
+    use super::*;
+
+    /// `integrator`'s description lists the library's integrators.
+    #[test]
+    fn integrator_names_match_the_library() {
+        let names = Integrator::ALL.map(|i| i.name()).join(", ");
+        assert_eq!(MASS_SPRING_VARIABLES[4].name, "integrator");
+        assert!(
+            MASS_SPRING_VARIABLES[4].description.ends_with(&names),
+            "{names}"
+        );
+        assert_eq!(DEFAULT_INTEGRATOR_NAME, DEFAULT_INTEGRATOR.name());
+    }
 }
 
 /// The gravitational and the total energy change as soon as `gravity.*` is

@@ -219,50 +219,70 @@ pub fn num_yarns(scene: &YarnScene) -> usize {
     scene.curves().len()
 }
 
-/// A Real parameter that lives in the scene: how to read and override it.
-#[derive(Clone, Copy)]
-pub struct SceneField {
-    pub get: fn(&YarnScene) -> f64,
-    pub set: fn(&mut YarnScene, f64),
+/// A Real parameter that lives in the scene (of type `S`, the yarn scene
+/// by default): how to read and override it.
+pub struct SceneField<S = YarnScene> {
+    pub get: fn(&S) -> f64,
+    pub set: fn(&mut S, f64),
     /// Must be > 0 (else >= 0).
     pub positive: bool,
     /// Largest accepted value.
     pub max: f64,
 }
 
-/// Where a variable's start value comes from.
-#[derive(Clone, Copy)]
-pub enum Start {
+impl<S> Clone for SceneField<S> {
+    fn clone(&self) -> Self {
+        *self
+    }
+}
+impl<S> Copy for SceneField<S> {}
+
+/// Where a variable's start value comes from (a scene of type `S`).
+pub enum Start<S = YarnScene> {
     /// Outputs have none.
     None,
     /// A Real parameter in the scene (also its getter and setter).
-    Scene(SceneField),
+    Scene(SceneField<S>),
     /// A Real read from the scene.
-    Real(fn(&YarnScene) -> f64),
+    Real(fn(&S) -> f64),
     /// A Boolean read from the scene.
-    Bool(fn(&YarnScene) -> bool),
+    Bool(fn(&S) -> bool),
     /// A fixed text.
     Text(&'static str),
     /// A name read from the scene.
-    Name(fn(&YarnScene) -> &'static str),
+    Name(fn(&S) -> &'static str),
 }
 
-/// One row of a model's variable table.
-#[derive(Clone, Copy)]
-pub struct VarSpec {
+impl<S> Clone for Start<S> {
+    fn clone(&self) -> Self {
+        *self
+    }
+}
+impl<S> Copy for Start<S> {}
+
+/// One row of a model's variable table; `S` is the scene type its start
+/// values are read from (the yarn scene, or the mass-spring layout).
+pub struct VarSpec<S = YarnScene> {
     pub name: &'static str,
     pub vr: u32,
     pub ty: VarType,
     pub causality: &'static str,
     pub variability: &'static str,
     pub unit: Option<&'static str>,
-    pub start: Start,
+    pub start: Start<S>,
     pub description: &'static str,
 }
 
-impl VarSpec {
+impl<S> Clone for VarSpec<S> {
+    fn clone(&self) -> Self {
+        *self
+    }
+}
+impl<S> Copy for VarSpec<S> {}
+
+impl<S> VarSpec<S> {
     /// The variable as written in `modelDescription.xml`, for this scene.
-    pub fn variable(&self, scene: &YarnScene) -> Variable {
+    pub fn variable(&self, scene: &S) -> Variable {
         Variable {
             name: self.name.to_string(),
             vr: self.vr,
@@ -283,14 +303,15 @@ impl VarSpec {
     }
 }
 
-const fn input(
+/// An input row (Real inputs continuous, others discrete).
+pub const fn input<S>(
     name: &'static str,
     vr: u32,
     ty: VarType,
     unit: Option<&'static str>,
-    start: Start,
+    start: Start<S>,
     description: &'static str,
-) -> VarSpec {
+) -> VarSpec<S> {
     VarSpec {
         name,
         vr,
@@ -306,14 +327,15 @@ const fn input(
     }
 }
 
-const fn parameter(
+/// A fixed parameter row.
+pub const fn parameter<S>(
     name: &'static str,
     vr: u32,
     ty: VarType,
     unit: Option<&'static str>,
-    start: Start,
+    start: Start<S>,
     description: &'static str,
-) -> VarSpec {
+) -> VarSpec<S> {
     VarSpec {
         name,
         vr,
@@ -326,12 +348,13 @@ const fn parameter(
     }
 }
 
-const fn output(
+/// A continuous Real output row.
+pub const fn output<S>(
     name: &'static str,
     vr: u32,
     unit: Option<&'static str>,
     description: &'static str,
-) -> VarSpec {
+) -> VarSpec<S> {
     VarSpec {
         name,
         vr,
