@@ -90,6 +90,7 @@ struct ScatterCtx<'a> {
     dt: f64,
     bending: f64,
     obstacles: &'a [Obstacle],
+    pinned: &'a [bool],
 }
 
 /// Splits `v` into the scatter's chunks of `n` items.
@@ -117,6 +118,23 @@ pub fn scatter(
     obstacles: &[Obstacle],
     flip: bool,
 ) {
+    scatter_pinned(p, grid, dt, bending, obstacles, flip, &[]);
+}
+
+/// [`scatter`] with pinned vertices: `pinned[i]` (empty: none) marks a vertex
+/// whose motion a pin prescribes. Its internal force is not scattered (the
+/// pin takes it up; scattered, the tension a hanging yarn exerts on its pinned
+/// top vertex pulled the grid nodes there down, and under FLIP the yarn's top
+/// segments gained that impulse every substep and diverged within 0.02 s).
+pub fn scatter_pinned(
+    p: &mut Particles,
+    grid: &mut Grid,
+    dt: f64,
+    bending: f64,
+    obstacles: &[Obstacle],
+    flip: bool,
+    pinned: &[bool],
+) {
     let geom = grid.geom;
     let (nv, nq) = (p.vert.x.len(), p.quad.x.len());
     // Each chunk writes the stencils and forces of its own vertex range
@@ -132,6 +150,7 @@ pub fn scatter(
         dt,
         bending,
         obstacles,
+        pinned,
     };
     grid.buffers
         .par_iter_mut()
@@ -172,7 +191,11 @@ multiversion! {
         for ((i, st), f) in vr.zip(sts.iter_mut()).zip(fs.iter()) {
             *st = Stencil::new(vert.x[i], geom.inv_dx);
             let m = vert.m[i];
-            let f0 = f * dt;
+            let f0 = if ctx.pinned.get(i).copied().unwrap_or(false) {
+                Vec2::zeros()
+            } else {
+                f * dt
+            };
             let s = Splat {
                 m,
                 mc: contact_mass(ctx.obstacles, margin, vert.x[i], m),

@@ -5,7 +5,7 @@
 //! force on the yarn.
 
 use super::particles::{Particles, Vertices};
-use crate::math::{perp, Vec2};
+use crate::math::{perp, Mat2, Vec2};
 use crate::scene::{PinMotionKind, SceneError, YarnScene};
 
 /// How a pin moves its vertices.
@@ -46,6 +46,16 @@ impl Pin {
             }
         }
     }
+
+    /// Prescribed affine velocity matrix `C` (the velocity gradient of the
+    /// motion) of the pin's vertices: zero for fixed and line motions, the
+    /// rotation rate `omega [[0, -1], [1, 0]]` for a circle.
+    pub fn affine(&self) -> Mat2 {
+        match self.motion {
+            PinMotion::Fixed | PinMotion::Line { .. } => Mat2::zeros(),
+            PinMotion::Circle { omega, .. } => Mat2::new(0.0, -omega, omega, 0.0),
+        }
+    }
 }
 
 /// The pins of a scene over its particles (validated).
@@ -81,17 +91,23 @@ pub fn pins_of_scene(scene: &YarnScene, p: &Particles) -> Result<Vec<Pin>, Scene
 
 /// Puts every pinned vertex at its target at time `t` and returns, per pin,
 /// the force the pin exerted on the yarn over the last substep of length
-/// `dt`: `sum m (v_target - v) / dt` over its vertices, with `v` the
-/// velocity the vertex had from the grid.
+/// `dt`: `sum (m (v_target - v) / dt - f)` over its vertices, with `v` the
+/// velocity the vertex had from the grid and `f` the yarn's internal force
+/// on it (not scattered to the grid: the pin takes it up, see
+/// [`super::particle_to_grid::scatter_pinned`]).
 pub fn apply(pins: &[Pin], vert: &mut Vertices, t: f64, dt: f64, reactions: &mut Vec<Vec2>) {
     reactions.clear();
     for pin in pins {
         let mut force = Vec2::zeros();
         for (k, &i) in pin.vertices.iter().enumerate() {
             let (x, v) = pin.target(k, t);
-            force += (v - vert.v[i]) * (vert.m[i] / dt);
+            force += (v - vert.v[i]) * (vert.m[i] / dt) - vert.f[i];
             vert.x[i] = x;
             vert.v[i] = v;
+            // Without this a FLIP transfer keeps adding the grid's change of
+            // `C` to a vertex whose velocity is reset, and `C` grows without
+            // bound (a pinned hanging yarn diverged within 0.02 s).
+            vert.c[i] = pin.affine();
         }
         reactions.push(force);
     }
@@ -105,6 +121,7 @@ pub fn place(pins: &[Pin], vert: &mut Vertices, t: f64) {
             let (x, v) = pin.target(k, t);
             vert.x[i] = x;
             vert.v[i] = v;
+            vert.c[i] = pin.affine();
         }
     }
 }

@@ -359,13 +359,14 @@ impl YarnSim {
             self.frames_stale = false;
         }
         let t1 = Instant::now();
-        particle_to_grid::scatter(
+        particle_to_grid::scatter_pinned(
             &mut self.particles,
             &mut self.grid,
             dt,
             bending,
             obstacles,
             flip,
+            &self.pinned,
         );
         let t2 = Instant::now();
         let ext = GridForces {
