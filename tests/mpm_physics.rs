@@ -510,11 +510,13 @@ end = "start"
     assert_eq!(p.vert.x[0], Vec2::new(0.5, 0.8));
     assert_eq!(p.vert.c[0], Mat2::zeros());
     let vmax = p.vert.v.iter().map(|v| v.norm()).fold(0.0, f64::max);
-    // a 0.5 m chain from near rest: far below free-fall speed g t = 2 m/s
-    assert!(vmax < 0.5, "{vmax}");
-    // the pin carries the yarn's weight (rho g L = 4.9 N/m) within 10 %
+    // a 0.5 m chain from near rest: far below free-fall speed g t = 3 m/s
+    // (measured 0.029 m/s)
+    assert!(vmax < 0.1, "{vmax}");
+    // the pin carries the yarn's weight (rho g L = 4.9 N/m) within 2 %
+    // (measured 4.896)
     assert!(
-        (mean.y - 4.9).abs() < 0.49 && mean.x.abs() < 0.1,
+        (mean.y - 4.9).abs() < 0.098 && mean.x.abs() < 0.05,
         "{mean:?}"
     );
 }
