@@ -19,18 +19,28 @@ use crate::error::CliError;
 pub enum EvidenceCommand {
     /// Work-precision: run time against error per scene and integrator
     /// (`yarnsim bench precision`): CSV, SVG plots, convergence orders and
-    /// the fastest method per error level.
+    /// the fastest method per error level
+    ///
+    /// Mass-spring scenes per integrator against a converged reference; the
+    /// yarn against the hanging-chain oracle (first-mode frequency) per
+    /// transfer scheme over a dt ladder and a grid ladder, with the cheapest
+    /// setting per error level 1e-1, 1e-2, 1e-3.
     #[command(name = "bench-precision", visible_alias = "precision")]
     BenchPrecision {
-        /// Output directory for precision*.csv, precision_<scene>.svg, precision.txt.
+        /// Output directory for precision*.csv, precision_<scene>.svg,
+        /// precision_chain.svg, precision.txt.
         #[arg(long, value_name = "DIR", default_value = "evidence")]
         out: PathBuf,
         /// Fewer step sizes and shorter runs (seconds instead of a minute or two).
         #[arg(long)]
         quick: bool,
-        /// Also run the (slow) yarn reference scene.
+        /// Also run the (slow) yarn reference scene (against a finer run of
+        /// itself: self-convergence, not accuracy).
         #[arg(long)]
         yarn_reference: bool,
+        /// Leave out the yarn hanging-chain study (mass-spring scenes only).
+        #[arg(long)]
+        no_chain: bool,
     },
     /// Stability stress: largest stable dt per integrator and stiffness / yarn
     /// parameter by bisection, next to the theoretical bound.
@@ -81,10 +91,12 @@ pub fn execute(cmd: &EvidenceCommand) -> Result<(String, Vec<String>), CliError>
             out,
             quick,
             yarn_reference,
+            no_chain,
         } => {
             let r = precision::run(&precision::PrecisionOptions {
                 quick: *quick,
                 yarn_reference: *yarn_reference,
+                no_chain: *no_chain,
             })
             .map_err(CliError::Failed)?;
             Ok((r.to_text(), write(out, &r.files())?))
@@ -150,9 +162,16 @@ mod tests {
             out: dir.clone(),
             quick: true,
             yarn_reference: false,
+            no_chain: false,
         })
         .unwrap();
         assert!(text.contains("Fastest method per error level"));
+        assert!(text.contains("Cheapest setting per error level"));
+        let chain = std::fs::read_to_string(dir.join("precision_chain.svg")).unwrap();
+        assert!(chain.starts_with("<svg") && chain.contains("polyline"));
+        assert!(files
+            .iter()
+            .any(|f| f.ends_with("precision_chain_summary.csv")));
         assert!(files.iter().any(|f| f.ends_with("precision.csv")));
         let svg = std::fs::read_to_string(dir.join("precision_wire.svg")).unwrap();
         assert!(svg.starts_with("<svg") && svg.contains("polyline"));

@@ -1,5 +1,6 @@
 //! Runs the evidence studies without the CLI:
-//! `cargo run --release -p yarnsim-evidence --example evidence -- precision|stress|skip [--quick] [--out DIR]`.
+//! `cargo run --release -p yarnsim-evidence --example evidence -- precision|stress|skip [--quick] [--out DIR]`
+//! (precision also takes `--yarn-reference` and `--no-chain`).
 
 use std::path::PathBuf;
 
@@ -20,6 +21,7 @@ fn main() {
             let r = precision::run(&precision::PrecisionOptions {
                 quick,
                 yarn_reference: args.iter().any(|a| a == "--yarn-reference"),
+                no_chain: args.iter().any(|a| a == "--no-chain"),
             })
             .unwrap_or_else(|e| panic!("{e}"));
             (r.to_text(), r.files())

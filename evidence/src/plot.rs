@@ -18,6 +18,16 @@ pub struct Series {
     pub color: Option<usize>,
     /// Dashed line (to tell apart two series of the same colour).
     pub dashed: bool,
+    /// Marker shape of the points (filled circle by default).
+    pub marker: Marker,
+}
+
+/// Marker shape of a [`Series`]' points.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Marker {
+    #[default]
+    Circle,
+    Square,
 }
 
 /// A line plot with optional logarithmic axes.
@@ -212,14 +222,23 @@ impl LinePlot {
                     coords.join(" ")
                 );
             }
-            let marker = |x: f64, y: f64| {
-                if s.markers_only {
-                    format!(
-                        r#"<circle cx="{x:.1}" cy="{y:.1}" r="5" fill="none" stroke="{c}" stroke-width="2"/>"#
-                    )
-                } else {
+            let marker = |x: f64, y: f64| match (s.markers_only, s.marker) {
+                (true, Marker::Circle) => format!(
+                    r#"<circle cx="{x:.1}" cy="{y:.1}" r="5" fill="none" stroke="{c}" stroke-width="2"/>"#
+                ),
+                (false, Marker::Circle) => {
                     format!(r#"<circle cx="{x:.1}" cy="{y:.1}" r="3" fill="{c}"/>"#)
                 }
+                (true, Marker::Square) => format!(
+                    r#"<rect x="{:.1}" y="{:.1}" width="9" height="9" fill="none" stroke="{c}" stroke-width="2"/>"#,
+                    x - 4.5,
+                    y - 4.5
+                ),
+                (false, Marker::Square) => format!(
+                    r#"<rect class="marker" x="{:.1}" y="{:.1}" width="7" height="7" fill="{c}"/>"#,
+                    x - 3.5,
+                    y - 3.5
+                ),
             };
             for &(x, y) in &p {
                 let _ = writeln!(out, "{}", marker(px(x), py(y)));
@@ -229,10 +248,14 @@ impl LinePlot {
             let key = if s.markers_only {
                 marker(lx + 10.0, ly)
             } else {
-                format!(
+                let mut k = format!(
                     r#"<line x1="{lx}" y1="{ly}" x2="{}" y2="{ly}" stroke="{c}" stroke-width="3"{dash}/>"#,
                     lx + 20.0
-                )
+                );
+                if s.marker != Marker::Circle {
+                    k.push_str(&marker(lx + 10.0, ly));
+                }
+                k
             };
             let _ = writeln!(
                 out,
@@ -352,6 +375,18 @@ mod tests {
         assert_eq!(svg.matches(PALETTE[0]).count(), 3 + 2 + 2 + 2);
         assert!(svg.contains("t &lt;&amp;&gt;"));
         assert!(!svg.contains("NaN") && !svg.contains("inf"));
+    }
+
+    #[test]
+    fn square_markers_in_plot_and_legend() {
+        let svg = plot(vec![Series {
+            name: "squares".into(),
+            points: vec![(1.0, 1e-3), (10.0, 1e-4)],
+            marker: Marker::Square,
+            ..Series::default()
+        }]);
+        assert_eq!(svg.matches(r#"class="marker""#).count(), 3);
+        assert_eq!(svg.matches("<circle").count(), 0);
     }
 
     #[test]

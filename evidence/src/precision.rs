@@ -11,10 +11,12 @@
 //!   (8 chord-Newton iterations, CG tolerance 1e-14) at a step 2^-4 of the
 //!   finest ladder step; its own error is estimated by Richardson from the
 //!   same run at twice the step (`|x_h - x_2h| / 3`, order 2) and printed.
-//! * Yarn reference: MPM at a step 2^-3 of the finest ladder step; MPM is
-//!   first order in time, so its error estimate is `|x_h - x_2h|`.
-//! * Yarn scene: [`yarn_precision_scene`] (no circle: contact with friction
-//!   makes the end state depend non-smoothly on dt; an attractor bends the bundle).
+//! * Yarn: against a physical oracle, the hanging chain's first-mode
+//!   frequency ([`crate::chain`]), over a dt ladder and a grid ladder per
+//!   transfer scheme, with the cheapest setting per error level. The
+//!   optional `yarn_reference` scene is still measured against a finer run
+//!   of itself (MPM at a step 2^-3 of the finest ladder step, error estimate
+//!   `|x_h - x_2h|`): self-convergence, not accuracy.
 //! * Observed order: least-squares slope of log error against log step over
 //!   the runs whose error is at least 10x the reference's error estimate.
 //!
@@ -25,22 +27,23 @@
 
 use std::time::Instant;
 
+use crate::chain::{self, ChainReport};
 use crate::plot::{LinePlot, Series};
 use crate::{extent, num, Table};
 use yarnsim::massspring::{scenes, Integrator, IntegratorOptions, Simulation, System, V3};
 use yarnsim::mpm::YarnSim;
-use yarnsim::scene::{
-    builtin::{small_yarn_scene, yarn_reference},
-    YarnScene,
-};
+use yarnsim::scene::{builtin::yarn_reference, YarnScene};
 
 /// What to run.
 #[derive(Clone, Debug, Default)]
 pub struct PrecisionOptions {
     /// Fewer step sizes and shorter runs (for tests and a first look).
     pub quick: bool,
-    /// Also run the yarn reference scene (slow: about a minute).
+    /// Also run the yarn reference scene (slow: about a minute;
+    /// self-convergence, not accuracy).
     pub yarn_reference: bool,
+    /// Leave out the yarn hanging-chain study ([`crate::chain`]).
+    pub no_chain: bool,
 }
 
 /// One run.
@@ -74,7 +77,10 @@ pub struct SceneResult {
 /// The whole report.
 #[derive(Clone, Debug)]
 pub struct PrecisionReport {
+    /// Mass-spring scenes (and the optional yarn reference scene).
     pub scenes: Vec<SceneResult>,
+    /// The yarn against the hanging-chain oracle.
+    pub chain: Option<ChainReport>,
     /// Rayon worker threads during the yarn runs.
     pub threads: usize,
 }
@@ -276,24 +282,6 @@ fn yarn_scene(
     })
 }
 
-/// The yarn scene of the study: the small scene without its circle (contact
-/// with Coulomb friction is not smooth in time, so the trajectory after it
-/// is not a convergent function of dt), with an attractor at (0.5, 0.4) of
-/// strength 20 m/s^2 that bends the falling bundle.
-pub fn yarn_precision_scene(quick: bool) -> YarnScene {
-    let mut s = if quick {
-        small_yarn_scene(2, 40, 64)
-    } else {
-        small_yarn_scene(4, 60, 64)
-    };
-    s.name = "yarn-small".into();
-    s.obstacles.clear();
-    s.attractor.active = true;
-    s.attractor.position = [0.5, 0.4];
-    s.attractor.strength = 20.0;
-    s
-}
-
 /// The wire of seed 002 as a system.
 pub fn wire_system() -> System {
     scenes::wire().build().expect("built-in wire builds")
@@ -326,14 +314,6 @@ pub fn run(opts: &PrecisionOptions) -> Result<PrecisionReport, String> {
         if q { 4 } else { 6 },
         &[8, 32, 128],
     )?);
-    let small = yarn_precision_scene(q);
-    scenes.push(yarn_scene(
-        "yarn-small",
-        &small,
-        0.05,
-        4e-4,
-        if q { 4 } else { 6 },
-    )?);
     if opts.yarn_reference {
         scenes.push(yarn_scene(
             "yarn-reference",
@@ -343,8 +323,10 @@ pub fn run(opts: &PrecisionOptions) -> Result<PrecisionReport, String> {
             3,
         )?);
     }
+    let chain = (!opts.no_chain).then(|| chain::run(q));
     Ok(PrecisionReport {
         scenes,
+        chain,
         threads: rayon::current_num_threads(),
     })
 }
@@ -527,7 +509,9 @@ impl PrecisionReport {
     }
 
     /// Files to write: `precision.csv`, `precision_orders.csv`,
-    /// `precision_summary.csv`, `precision_<scene>.svg`, `precision.txt`.
+    /// `precision_summary.csv`, `precision_<scene>.svg`, `precision.txt`,
+    /// and with the chain study `precision_chain.csv`,
+    /// `precision_chain_summary.csv`, `precision_chain.svg`.
     pub fn files(&self) -> Vec<(String, String)> {
         let mut f = vec![
             ("precision.csv".to_string(), self.runs_table().to_csv()),
@@ -544,18 +528,31 @@ impl PrecisionReport {
         for s in &self.scenes {
             f.push((format!("precision_{}.svg", s.scene), s.plot().to_svg()));
         }
+        if let Some(c) = &self.chain {
+            f.push(("precision_chain.csv".into(), c.runs_table().to_csv()));
+            f.push((
+                "precision_chain_summary.csv".into(),
+                c.summary_table().to_csv(),
+            ));
+            f.push(("precision_chain.svg".into(), c.plot().to_svg()));
+        }
         f
     }
 
     /// The human-readable report.
     pub fn to_text(&self) -> String {
-        format!(
+        let mut t = format!(
             "Work-precision (error = max particle position error / scene extent; wall time = stepping only; {} threads)\n\n{}\nObserved convergence order (slope of log error vs log dt)\n\n{}\nFastest method per error level\n\n{}",
             self.threads,
             self.references(),
             self.orders_table().to_text(),
             self.summary_table().to_text()
-        )
+        );
+        if let Some(c) = &self.chain {
+            t.push('\n');
+            t.push_str(&c.to_text());
+        }
+        t
     }
 }
 
@@ -601,6 +598,7 @@ mod tests {
         assert!(errs.windows(2).all(|w| w[1] < w[0]), "{errs:?}");
         let csv = PrecisionReport {
             scenes: vec![r],
+            chain: None,
             threads: 1,
         }
         .runs_table()

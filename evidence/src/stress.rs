@@ -447,6 +447,7 @@ impl StressReport {
                     markers_only: true,
                     color,
                     dashed,
+                    ..Series::default()
                 });
             }
         }
