@@ -1,0 +1,229 @@
+#!/usr/bin/env python3
+"""yarnsim against the seed's Taichi implementation, side by side.
+
+Usage (normally through tools/taichi_bench.sh, which sets up Taichi 1.7.4):
+
+    python tools/taichi_bench.py SEED_FILE [--yarnsim BIN] [--threads 1,2]
+        [--rounds 3] [--steps 1000] [--warmup 100] [--f64]
+
+SEED_FILE is `aempm/aempm_2d_pill.py` of
+github.com/zzigak/Anisotropic-Elastoplastic-model-in-MPM at commit 3cc3af6
+(not shipped with yarnsim: it carries no licence; see the README).
+
+For every round and thread count J the script runs `yarnsim bench
+yarn-reference -j J --steps N --warmup W` and, in a fresh process, the
+seed's substep (its seven kernels, in the order of its `main()` loop) on
+the CPU with `ti.init(arch=ti.cpu, cpu_max_num_threads=J)`, no GUI: W
+untimed substeps (they include Taichi's kernel compilation), then N timed
+ones ending with `ti.sync()`. The order of the two programs alternates from
+round to round. Throughput is particle-substeps/s with the same particle
+count for both: vertices + quadrature particles (12 x 200 + 12 x 199 =
+4788). The seed's scene is moved onto yarnsim's reference scene (yarn start,
+length and spacing; the rest already agrees); the remaining differences in
+the physics are listed in the README.
+
+Internal: `--worker` runs one Taichi measurement and prints
+`<number> particle-substeps/s`.
+"""
+
+import argparse
+import hashlib
+import importlib.util
+import os
+import statistics
+import subprocess
+import sys
+import time
+
+SEED_SHA256 = "ba1c22e8c424912bf16b27d48d69507ded0d5b07b71d4d3de004e76365839579"
+RATE_SUFFIX = " particle-substeps/s"
+
+# yarnsim's `yarn-reference` (src/scene/builtin.rs) against the seed file's
+# module constants: (name, seed value, yarnsim value).
+SCENE_PATCH = [
+    ("start_pos", (0.2, 0.8), (0.1, 0.75)),  # first vertex of the first yarn
+    ("Length", 0.75, 0.8),  # yarn length
+    ("dlx", 0.015, 0.01),  # spacing between the yarns (y)
+]
+# Already equal in both: 12 yarns x 200 vertices, 256^2 grid over 1 m,
+# dt 4e-5, density 1, k 1000, gamma 500, E 1000, return-mapping friction
+# 0.05, gravity 9.8, three circles of radius 0.08 at (0.25, 0.6),
+# (0.5, 0.3), (0.75, 0.5), attractor off, walls 3 cells.
+SEED_EQUAL = [
+    ("N_Line", 12),
+    ("ln_type2", 200),
+    ("n_grid", 256),
+    ("dt", 4e-5),
+    ("p_rho", 1),
+    ("k", 1000),
+    ("gamma", 500),
+    ("E", 1000),
+    ("cf", 0.05),
+    ("bound", 3),
+    ("Circle1_Radius", 0.08),
+    ("Circle2_Radius", 0.08),
+    ("Circle3_Radius", 0.08),
+]
+
+
+def worker(args):
+    import taichi as ti
+
+    real_init = ti.init
+
+    def cpu_init(*_a, **_kw):  # the seed calls ti.init(arch=ti.gpu) on import
+        return real_init(
+            arch=ti.cpu,
+            cpu_max_num_threads=args.threads,
+            default_fp=ti.f64 if args.f64 else ti.f32,
+            log_level=ti.WARN,
+        )
+
+    ti.init = cpu_init
+    try:
+        spec = importlib.util.spec_from_file_location("aempm_seed", args.seed)
+        seed = importlib.util.module_from_spec(spec)
+        spec.loader.exec_module(seed)  # not __main__: main() (the GUI loop) does not run
+    finally:
+        ti.init = real_init
+
+    for name, want in SEED_EQUAL:
+        got = getattr(seed, name)
+        if abs(got - want) > 1e-12 * abs(want):
+            sys.exit(f"seed file: {name} = {got}, expected {want} (not the 3cc3af6 version?)")
+    for name, seed_value, ours in SCENE_PATCH:
+        got = getattr(seed, name)
+        got = tuple(got) if name == "start_pos" else got
+        if got != seed_value:
+            sys.exit(f"seed file: {name} = {got}, expected {seed_value} (not the 3cc3af6 version?)")
+    # Kernels read module globals when they are first compiled (below), so
+    # setting them now moves the scene. volume2/3 and sl follow from Length.
+    seed.start_pos = ti.Vector(list(SCENE_PATCH[0][2]))
+    seed.Length = SCENE_PATCH[1][2]
+    seed.dlx = SCENE_PATCH[2][2]
+    seed.sl = seed.Length / (seed.ln_type2 - 1)
+    seed.volume2 = seed.dx * seed.Length / (seed.ln_type3 + seed.ln_type2)
+    seed.volume3 = seed.volume2
+    seed.attractor_strength[None] = 0.0  # the GUI loop sets 0 unless a mouse button is down
+
+    particles = seed.n_type2 + seed.n_type3
+    kernels = [
+        seed.Reset,
+        seed.Particle_To_Grid,
+        seed.Grid_Force,
+        seed.Grid_Collision,
+        seed.Grid_To_Particle,
+        seed.Update_Particle_State,
+        seed.Return_Mapping,
+    ]
+
+    def substeps(n):
+        for _ in range(n):
+            for kernel in kernels:
+                kernel()
+
+    seed.initialize()
+    substeps(args.warmup)
+    ti.sync()
+    t0 = time.perf_counter()
+    substeps(args.steps)
+    ti.sync()
+    seconds = time.perf_counter() - t0
+
+    x = seed.x2.to_numpy()
+    if not (x == x).all():
+        sys.exit("seed run: non-finite vertex positions")
+    fp = "f64" if args.f64 else "f32"
+    print(
+        f"taichi seed: {particles} particles, {args.steps} substeps after {args.warmup} warm-up, "
+        f"{args.threads} thread(s), {fp}, {seconds:.3f} s, vertices x {x[:, 0].min():.4f}..{x[:, 0].max():.4f}, "
+        f"mean y {x[:, 1].mean():.6f}"
+    )
+    print(f"{particles * args.steps / seconds:.0f}{RATE_SUFFIX}")
+
+
+def rate_of(output, what):
+    for line in output.splitlines():
+        if line.endswith(RATE_SUFFIX):
+            return float(line[: -len(RATE_SUFFIX)])
+    sys.exit(f"{what}: no '<number>{RATE_SUFFIX}' line in its output:\n{output}")
+
+
+def run(cmd, what):
+    p = subprocess.run(cmd, capture_output=True, text=True)
+    if p.returncode != 0:
+        sys.exit(f"{what} failed ({p.returncode}): {' '.join(cmd)}\n{p.stdout}{p.stderr}")
+    return rate_of(p.stdout, what)
+
+
+def mega(r):
+    return f"{r / 1e6:.2f} M"
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("seed", help="path of aempm/aempm_2d_pill.py (commit 3cc3af6)")
+    ap.add_argument("--yarnsim", default=None, help="yarnsim binary (default: target/release/yarnsim)")
+    ap.add_argument("--threads", default="1,2", help="comma-separated thread counts (default 1,2)")
+    ap.add_argument("--rounds", type=int, default=3)
+    ap.add_argument("--steps", type=int, default=1000, help="timed substeps (yarnsim bench default)")
+    ap.add_argument("--warmup", type=int, default=100, help="untimed substeps (yarnsim bench default)")
+    ap.add_argument("--f64", action="store_true", help="run the seed in f64 (it is written for Taichi's default f32)")
+    ap.add_argument("--worker", action="store_true", help=argparse.SUPPRESS)
+    args = ap.parse_args()
+
+    if args.worker:
+        args.threads = int(args.threads)
+        worker(args)
+        return
+
+    seed = os.path.abspath(args.seed)
+    with open(seed, "rb") as f:
+        digest = hashlib.sha256(f.read()).hexdigest()
+    if digest != SEED_SHA256:
+        print(f"warning: {seed} is not the 3cc3af6 version (sha256 {digest})")
+    root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    yarnsim = args.yarnsim or os.path.join(root, "target", "release", "yarnsim")
+    if not os.access(yarnsim, os.X_OK):
+        sys.exit(f"no yarnsim binary at {yarnsim}: cargo build --release -p yarnsim-cli, or pass --yarnsim")
+    threads = [int(t) for t in args.threads.split(",")]
+
+    import taichi
+
+    print(
+        f"yarnsim {yarnsim} against the seed {seed} on Taichi {'.'.join(map(str, taichi.__version__))} "
+        f"(CPU, {'f64' if args.f64 else 'f32'}), scene yarn-reference, 4788 particles, "
+        f"{args.steps} timed substeps after {args.warmup} warm-up, {args.rounds} rounds, alternating"
+    )
+    results = {j: [] for j in threads}  # j -> [(yarnsim, taichi)]
+    for r in range(args.rounds):
+        for j in threads:
+            ycmd = [yarnsim, "bench", "yarn-reference", "-j", str(j),
+                    "--steps", str(args.steps), "--warmup", str(args.warmup)]
+            tcmd = [sys.executable, os.path.abspath(__file__), seed, "--worker", "--threads", str(j),
+                    "--steps", str(args.steps), "--warmup", str(args.warmup)] + (["--f64"] if args.f64 else [])
+            if r % 2 == 0:
+                y = run(ycmd, "yarnsim")
+                t = run(tcmd, "taichi seed")
+            else:
+                t = run(tcmd, "taichi seed")
+                y = run(ycmd, "yarnsim")
+            results[j].append((y, t))
+            first = "yarnsim first" if r % 2 == 0 else "taichi first"
+            print(f"round {r + 1}, {j} thread(s) ({first}): yarnsim {mega(y)}, taichi {mega(t)} "
+                  f"particle-substeps/s, ratio {y / t:.1f}x", flush=True)
+
+    print()
+    print("| threads | yarnsim (median) | taichi seed (median) | ratio of medians | ratio per round |")
+    print("|---|---|---|---|---|")
+    for j in threads:
+        ys = [y for y, _ in results[j]]
+        ts = [t for _, t in results[j]]
+        ym, tm = statistics.median(ys), statistics.median(ts)
+        per = ", ".join(f"{y / t:.1f}x" for y, t in results[j])
+        print(f"| {j} | {mega(ym)} | {mega(tm)} | {ym / tm:.1f}x | {per} |")
+    print("(particle-substeps/s; M = 10^6)")
+
+
+if __name__ == "__main__":
+    main()
