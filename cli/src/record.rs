@@ -22,7 +22,8 @@
 //! wall-clock `log_time` timeline is switched off, so two recordings of the
 //! same scene hold the same data everywhere except under `timing/`.
 
-use std::path::Path;
+use std::io::IsTerminal;
+use std::path::{Path, PathBuf};
 
 use rerun::blueprint::{
     Blueprint, Horizontal, Spatial2DView, Spatial3DView, TimePanel, TimeSeriesView, Vertical,
@@ -36,7 +37,9 @@ use yarnsim::math::qr::qr;
 use yarnsim::scene::{Scene, WallMode};
 use yarnsim::YarnSim;
 
-use crate::driver::{interrupt_flag, progress_bar, run_frames, FrameInfo, Outcome, Stepper};
+use crate::driver::{
+    interrupt_flag, progress_bar, run_frames, FrameInfo, FrameRun, Outcome, Stepper,
+};
 use crate::error::CliError;
 use crate::massspring::{spring_stretches, IntegratorArgs, MassSpringRun};
 use crate::run::no_integrator_for_yarn;
@@ -169,69 +172,195 @@ impl PlasticState {
     }
 }
 
+/// Address `--connect` uses without a value: a viewer started with plain `rerun`.
+pub const DEFAULT_CONNECT_URL: &str = "rerun+http://127.0.0.1:9876/proxy";
+
+/// Where a recording goes: Rerun's usual sinks.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum Sink {
+    /// An `.rrd` file (`-o FILE`, `--save FILE`).
+    File(PathBuf),
+    /// Standard output (`-o -`), to pipe into `rerun -`.
+    Stdout,
+    /// A viewer started for this recording (`--spawn`, needs `rerun` on PATH).
+    Spawn,
+    /// A running viewer or server at this gRPC URL (`--connect [ADDR]`).
+    Connect(String),
+}
+
+impl Sink {
+    /// The sink of `-o NAME`: `-` is standard output, anything else must be
+    /// a file name ending in `.rrd` (the only format the viewer opens).
+    pub fn output(name: &Path) -> Result<Sink, CliError> {
+        if name.as_os_str() == "-" {
+            return Ok(Sink::Stdout);
+        }
+        if name.extension().is_some_and(|e| e == "rrd") {
+            Ok(Sink::File(name.to_path_buf()))
+        } else {
+            Err(CliError::Usage(format!(
+                "output `{}` does not end in .rrd: Rerun recordings are .rrd files \
+                 (or `-o -` for standard output, to pipe into `rerun -`)",
+                name.display()
+            )))
+        }
+    }
+
+    /// The sink of `--connect ADDR`: a full `rerun+http://.../proxy` URL, or
+    /// just `HOST:PORT`.
+    pub fn connect(addr: &str) -> Sink {
+        if addr.contains("://") {
+            Sink::Connect(addr.to_string())
+        } else {
+            Sink::Connect(format!("rerun+http://{addr}/proxy"))
+        }
+    }
+
+    /// Where the data went, for the closing message.
+    pub fn describe(&self) -> String {
+        match self {
+            Sink::File(p) => p.display().to_string(),
+            Sink::Stdout => "standard output".into(),
+            Sink::Spawn => "a new Rerun viewer".into(),
+            Sink::Connect(url) => format!("the viewer at {url}"),
+        }
+    }
+
+    /// An error of this sink, with the innermost cause only (Rerun's errors
+    /// repeat the path and wrap the OS error).
+    fn error(&self, e: impl std::error::Error) -> CliError {
+        let cause = root_cause(&e);
+        match self {
+            Sink::File(p) => CliError::output(p, cause),
+            Sink::Stdout => CliError::Viewer(format!("cannot write to standard output: {cause}")),
+            Sink::Spawn => CliError::Viewer(format!("cannot start a Rerun viewer: {cause}")),
+            Sink::Connect(url) => {
+                CliError::Viewer(format!("cannot stream to the viewer at {url}: {cause}"))
+            }
+        }
+    }
+}
+
+/// The innermost error of a chain, as text.
+fn root_cause(e: &dyn std::error::Error) -> String {
+    let mut e = e;
+    while let Some(inner) = e.source() {
+        e = inner;
+    }
+    e.to_string()
+}
+
+/// What to record: the sink and which frames.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct RecordOptions {
+    pub sink: Sink,
+    /// Log every `every`-th frame (1 = all); frame 0 and the last frame are always logged.
+    pub every: u64,
+}
+
+impl RecordOptions {
+    /// All frames into `path` (checked like `-o`).
+    pub fn file(path: &Path) -> Result<Self, CliError> {
+        Ok(RecordOptions {
+            sink: Sink::output(path)?,
+            every: 1,
+        })
+    }
+
+    fn logs(&self, frame: &FrameInfo) -> bool {
+        frame.last || frame.frame.is_multiple_of(self.every.max(1))
+    }
+}
+
 /// How a `record` command ended.
-#[derive(Clone, Copy, Debug)]
+#[derive(Debug)]
 pub struct RecordOutcome {
     pub outcome: Outcome,
     pub particles: usize,
     pub frames_logged: u64,
+    /// The simulation error that stopped the run early; the recording holds
+    /// the frames before it and is complete.
+    pub failure: Option<CliError>,
 }
 
-/// Records `scene` for `duration` seconds to `out`; `integrator` applies to
+/// Records `scene` for `duration` seconds; `integrator` applies to
 /// mass-spring scenes only.
 pub fn record(
     scene: &Scene,
     duration: f64,
-    out: &Path,
+    opts: &RecordOptions,
     integrator: &IntegratorArgs,
 ) -> Result<RecordOutcome, CliError> {
     match scene {
         Scene::Yarn(y) => {
             no_integrator_for_yarn(integrator)?;
-            record_yarn(&mut YarnSim::new(y)?, duration, out)
+            record_yarn(&mut YarnSim::new(y)?, duration, opts)
         }
         Scene::MassSpring(l) => {
-            record_massspring(&mut MassSpringRun::new(l, integrator)?, duration, out)
+            record_massspring(&mut MassSpringRun::new(l, integrator)?, duration, opts)
         }
     }
 }
 
-/// Opens the recording file, without the wall-clock `log_time` timeline.
-fn open(name: &str, blueprint: Blueprint, out: &Path) -> Result<RecordingStream, CliError> {
-    let rec = RecordingStreamBuilder::new(APP_ID)
+/// Opens the recording stream on its sink, without the wall-clock
+/// `log_time` timeline.
+fn open(name: &str, blueprint: Blueprint, sink: &Sink) -> Result<RecordingStream, CliError> {
+    let builder = RecordingStreamBuilder::new(APP_ID)
         .recording_name(name.to_string())
-        .with_blueprint(blueprint)
-        .save(out)
-        .map_err(|e| CliError::output(out, e))?;
+        .with_blueprint(blueprint);
+    let rec = match sink {
+        Sink::File(path) => {
+            // Rerun's own error repeats the path and nests the OS error.
+            std::fs::File::create(path).map_err(|e| CliError::output(path, e))?;
+            builder.save(path)
+        }
+        Sink::Stdout => {
+            if std::io::stdout().is_terminal() {
+                return Err(CliError::Usage(
+                    "`-o -` writes the recording to standard output, which is a terminal here; \
+                     pipe it into the viewer (`yarnsim record -o - | rerun -`) or give a file name"
+                        .into(),
+                ));
+            }
+            builder.stdout()
+        }
+        Sink::Spawn => builder.spawn(),
+        Sink::Connect(url) => builder.connect_grpc_opts(url.clone()),
+    }
+    .map_err(|e| sink.error(e))?;
     rec.set_log_time_enabled(false);
     Ok(rec)
 }
 
-/// Runs `schedule` on `sim`, logging each frame with `log`, then writes the
-/// file's end whatever happened (error, Ctrl-C), so the file stays readable.
+/// Runs `schedule` on `sim`, logging the frames `opts` selects with `log`,
+/// then flushes and closes the stream whatever happened (divergence,
+/// Ctrl-C, SIGTERM), so a file ends readable.
 fn record_frames<S: Stepper>(
     rec: RecordingStream,
     sim: &mut S,
     schedule: &Schedule,
     label: &str,
-    out: &Path,
+    opts: &RecordOptions,
     mut log: impl FnMut(&RecordingStream, &S, FrameInfo) -> rerun::RecordingStreamResult<()>,
 ) -> Result<RecordOutcome, CliError> {
     let progress = progress_bar(schedule.total_steps, label);
     let mut frames_logged = 0;
     let result = run_frames(sim, schedule, &interrupt_flag(), &progress, |sim, frame| {
-        log(&rec, sim, frame).map_err(|e| CliError::output(out, e))?;
-        frames_logged += 1;
+        if opts.logs(&frame) {
+            log(&rec, sim, frame).map_err(|e| opts.sink.error(e))?;
+            frames_logged += 1;
+        }
         Ok(())
     });
     let flushed = rec.flush_blocking();
     drop(rec);
-    let outcome = result?;
-    flushed.map_err(|e| CliError::output(out, e))?;
+    let FrameRun { outcome, failure } = result?;
+    flushed.map_err(|e| opts.sink.error(e))?;
     Ok(RecordOutcome {
         outcome,
         particles: sim.num_particles(),
         frames_logged,
+        failure,
     })
 }
 
@@ -239,14 +368,14 @@ fn record_frames<S: Stepper>(
 pub fn record_yarn(
     sim: &mut YarnSim,
     duration: f64,
-    out: &Path,
+    opts: &RecordOptions,
 ) -> Result<RecordOutcome, CliError> {
     let schedule = Schedule::new(duration, sim.dt(), sim.scene().time.frame_dt)?;
     let name = sim.scene().name.clone();
-    let rec = open(&name, yarn_blueprint(), out)?;
-    log_yarn_static(&rec, sim).map_err(|e| CliError::output(out, e))?;
+    let rec = open(&name, yarn_blueprint(), &opts.sink)?;
+    log_yarn_static(&rec, sim).map_err(|e| opts.sink.error(e))?;
     let t0 = sim.time();
-    record_frames(rec, sim, &schedule, &name, out, |rec, sim, frame| {
+    record_frames(rec, sim, &schedule, &name, opts, |rec, sim, frame| {
         log_yarn_frame(rec, sim, frame, sim.time() - t0)
     })
 }
@@ -255,14 +384,14 @@ pub fn record_yarn(
 pub fn record_massspring(
     run: &mut MassSpringRun,
     duration: f64,
-    out: &Path,
+    opts: &RecordOptions,
 ) -> Result<RecordOutcome, CliError> {
     let schedule = Schedule::new(duration, run.h, run.sim.system().frame_time)?;
     let name = run.name.clone();
-    let rec = open(&name, massspring_blueprint(), out)?;
-    log_massspring_static(&rec, run).map_err(|e| CliError::output(out, e))?;
+    let rec = open(&name, massspring_blueprint(), &opts.sink)?;
+    log_massspring_static(&rec, run).map_err(|e| opts.sink.error(e))?;
     let t0 = run.time();
-    record_frames(rec, run, &schedule, &name, out, |rec, run, frame| {
+    record_frames(rec, run, &schedule, &name, opts, |rec, run, frame| {
         log_massspring_frame(rec, run, frame, run.time() - t0)
     })
 }

@@ -230,10 +230,11 @@ fn massspring_recording_holds_the_library_state_at_every_frame() {
     assert_ne!(pos[0].1, pos[3].1);
 }
 
+/// Starts a long recording, sends `signal` once the file has grown, and
+/// checks exit code 130 and a decodable file with contiguous frames.
 #[cfg(unix)]
-#[test]
-fn ctrl_c_finishes_the_recording_cleanly() {
-    let rrd = tmp("record-interrupted.rrd");
+fn signal_finishes_the_recording_cleanly(signal: &str) {
+    let rrd = tmp(&format!("record-interrupted-{signal}.rrd"));
     let _ = std::fs::remove_file(&rrd);
     let scene_file = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/small.toml");
     let child = Command::new(env!("CARGO_BIN_EXE_yarnsim"))
@@ -251,7 +252,7 @@ fn ctrl_c_finishes_the_recording_cleanly() {
         std::thread::sleep(std::time::Duration::from_millis(50));
     }
     let kill = Command::new("kill")
-        .args(["-INT", &child.id().to_string()])
+        .args([&format!("-{signal}"), &child.id().to_string()])
         .status()
         .unwrap();
     assert!(kill.success());
@@ -278,5 +279,145 @@ fn ctrl_c_finishes_the_recording_cleanly() {
     assert!(
         stdout.contains(&format!("recorded {} frames", frames.len())),
         "{stdout}"
+    );
+}
+
+#[cfg(unix)]
+#[test]
+fn ctrl_c_finishes_the_recording_cleanly() {
+    signal_finishes_the_recording_cleanly("INT");
+}
+
+#[cfg(unix)]
+#[test]
+fn sigterm_finishes_the_recording_like_ctrl_c() {
+    signal_finishes_the_recording_cleanly("TERM");
+}
+
+fn small_scene() -> String {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/data/small.toml")
+        .to_str()
+        .unwrap()
+        .to_string()
+}
+
+/// Frames at which `world/vertices` was logged.
+fn vertex_frames(chunks: &BTreeMap<String, Vec<Chunk>>) -> Vec<i64> {
+    by_frame::<Position2D>(
+        &chunks["world/vertices"],
+        Points2D::descriptor_positions().component,
+    )
+    .iter()
+    .map(|(f, _)| *f)
+    .collect()
+}
+
+#[test]
+fn dash_o_dash_writes_the_recording_to_stdout() {
+    // `yarnsim record -o - | rerun -`: the bytes on stdout are the recording,
+    // the closing message goes to stderr.
+    let out = yarnsim(&["record", &small_scene(), "--duration", "2ms", "-o", "-"]);
+    let piped = tmp("record-stdout.rrd");
+    std::fs::write(&piped, &out.stdout).unwrap();
+    assert_eq!(vertex_frames(&decode(&piped)), (0..=5).collect::<Vec<_>>());
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(stderr.contains("recorded 6 frames"), "{stderr}");
+    assert!(stderr.contains("to standard output"), "{stderr}");
+    assert!(!Path::new("-").exists(), "wrote a file named -");
+}
+
+#[test]
+fn save_is_an_alias_of_output() {
+    let rrd = tmp("record-save.rrd");
+    let _ = std::fs::remove_file(&rrd);
+    yarnsim(&[
+        "record",
+        &small_scene(),
+        "-d",
+        "1ms",
+        "--save",
+        rrd.to_str().unwrap(),
+    ]);
+    assert_eq!(vertex_frames(&decode(&rrd)), (0..=3).collect::<Vec<_>>());
+}
+
+#[test]
+fn every_n_logs_every_nth_frame_and_the_last() {
+    let rrd = tmp("record-every.rrd");
+    let _ = std::fs::remove_file(&rrd);
+    let out = yarnsim(&[
+        "record",
+        &small_scene(),
+        "--duration",
+        "2ms",
+        "--every",
+        "2",
+        "-o",
+        rrd.to_str().unwrap(),
+    ]);
+    assert_eq!(vertex_frames(&decode(&rrd)), vec![0, 2, 4, 5]);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        stdout.contains("recorded 4 frames (1 in 2 of 6 frames)"),
+        "{stdout}"
+    );
+}
+
+fn fails(args: &[&str], env: &[(&str, &str)]) -> (i32, String) {
+    let mut cmd = Command::new(env!("CARGO_BIN_EXE_yarnsim"));
+    cmd.args(args);
+    for (k, v) in env {
+        cmd.env(k, v);
+    }
+    let out = cmd.output().expect("run yarnsim");
+    assert!(out.stdout.is_empty(), "{args:?} printed to stdout");
+    (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+#[test]
+fn sinks_refuse_clearly() {
+    let small = small_scene();
+    // Not an .rrd name: refused before anything runs.
+    let (code, err) = fails(&["record", &small, "-d", "1ms", "-o", "x.txt"], &[]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("`x.txt` does not end in .rrd"), "{err}");
+    assert!(!Path::new("x.txt").exists());
+    // One sink at a time.
+    let (code, err) = fails(&["record", &small, "--spawn", "-o", "a.rrd"], &[]);
+    assert_eq!(code, 2, "{err}");
+    // --serve is not built in, and says what to do instead.
+    let (code, err) = fails(&["record", &small, "--serve"], &[]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("rerun --serve-web"), "{err}");
+    // --spawn without a viewer on PATH.
+    let (code, err) = fails(
+        &["record", &small, "-d", "1ms", "--spawn"],
+        &[("PATH", "/nonexistent")],
+    );
+    assert_eq!(code, 4, "{err}");
+    assert!(err.contains("cannot start a Rerun viewer"), "{err}");
+    // A bad --connect URL.
+    let (code, err) = fails(
+        &["record", &small, "-d", "1ms", "--connect", "ftp://nowhere"],
+        &[],
+    );
+    assert_eq!(code, 4, "{err}");
+    assert!(
+        err.contains("cannot stream to the viewer at ftp://nowhere"),
+        "{err}"
+    );
+    // No viewer listening: Rerun gives up after 5 s, and the run says so.
+    let (code, err) = fails(
+        &["record", &small, "-d", "1ms", "--connect", "127.0.0.1:1"],
+        &[],
+    );
+    assert_eq!(code, 4, "{err}");
+    assert!(
+        err.contains("cannot stream to the viewer at rerun+http://127.0.0.1:1/proxy"),
+        "{err}"
     );
 }
