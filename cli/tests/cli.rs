@@ -61,6 +61,9 @@ fn scenes_lists_every_builtin() {
     for (name, _) in yarnsim::scene::builtin_names() {
         assert!(text.contains(name), "{name} missing");
     }
+    for line in text.lines() {
+        assert!(line.chars().count() <= 100, "{line}");
+    }
     insta::assert_snapshot!("scenes", text);
 }
 
