@@ -420,11 +420,15 @@ fn plot(name: &str, origin: &str) -> TimeSeriesView {
 }
 
 /// Blueprint and selection panels collapsed, so the scene gets the width;
-/// the time panel on the `sim_time` timeline.
+/// the time panel collapsed to its play bar, on the `sim_time` timeline.
 fn with_panels(b: Blueprint) -> Blueprint {
     b.with_blueprint_panel(BlueprintPanel::new().with_state(PanelState::Collapsed))
         .with_selection_panel(SelectionPanel::new().with_state(PanelState::Collapsed))
-        .with_time_panel(TimePanel::new().with_timeline(TIMELINE_SIM_TIME))
+        .with_time_panel(
+            TimePanel::new()
+                .with_timeline(TIMELINE_SIM_TIME)
+                .with_state(PanelState::Collapsed),
+        )
 }
 
 /// The layout the recording opens with: the 2D scene and the colour scales

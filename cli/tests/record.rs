@@ -519,9 +519,9 @@ fn recordings_read_at_a_glance() {
     .map(|e| all_values::<Color>(&chunks[*e])[0].to_array())
     .collect();
     assert_eq!(energy_colors.len(), 4, "energy series share colours");
-    // Blueprint and selection panels start collapsed.
+    // Blueprint, selection and time panels start collapsed.
     let bp = decode_store(&rrd, StoreKind::Blueprint);
-    for panel in ["blueprint_panel", "selection_panel"] {
+    for panel in ["blueprint_panel", "selection_panel", "time_panel"] {
         let states = all_values::<PanelState>(&bp[panel]);
         assert_eq!(states, vec![PanelState::Collapsed], "{panel}");
     }
