@@ -28,13 +28,16 @@ fn segment_distance(c: Vec2, a: Vec2, b: Vec2) -> f64 {
 }
 
 /// Refuses a yarn scene in which a yarn passes through an obstacle at the
-/// start (closer to its centre than its radius). Yarns are numbered as in
-/// the simulation, the CSV and the recording: copies of a `[[yarns]]` entry
-/// one after another. `text` (the scene file) gives the obstacle's line.
+/// start: closer to its centre than its radius less half a grid cell (the
+/// contact's resolution; a yarn laid on the surface, whose chords cut the
+/// circle by their sagitta, is fine). Yarns are numbered as in the
+/// simulation, the CSV and the recording: copies of a `[[yarns]]` entry one
+/// after another. `text` (the scene file) gives the obstacle's line.
 pub fn check_yarns_clear_of_obstacles(
     scene: &YarnScene,
     text: Option<&str>,
 ) -> Result<(), SceneError> {
+    let tolerance = 0.5 * scene.dx();
     let mut yarn = 0;
     for (entry, spec) in scene.yarns.iter().enumerate() {
         let Ok(curves) = spec.curves() else {
@@ -51,15 +54,15 @@ pub fn check_yarns_clear_of_obstacles(
                         .map(|s| segment_distance(c, s[0], s[1]))
                         .fold(f64::INFINITY, f64::min),
                 };
-                if d < o.radius {
+                if d < o.radius - tolerance {
                     return Err(SceneError::Invalid {
                         field: format!("obstacles[{j}]"),
                         line: table_line(text, "[[obstacles]]", j),
                         message: format!(
                             "obstacle {j} (centre ({}, {}), radius {}) overlaps yarn {yarn} \
                              ([[yarns]] entry {entry}, copy {copy}) at the start: the yarn passes \
-                             {d:.4} m from the centre, {:.4} m inside the circle; move the \
-                             obstacle or the yarn apart",
+                             {d:.4} m from the centre, {:.4} m inside the circle (more than half \
+                             a grid cell); move the obstacle or the yarn apart",
                             o.center[0],
                             o.center[1],
                             o.radius,
@@ -89,7 +92,7 @@ pub fn check_particles_outside_spheres(
             .iter()
             .enumerate()
             .map(|(i, x)| (i, (x - c).norm()))
-            .filter(|&(_, d)| d < s.radius);
+            .filter(|&(_, d)| d < s.radius * (1.0 - 1e-9));
         let (count, deepest) = inside.fold((0usize, None::<(usize, f64)>), |(n, best), (i, d)| {
             let best = match best {
                 Some((_, bd)) if bd <= d => best,
@@ -148,6 +151,31 @@ mod tests {
         assert!(text.contains("overlaps yarn"), "{text}");
         assert!(text.contains("inside the circle"), "{text}");
         assert!(s.validate().is_err());
+    }
+
+    #[test]
+    fn a_yarn_laid_on_an_obstacle_is_accepted() {
+        // A polyline on the circle: its chords cut the circle by their sagitta.
+        let Scene::Yarn(mut s) = Scene::resolve("yarn-drape").unwrap() else {
+            unreachable!()
+        };
+        let o = s.obstacles[0].clone();
+        let points: Vec<[f64; 2]> = (0..=20)
+            .map(|k| {
+                let a = std::f64::consts::PI * k as f64 / 20.0;
+                [
+                    o.center[0] + o.radius * a.cos(),
+                    o.center[1] + o.radius * a.sin(),
+                ]
+            })
+            .collect();
+        s.yarns[0].start = None;
+        s.yarns[0].end = None;
+        s.yarns[0].direction = None;
+        s.yarns[0].length = None;
+        s.yarns[0].points = Some(points);
+        s.yarns[0].vertices = 21;
+        check_yarns_clear_of_obstacles(&s, None).unwrap();
     }
 
     #[test]
