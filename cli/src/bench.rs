@@ -8,7 +8,9 @@ use yarnsim::mpm::PassTimes;
 use yarnsim::scene::Scene;
 use yarnsim::YarnSim;
 
-use crate::driver::Stepper;
+use indicatif::ProgressBar;
+
+use crate::driver::{progress_bar, Stepper};
 use crate::error::CliError;
 use crate::massspring::{IntegratorArgs, MassSpringRun};
 use crate::run::no_integrator_for_yarn;
@@ -68,30 +70,50 @@ pub fn bench(
             .map_err(|e| CliError::Usage(format!("cannot start {:?} threads: {e}", opts.threads)))?
     };
     let threads = pool.current_num_threads();
-    match scene {
+    let progress = progress_bar(opts.warmup + opts.steps, &format!("bench {}", scene.name()));
+    let result = match scene {
         Scene::Yarn(y) => {
             no_integrator_for_yarn(integrator)?;
-            pool.install(|| bench_yarn(&mut YarnSim::new(y)?, opts, threads))
+            let mut sim = YarnSim::new(y)?;
+            pool.install(|| bench_yarn(&mut sim, opts, threads, &progress))
         }
         Scene::MassSpring(l) => {
             let mut run = MassSpringRun::new(l, integrator)?;
-            pool.install(|| bench_massspring(&mut run, opts, threads))
+            pool.install(|| bench_massspring(&mut run, opts, threads, &progress))
         }
+    };
+    progress.finish_and_clear();
+    result
+}
+
+/// Runs `n` substeps in about 100 chunks, advancing the progress bar
+/// between chunks (the bar's cost stays out of the timed substeps' hot loop).
+fn steps_with_progress(
+    n: u64,
+    progress: &ProgressBar,
+    mut steps: impl FnMut(u64) -> Result<(), CliError>,
+) -> Result<(), CliError> {
+    let chunk = (n / 100).max(1);
+    let mut done = 0;
+    while done < n {
+        let k = chunk.min(n - done);
+        steps(k)?;
+        done += k;
+        progress.inc(k);
     }
+    Ok(())
 }
 
 fn bench_massspring(
     run: &mut MassSpringRun,
     opts: BenchOptions,
     threads: usize,
+    progress: &ProgressBar,
 ) -> Result<BenchResult, CliError> {
-    for _ in 0..opts.warmup {
-        run.step()?;
-    }
+    let mut steps = |k: u64| (0..k).try_for_each(|_| run.step());
+    steps_with_progress(opts.warmup, progress, &mut steps)?;
     let t0 = Instant::now();
-    for _ in 0..opts.steps {
-        run.step()?;
-    }
+    steps_with_progress(opts.steps, progress, &mut steps)?;
     let seconds = t0.elapsed().as_secs_f64();
     Ok(BenchResult {
         scene: run.name.clone(),
@@ -109,11 +131,12 @@ fn bench_yarn(
     sim: &mut YarnSim,
     opts: BenchOptions,
     threads: usize,
+    progress: &ProgressBar,
 ) -> Result<BenchResult, CliError> {
-    sim.steps_n(opts.warmup)?;
+    steps_with_progress(opts.warmup, progress, |k| Ok(sim.steps_n(k)?))?;
     sim.reset_timings();
     let t0 = Instant::now();
-    sim.steps_n(opts.steps)?;
+    steps_with_progress(opts.steps, progress, |k| Ok(sim.steps_n(k)?))?;
     let seconds = t0.elapsed().as_secs_f64();
     Ok(BenchResult {
         scene: sim.scene().name.clone(),

@@ -19,6 +19,11 @@ pub trait Stepper {
     fn steps(&self) -> u64;
     /// Number of particles (the unit of the throughput figure).
     fn num_particles(&self) -> usize;
+    /// Checked after every frame: an error when the state is no longer
+    /// finite (for simulations whose `step` does not check it itself).
+    fn check_finite(&self) -> Result<(), CliError> {
+        Ok(())
+    }
 }
 
 impl Stepper for YarnSim {
@@ -42,6 +47,9 @@ pub struct FrameInfo {
     pub substeps: u64,
     /// Wall-clock seconds those substeps took.
     pub step_seconds: f64,
+    /// Whether this is the run's last frame (its end, or the state reached
+    /// when it was interrupted): `record --every N` always logs it.
+    pub last: bool,
 }
 
 /// How a run of frames ended.
@@ -53,11 +61,20 @@ pub struct Outcome {
     pub substeps: u64,
     /// Wall-clock seconds spent stepping (frame callbacks excluded).
     pub step_seconds: f64,
-    /// Whether Ctrl-C stopped the run before its end.
+    /// Whether Ctrl-C (or SIGTERM, SIGHUP) stopped the run before its end.
     pub interrupted: bool,
 }
 
-/// The Ctrl-C flag, installed once per process. When the handler cannot be
+/// A run of frames: how far it got and, when a substep failed (divergence,
+/// solver failure), why it stopped. The frames before the failure were all
+/// handed to the frame callback.
+#[derive(Debug)]
+pub struct FrameRun {
+    pub outcome: Outcome,
+    pub failure: Option<CliError>,
+}
+
+/// The interrupt flag, set by SIGINT (Ctrl-C), SIGTERM and SIGHUP, installed once per process. When the handler cannot be
 /// installed (e.g. no signal support), the flag simply never gets set.
 pub fn interrupt_flag() -> Arc<AtomicBool> {
     static FLAG: OnceLock<Arc<AtomicBool>> = OnceLock::new();
@@ -88,24 +105,42 @@ pub fn progress_bar(total_steps: u64, label: &str) -> ProgressBar {
     bar
 }
 
+/// A spinner with the elapsed time for work whose length is not known in
+/// steps (the evidence studies), drawn on stderr only when it is a terminal.
+pub fn spinner(label: &str) -> ProgressBar {
+    let bar = ProgressBar::with_draw_target(None, ProgressDrawTarget::stderr());
+    bar.set_style(
+        ProgressStyle::with_template("{spinner} {prefix} {elapsed_precise}  {msg}")
+            .expect("valid spinner template"),
+    );
+    bar.set_prefix(label.to_string());
+    bar.enable_steady_tick(Duration::from_millis(200));
+    bar
+}
+
 /// Runs `schedule` frame by frame: calls `on_frame` with the initial state
 /// (frame 0), then after each frame's substeps. Stops after the current
 /// substep when `interrupt` is set, and then calls `on_frame` once more for
-/// the state reached (a partial frame), so nothing stepped is lost.
+/// the state reached (a partial frame), so nothing stepped is lost. A failing
+/// substep stops the run: the frames before it have been handed over, and
+/// the error comes back in [`FrameRun::failure`]. Errors of `on_frame`
+/// (output) end the run with `Err`.
 pub fn run_frames<S: Stepper>(
     sim: &mut S,
     schedule: &Schedule,
     interrupt: &AtomicBool,
     progress: &ProgressBar,
     mut on_frame: impl FnMut(&S, FrameInfo) -> Result<(), CliError>,
-) -> Result<Outcome, CliError> {
+) -> Result<FrameRun, CliError> {
     let start_steps = sim.steps();
+    let last_frame = schedule.last_frame();
     on_frame(
         sim,
         FrameInfo {
             frame: 0,
             substeps: 0,
             step_seconds: 0.0,
+            last: last_frame == 0,
         },
     )?;
     let mut outcome = Outcome {
@@ -114,7 +149,8 @@ pub fn run_frames<S: Stepper>(
         step_seconds: 0.0,
         interrupted: false,
     };
-    for frame in 1..=schedule.last_frame() {
+    let mut failure = None;
+    for frame in 1..=last_frame {
         let target = start_steps + schedule.steps_at_frame(frame);
         let before = sim.steps();
         let t0 = Instant::now();
@@ -123,13 +159,22 @@ pub fn run_frames<S: Stepper>(
                 outcome.interrupted = true;
                 break;
             }
-            sim.step()?;
+            if let Err(e) = sim.step() {
+                failure = Some(e);
+                break;
+            }
+        }
+        if failure.is_none() {
+            failure = sim.check_finite().err();
         }
         let secs = t0.elapsed().as_secs_f64();
         let substeps = sim.steps() - before;
         outcome.step_seconds += secs;
         outcome.substeps += substeps;
         progress.set_position(sim.steps() - start_steps);
+        if failure.is_some() {
+            break;
+        }
         if substeps > 0 {
             on_frame(
                 sim,
@@ -137,6 +182,7 @@ pub fn run_frames<S: Stepper>(
                     frame,
                     substeps,
                     step_seconds: secs,
+                    last: frame == last_frame || outcome.interrupted,
                 },
             )?;
             outcome.last_frame = frame;
@@ -146,7 +192,7 @@ pub fn run_frames<S: Stepper>(
         }
     }
     progress.finish_and_clear();
-    Ok(outcome)
+    Ok(FrameRun { outcome, failure })
 }
 
 #[cfg(test)]
@@ -177,12 +223,21 @@ mod tests {
             &AtomicBool::new(false),
             &ProgressBar::hidden(),
             |s, f| {
-                seen.push((f.frame, f.substeps, s.0));
+                seen.push((f.frame, f.substeps, s.0, f.last));
                 Ok(())
             },
         )
-        .unwrap();
-        assert_eq!(seen, vec![(0, 0, 0), (1, 10, 10), (2, 10, 20), (3, 5, 25)]);
+        .unwrap()
+        .outcome;
+        assert_eq!(
+            seen,
+            vec![
+                (0, 0, 0, false),
+                (1, 10, 10, false),
+                (2, 10, 20, false),
+                (3, 5, 25, true)
+            ]
+        );
         assert_eq!(out.substeps, 25);
         assert_eq!(out.last_frame, 3);
         assert!(!out.interrupted);
@@ -202,8 +257,48 @@ mod tests {
                 Ok(())
             },
         )
-        .unwrap();
+        .unwrap()
+        .outcome;
         assert!(out.interrupted);
         assert_eq!((frames, out.substeps, out.last_frame), (1, 0, 0));
+    }
+
+    /// Fails at its 15th substep, like a diverging simulation.
+    struct Diverging(u64);
+    impl Stepper for Diverging {
+        fn step(&mut self) -> Result<(), CliError> {
+            if self.0 == 14 {
+                return Err(CliError::Failed("diverged".into()));
+            }
+            self.0 += 1;
+            Ok(())
+        }
+        fn steps(&self) -> u64 {
+            self.0
+        }
+        fn num_particles(&self) -> usize {
+            1
+        }
+    }
+
+    #[test]
+    fn a_failing_substep_keeps_the_frames_before_it() {
+        let schedule = Schedule::new(0.025, 1e-3, 0.01).unwrap();
+        let mut seen = Vec::new();
+        let run = run_frames(
+            &mut Diverging(0),
+            &schedule,
+            &AtomicBool::new(false),
+            &ProgressBar::hidden(),
+            |s, f| {
+                seen.push((f.frame, s.0));
+                Ok(())
+            },
+        )
+        .unwrap();
+        assert_eq!(seen, vec![(0, 0), (1, 10)]);
+        assert_eq!(run.outcome.last_frame, 1);
+        assert_eq!(run.outcome.substeps, 14);
+        assert!(matches!(run.failure, Some(CliError::Failed(_))));
     }
 }

@@ -5,7 +5,7 @@ use std::path::Path;
 
 use yarnsim::{SceneError, SimError};
 
-/// Exit code of a run that was interrupted by Ctrl-C (128 + SIGINT).
+/// Exit code of a run that was interrupted by Ctrl-C (128 + SIGINT), SIGTERM or SIGHUP.
 pub const EXIT_INTERRUPTED: u8 = 130;
 
 /// Why a command failed. Each kind has its own exit code, see [`CliError::exit_code`].
@@ -17,6 +17,8 @@ pub enum CliError {
     Scene(SceneError),
     /// An output file cannot be created or written (exit code 4).
     Output { path: String, message: String },
+    /// A viewer cannot be started or reached, or standard output fails (exit code 4).
+    Viewer(String),
     /// The simulation diverged or refused its input (exit code 1).
     Sim(SimError),
     /// Another simulation failure, e.g. a mass-spring solver (exit code 1).
@@ -30,7 +32,7 @@ impl CliError {
             CliError::Sim(_) | CliError::Failed(_) => 1,
             CliError::Usage(_) => 2,
             CliError::Scene(_) => 3,
-            CliError::Output { .. } => 4,
+            CliError::Output { .. } | CliError::Viewer(_) => 4,
         }
     }
 
@@ -51,6 +53,7 @@ impl fmt::Display for CliError {
             CliError::Output { path, message } => {
                 write!(f, "cannot write output file {path}: {message}")
             }
+            CliError::Viewer(m) => write!(f, "{m}"),
             CliError::Sim(e) => write!(f, "{e}"),
             CliError::Failed(m) => write!(f, "{m}"),
         }

@@ -7,11 +7,13 @@
 //! * [`record`]: `yarnsim record`, the only module that talks to Rerun.
 //! * [`bench`]: `yarnsim bench`.
 //! * [`driver`], [`schedule`]: the frame loop, progress bar and Ctrl-C.
+//! * [`estimate`]: memory and recording-size estimates of large scenes.
 
 pub mod bench;
 pub mod driver;
 pub mod duration;
 pub mod error;
+pub mod estimate;
 pub mod evidence;
 pub mod massspring;
 pub mod record;

@@ -8,8 +8,9 @@ use yarnsim::scene::DEFAULT_SCENE;
 use yarnsim_cli::bench::{bench, format_bench, BenchOptions};
 use yarnsim_cli::duration::parse_duration;
 use yarnsim_cli::error::{CliError, EXIT_INTERRUPTED};
+use yarnsim_cli::estimate::{announce, Estimate};
 use yarnsim_cli::massspring::IntegratorArgs;
-use yarnsim_cli::record::record;
+use yarnsim_cli::record::{record, RecordOptions, Sink, DEFAULT_CONNECT_URL};
 use yarnsim_cli::run::run;
 use yarnsim_cli::scenes::{list_scenes, load_scene, show_scene};
 use yarnsim_cli::table::{format_summary, Timing};
@@ -22,8 +23,8 @@ use yarnsim_cli::table::{format_summary, Timing};
 ///
 /// Exit codes: 0 success, 1 simulation failure, 2 bad arguments (e.g. an
 /// invalid duration), 3 unknown scene or unreadable/invalid scene file,
-/// 4 output file cannot be written, 130 interrupted by Ctrl-C (output so far
-/// is complete and valid).
+/// 4 output file cannot be written or viewer unreachable, 130 interrupted by
+/// Ctrl-C or SIGTERM (output so far is complete and valid).
 #[derive(Parser, Debug)]
 #[command(name = "yarnsim", version, max_term_width = 100)]
 struct Cli {
@@ -52,10 +53,12 @@ enum Command {
         #[command(flatten)]
         integrator: IntegratorFlags,
     },
-    /// Record a scene to a Rerun file (.rrd): particles, yarns or springs, obstacles, plots.
+    /// Record a scene for the Rerun viewer: particles, yarns or springs, obstacles, plots.
     ///
-    /// Open the result with `rerun FILE.rrd`. Timelines are `frame` and
-    /// `sim_time`; there is no wall-clock timeline.
+    /// Into a file (default run.rrd; open it with `rerun run.rrd`), to
+    /// standard output (`-o - | rerun -`), or live into a viewer (`--spawn`,
+    /// `--connect`). Timelines are `frame` and `sim_time`; there is no
+    /// wall-clock timeline.
     Record {
         /// Built-in scene name or scene file.
         #[arg(default_value = DEFAULT_SCENE)]
@@ -63,9 +66,30 @@ enum Command {
         /// Simulated time, in seconds: 2, 2.5s or 250ms.
         #[arg(short, long, default_value = "1", value_parser = parse_duration, allow_negative_numbers = true)]
         duration: f64,
-        /// Output file.
-        #[arg(short, long, value_name = "FILE", default_value = "run.rrd")]
-        output: PathBuf,
+        /// Output file, ending in .rrd (default run.rrd), or `-` for standard
+        /// output, to pipe into `rerun -`.
+        #[arg(
+            short,
+            long,
+            visible_alias = "save",
+            value_name = "FILE",
+            group = "sink"
+        )]
+        output: Option<PathBuf>,
+        /// Start a Rerun viewer (`rerun` on PATH) and stream to it live.
+        #[arg(long, group = "sink")]
+        spawn: bool,
+        /// Stream live to a running viewer (started with `rerun`), at ADDR:
+        /// a rerun+http://HOST:PORT/proxy URL or HOST:PORT.
+        #[arg(long, value_name = "ADDR", num_args = 0..=1, default_missing_value = DEFAULT_CONNECT_URL, group = "sink")]
+        connect: Option<String>,
+        /// Not built in (it needs Rerun's server feature): start `rerun
+        /// --serve-web` and record with `--connect` instead.
+        #[arg(long, group = "sink")]
+        serve: bool,
+        /// Log every Nth frame only (frame 0 and the last frame always).
+        #[arg(long, value_name = "N", default_value_t = 1, value_parser = clap::value_parser!(u64).range(1..))]
+        every: u64,
         #[command(flatten)]
         integrator: IntegratorFlags,
     },
@@ -103,6 +127,10 @@ struct IntegratorFlags {
     /// dt=0.001, cfl=0.5, preconditioner=jacobi, rho=0.99, strain-limit=0.1.
     #[arg(long = "option", value_name = "KEY=VALUE")]
     options: Vec<String>,
+    /// Mass-spring scenes only: run forward or symplectic Euler with a dt
+    /// above its stability bound instead of refusing.
+    #[arg(long)]
+    allow_unstable: bool,
 }
 
 impl IntegratorFlags {
@@ -110,6 +138,7 @@ impl IntegratorFlags {
         IntegratorArgs {
             integrator: self.integrator,
             options: self.options,
+            allow_unstable: self.allow_unstable,
         }
     }
 }
@@ -145,8 +174,13 @@ fn execute(command: Command) -> Result<u8, CliError> {
             integrator,
         } => {
             let scene = load_scene(&scene)?;
+            announce(&Estimate::of(&scene, duration, None));
             let summary = run(&scene, duration, csv.as_deref(), &integrator.args())?;
             print!("{}", format_summary(&summary, Timing::Show));
+            if let Some(failure) = &summary.failure {
+                eprintln!("error: {failure}");
+                return Ok(1);
+            }
             if summary.interrupted {
                 eprintln!("interrupted: the summary covers the frames run");
                 return Ok(EXIT_INTERRUPTED);
@@ -156,20 +190,58 @@ fn execute(command: Command) -> Result<u8, CliError> {
             scene,
             duration,
             output,
+            spawn,
+            connect,
+            serve,
+            every,
             integrator,
         } => {
+            let sink = if serve {
+                return Err(CliError::Usage(
+                    "--serve is not built into yarnsim (it needs Rerun's server feature); start \
+                     a server with a web viewer with `rerun --serve-web`, then record into it with \
+                     `yarnsim record --connect`"
+                        .into(),
+                ));
+            } else if spawn {
+                Sink::Spawn
+            } else if let Some(addr) = &connect {
+                Sink::connect(addr)
+            } else {
+                Sink::output(output.as_deref().unwrap_or("run.rrd".as_ref()))?
+            };
             let scene = load_scene(&scene)?;
-            let r = record(&scene, duration, &output, &integrator.args())?;
+            announce(&Estimate::of(&scene, duration, Some(every)));
+            let opts = RecordOptions { sink, every };
+            let r = record(&scene, duration, &opts, &integrator.args())?;
             let o = r.outcome;
-            println!(
-                "recorded {} frames ({} substeps, {} particles) to {} in {:.2} s of stepping",
+            let every_note = if every > 1 {
+                format!(" (1 in {every} of {} frames)", o.last_frame + 1)
+            } else {
+                String::new()
+            };
+            let text = format!(
+                "recorded {} frames{every_note} ({} substeps, {} particles) to {} in {:.2} s of stepping",
                 r.frames_logged,
                 o.substeps,
                 r.particles,
-                output.display(),
+                opts.sink.describe(),
                 o.step_seconds
             );
-            println!("open it with: rerun {}", output.display());
+            // With `-o -`, standard output carries the recording itself.
+            let say = |line: &str| match opts.sink {
+                Sink::Stdout => eprintln!("{line}"),
+                _ => println!("{line}"),
+            };
+            say(&text);
+            if let Sink::File(path) = &opts.sink {
+                say(&format!("open it with: rerun {}", path.display()));
+            }
+            if let Some(failure) = r.failure {
+                eprintln!("error: {failure}");
+                eprintln!("the recording holds the frames before the failure");
+                return Ok(failure.exit_code());
+            }
             if o.interrupted {
                 eprintln!("interrupted: the recording holds the frames up to the interruption");
                 return Ok(EXIT_INTERRUPTED);
@@ -183,6 +255,7 @@ fn execute(command: Command) -> Result<u8, CliError> {
             integrator,
         } => {
             let scene = load_scene(&scene)?;
+            announce(&Estimate::of(&scene, 0.0, None));
             let r = bench(
                 &scene,
                 BenchOptions {
@@ -195,7 +268,21 @@ fn execute(command: Command) -> Result<u8, CliError> {
             print!("{}", format_bench(&r));
         }
         Command::Evidence(cmd) => {
-            let (text, files) = yarnsim_cli::evidence::execute(&cmd)?;
+            use yarnsim_cli::evidence::EvidenceCommand as E;
+            // Durations measured on 2 cores (README, "Performance and accuracy evidence").
+            let (label, note) = match &cmd {
+                E::BenchPrecision { quick: false, .. } => ("bench precision", "about 40 s"),
+                E::BenchPrecision { quick: true, .. } => ("bench precision --quick", "about 5 s"),
+                E::Stress { quick: false, .. } => ("stress", "about 50 s"),
+                E::Stress { quick: true, .. } => ("stress --quick", "about 25 s"),
+                E::BenchSkip { .. } => ("bench skip", "grows with --steps x --repeats"),
+            };
+            let spinner = yarnsim_cli::driver::spinner(label);
+            spinner.set_message(note);
+            let result = yarnsim_cli::evidence::execute(&cmd);
+            spinner.finish_and_clear();
+            let (text, files) = result?;
+            let text = yarnsim_cli::table::fit_tables(&text, yarnsim_cli::table::MAX_WIDTH);
             print!("{text}");
             for f in files {
                 println!("wrote {f}");

@@ -16,12 +16,14 @@ pub const DEFAULT_INTEGRATOR: Integrator = Integrator::BackwardEuler;
 pub struct IntegratorArgs {
     pub integrator: Option<String>,
     pub options: Vec<String>,
+    /// Run an explicit integrator with a `dt` above its stability bound.
+    pub allow_unstable: bool,
 }
 
 impl IntegratorArgs {
     /// Whether nothing was given (the only valid case for yarn scenes).
     pub fn is_empty(&self) -> bool {
-        self.integrator.is_none() && self.options.is_empty()
+        self.integrator.is_none() && self.options.is_empty() && !self.allow_unstable
     }
 
     /// Parses the integrator name and options.
@@ -56,6 +58,45 @@ fn ms_error(e: MassSpringError) -> CliError {
     }
 }
 
+/// Refuses a step `h` above the stability bound of an explicit integrator
+/// (forward or symplectic Euler, bound of the system linearised at its
+/// initial state), unless `allow` is set; then it warns.
+pub fn check_stability(sim: &Simulation, h: f64, allow: bool) -> Result<(), CliError> {
+    let (Some(st), true) = (sim.stability(), sim.integrator().is_explicit()) else {
+        return Ok(());
+    };
+    let bound = match sim.integrator() {
+        Integrator::ForwardEuler => st.forward_euler,
+        _ => st.symplectic_euler,
+    };
+    if h <= bound * (1.0 + 1e-9) {
+        return Ok(());
+    }
+    let name = sim.integrator();
+    let why = if bound > 0.0 {
+        format!(
+            "the step {h:.4e} s is {:.1}x the stability bound of {name} for this scene, \
+             {bound:.4e} s (linearised at the initial state)",
+            h / bound
+        )
+    } else {
+        format!(
+            "{name} is unstable at every step size here: the springs have no damping \
+             (its bound b/k is 0)"
+        )
+    };
+    if allow {
+        eprintln!("warning: {why}; running anyway (--allow-unstable)");
+        Ok(())
+    } else {
+        Err(CliError::Usage(format!(
+            "{why}; it would blow up. Use a smaller dt, leave dt out (the step is then a \
+             CFL fraction of the bound), choose an implicit integrator, or pass --allow-unstable \
+             to run it anyway"
+        )))
+    }
+}
+
 /// A mass-spring simulation advanced in equal steps of `h = frame_time / n`,
 /// `n` the number of steps of the driver's step size per frame, so frames
 /// land exactly on step boundaries (as in [`Simulation::step_frame`]).
@@ -73,12 +114,29 @@ pub struct MassSpringRun {
 
 impl MassSpringRun {
     /// Builds the simulation of `layout` with the integrator from `args`.
+    /// Refuses an explicit integrator whose `--option dt` lies above its
+    /// stability bound (unless `args.allow_unstable`), and says on stderr
+    /// when the step actually taken differs from the `dt` asked for.
     pub fn new(layout: &Layout, args: &IntegratorArgs) -> Result<Self, CliError> {
         let (integrator, options) = args.parse()?;
+        let asked_dt = options.dt;
         let sim = Simulation::new(layout, integrator, options).map_err(ms_error)?;
         let ft = sim.system().frame_time;
         let n = (ft / sim.dt() * (1.0 - 1e-12)).ceil().max(1.0);
         let h = ft / n;
+        if let Some(dt) = asked_dt {
+            if dt > ft {
+                eprintln!(
+                    "warning: --option dt={dt} is longer than a frame of this scene; \
+                     clamped to the frame time {ft} s"
+                );
+            } else if h < dt * (1.0 - 1e-9) {
+                eprintln!(
+                    "note: --option dt={dt} rounded down to {h} s, so that {n} equal steps fill a frame of {ft} s"
+                );
+            }
+            check_stability(&sim, h, args.allow_unstable)?;
+        }
         let t0 = sim.time();
         Ok(MassSpringRun {
             name: layout.name.clone(),
@@ -124,6 +182,20 @@ impl Stepper for MassSpringRun {
     }
     fn num_particles(&self) -> usize {
         self.sim.system().len()
+    }
+    fn check_finite(&self) -> Result<(), CliError> {
+        let finite = |v: &[V3]| v.iter().all(|x| x.iter().all(|c| c.is_finite()));
+        let e = self.sim.energies();
+        let energy = e.kinetic + e.elastic + e.gravity;
+        if finite(self.sim.positions()) && finite(self.sim.velocities()) && energy.is_finite() {
+            Ok(())
+        } else {
+            Err(CliError::Failed(format!(
+                "the simulation diverged: its state or energy is no longer finite after step {} (t = {:.6} s)",
+                self.steps,
+                self.time()
+            )))
+        }
     }
 }
 
@@ -206,6 +278,7 @@ mod tests {
         let a = IntegratorArgs {
             integrator: Some("symplectic_euler".into()),
             options: vec!["cfl=0.5".into()],
+            ..Default::default()
         };
         let (i, o) = a.parse().unwrap();
         assert_eq!(i, Integrator::SymplecticEuler);
@@ -217,19 +290,56 @@ mod tests {
         for bad in [
             IntegratorArgs {
                 integrator: Some("rk4".into()),
-                options: vec![],
+                ..Default::default()
             },
             IntegratorArgs {
-                integrator: None,
                 options: vec!["cfl".into()],
+                ..Default::default()
             },
             IntegratorArgs {
-                integrator: None,
                 options: vec!["warp=9".into()],
+                ..Default::default()
             },
         ] {
             assert!(matches!(bad.parse(), Err(CliError::Usage(_))), "{bad:?}");
         }
+    }
+
+    #[test]
+    fn explicit_steps_above_the_stability_bound_are_refused() {
+        let args = |dt: &str, allow: bool| IntegratorArgs {
+            integrator: Some("symplectic-euler".into()),
+            options: vec![format!("dt={dt}")],
+            allow_unstable: allow,
+        };
+        let sim = Simulation::new(
+            &scenes::wire(),
+            Integrator::SymplecticEuler,
+            IntegratorOptions::default(),
+        )
+        .unwrap();
+        let bound = sim.stability().unwrap().symplectic_euler;
+        // Below the bound: accepted.
+        assert!(
+            MassSpringRun::new(&scenes::wire(), &args(&format!("{}", 0.5 * bound), false)).is_ok()
+        );
+        // 10x above: refused, naming the step, the factor and the bound.
+        let Err(CliError::Usage(m)) =
+            MassSpringRun::new(&scenes::wire(), &args(&format!("{}", 10.0 * bound), false))
+        else {
+            panic!("accepted an unstable step")
+        };
+        // (h = frame / n for a whole n, a little under 10x the bound)
+        assert!(
+            m.contains("x the stability bound of symplectic-euler"),
+            "{m}"
+        );
+        assert!(m.contains(&format!("{bound:.4e}")), "{m}");
+        assert!(m.contains("--allow-unstable"), "{m}");
+        // Unless the user insists.
+        assert!(
+            MassSpringRun::new(&scenes::wire(), &args(&format!("{}", 10.0 * bound), true)).is_ok()
+        );
     }
 
     #[test]

@@ -2,13 +2,14 @@
 //! recording (`.rrd`). All Rerun code of the project lives in this module.
 //!
 //! Layout (see the README, "Entity paths", for the full list):
-//! * `world` carries a static mirror transform so the 2D view shows +y up;
-//!   positions below it are the library's coordinates (m), unchanged.
-//! * `world/vertices` (type-2 particles): `Points2D` coloured by stretch, with
-//!   extra per-particle values (`velocity`, `stretch`).
-//! * `world/quadrature` (type-3 particles): `Points2D` coloured by plastic
-//!   state, with values `velocity`, `stretch`, `shear`, `r22`, `yield`, `plastic`.
-//! * `world/yarns`: one line strip per yarn.
+//! * 2D positions are `(x, size - y)` of the library's (m), so Rerun's
+//!   y-down 2D view shows +y up (see [`view2`]); no transform is involved.
+//! * `world/vertices` (type-2 particles): `Points2D` in their yarn's colour,
+//!   with extra per-particle values (`velocity`, `stretch`).
+//! * `world/quadrature` (type-3 particles): `Points2D` coloured by stretch,
+//!   with values `velocity`, `stretch`, `shear`, `r22`, `yield`, `plastic`.
+//! * `world/yarns`: one line strip per yarn, one colour per yarn.
+//! * `legend`: the colour scales and the domain (markdown).
 //! * `world/domain`, `world/walls`, `world/obstacles`, `world/attractor`: static geometry.
 //! * `plots/...`: one scalar series per diagnostic.
 //! * `timing/step_time`: wall-clock seconds per substep, the only entity that
@@ -22,21 +23,26 @@
 //! wall-clock `log_time` timeline is switched off, so two recordings of the
 //! same scene hold the same data everywhere except under `timing/`.
 
-use std::path::Path;
+use std::io::IsTerminal;
+use std::path::{Path, PathBuf};
 
+use rerun::blueprint::components::PanelState;
 use rerun::blueprint::{
-    Blueprint, Horizontal, Spatial2DView, Spatial3DView, TimePanel, TimeSeriesView, Vertical,
+    Blueprint, BlueprintPanel, Horizontal, SelectionPanel, Spatial2DView, Spatial3DView,
+    TextDocumentView, TimePanel, TimeSeriesView, Vertical,
 };
 use rerun::components::{Color, Scalar, Vector2D, Vector3D};
 use rerun::{
     AnyValues, Boxes2D, Ellipses2D, Ellipsoids3D, LineStrips2D, LineStrips3D, Points2D, Points3D,
-    RecordingStream, RecordingStreamBuilder, Scalars, SeriesLines, Transform3D,
+    RecordingStream, RecordingStreamBuilder, Scalars, SeriesLines, TextDocument, ViewCoordinates,
 };
 use yarnsim::math::qr::qr;
 use yarnsim::scene::{Scene, WallMode};
 use yarnsim::YarnSim;
 
-use crate::driver::{interrupt_flag, progress_bar, run_frames, FrameInfo, Outcome, Stepper};
+use crate::driver::{
+    interrupt_flag, progress_bar, run_frames, FrameInfo, FrameRun, Outcome, Stepper,
+};
 use crate::error::CliError;
 use crate::massspring::{spring_stretches, IntegratorArgs, MassSpringRun};
 use crate::run::no_integrator_for_yarn;
@@ -65,8 +71,15 @@ pub mod paths {
     pub const MOMENTUM_X: &str = "plots/momentum/x";
     pub const MOMENTUM_Y: &str = "plots/momentum/y";
     pub const ANGULAR_MOMENTUM: &str = "plots/angular_momentum";
+    pub const TOTAL: &str = "plots/energy/total";
     pub const MAX_STRETCH: &str = "plots/stretch/max";
     pub const MIN_STRETCH: &str = "plots/stretch/min";
+    pub const MEAN_STRETCH: &str = "plots/stretch/mean";
+    pub const COM_X: &str = "plots/center_of_mass/x";
+    pub const COM_Y: &str = "plots/center_of_mass/y";
+    pub const COM_Z: &str = "plots/center_of_mass/z";
+    /// The colour scales, as a markdown document (static).
+    pub const LEGEND: &str = "legend";
     /// Wall-clock seconds per substep: not reproducible, kept apart from `plots`.
     pub const STEP_TIME: &str = "timing/step_time";
 
@@ -86,10 +99,11 @@ pub mod paths {
     pub const CG_ITERATIONS: &str = "plots/cg_iterations";
 
     /// Every scalar series of a mass-spring recording, with its display name.
-    pub const MS_SERIES: [(&str, &str); 12] = [
+    pub const MS_SERIES: [(&str, &str); 16] = [
         (KINETIC, "kinetic energy [J]"),
         (ELASTIC, "elastic energy [J]"),
         (GRAVITY, "gravity energy [J]"),
+        (TOTAL, "total energy [J]"),
         (MOMENTUM_X, "momentum x [kg m/s]"),
         (MOMENTUM_Y, "momentum y [kg m/s]"),
         (MOMENTUM_Z, "momentum z [kg m/s]"),
@@ -97,6 +111,9 @@ pub mod paths {
         (ANGULAR_MOMENTUM_Y, "angular momentum y [kg m^2/s]"),
         (ANGULAR_MOMENTUM_Z, "angular momentum z [kg m^2/s]"),
         (MAX_STRAIN, "max |l/l0 - 1|"),
+        (COM_X, "centre of mass x [m]"),
+        (COM_Y, "centre of mass y [m]"),
+        (COM_Z, "centre of mass z [m]"),
         (STEP_TIME, "wall time per substep [s]"),
         (
             CG_ITERATIONS,
@@ -105,15 +122,19 @@ pub mod paths {
     ];
 
     /// Every scalar series of a yarn recording, with its display name.
-    pub const SERIES: [(&str, &str); 9] = [
+    pub const SERIES: [(&str, &str); 13] = [
         (KINETIC, "kinetic energy [J]"),
         (ELASTIC, "elastic energy [J]"),
         (POTENTIAL, "potential energy [J]"),
+        (TOTAL, "total energy [J]"),
         (MOMENTUM_X, "momentum x [kg m/s]"),
         (MOMENTUM_Y, "momentum y [kg m/s]"),
         (ANGULAR_MOMENTUM, "angular momentum [kg m^2/s]"),
         (MAX_STRETCH, "max stretch"),
         (MIN_STRETCH, "min stretch"),
+        (MEAN_STRETCH, "mean stretch"),
+        (COM_X, "centre of mass x [m]"),
+        (COM_Y, "centre of mass y [m]"),
         (STEP_TIME, "wall time per substep [s]"),
     ];
 }
@@ -169,69 +190,195 @@ impl PlasticState {
     }
 }
 
+/// Address `--connect` uses without a value: a viewer started with plain `rerun`.
+pub const DEFAULT_CONNECT_URL: &str = "rerun+http://127.0.0.1:9876/proxy";
+
+/// Where a recording goes: Rerun's usual sinks.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum Sink {
+    /// An `.rrd` file (`-o FILE`, `--save FILE`).
+    File(PathBuf),
+    /// Standard output (`-o -`), to pipe into `rerun -`.
+    Stdout,
+    /// A viewer started for this recording (`--spawn`, needs `rerun` on PATH).
+    Spawn,
+    /// A running viewer or server at this gRPC URL (`--connect [ADDR]`).
+    Connect(String),
+}
+
+impl Sink {
+    /// The sink of `-o NAME`: `-` is standard output, anything else must be
+    /// a file name ending in `.rrd` (the only format the viewer opens).
+    pub fn output(name: &Path) -> Result<Sink, CliError> {
+        if name.as_os_str() == "-" {
+            return Ok(Sink::Stdout);
+        }
+        if name.extension().is_some_and(|e| e == "rrd") {
+            Ok(Sink::File(name.to_path_buf()))
+        } else {
+            Err(CliError::Usage(format!(
+                "output `{}` does not end in .rrd: Rerun recordings are .rrd files \
+                 (or `-o -` for standard output, to pipe into `rerun -`)",
+                name.display()
+            )))
+        }
+    }
+
+    /// The sink of `--connect ADDR`: a full `rerun+http://.../proxy` URL, or
+    /// just `HOST:PORT`.
+    pub fn connect(addr: &str) -> Sink {
+        if addr.contains("://") {
+            Sink::Connect(addr.to_string())
+        } else {
+            Sink::Connect(format!("rerun+http://{addr}/proxy"))
+        }
+    }
+
+    /// Where the data went, for the closing message.
+    pub fn describe(&self) -> String {
+        match self {
+            Sink::File(p) => p.display().to_string(),
+            Sink::Stdout => "standard output".into(),
+            Sink::Spawn => "a new Rerun viewer".into(),
+            Sink::Connect(url) => format!("the viewer at {url}"),
+        }
+    }
+
+    /// An error of this sink, with the innermost cause only (Rerun's errors
+    /// repeat the path and wrap the OS error).
+    fn error(&self, e: impl std::error::Error) -> CliError {
+        let cause = root_cause(&e);
+        match self {
+            Sink::File(p) => CliError::output(p, cause),
+            Sink::Stdout => CliError::Viewer(format!("cannot write to standard output: {cause}")),
+            Sink::Spawn => CliError::Viewer(format!("cannot start a Rerun viewer: {cause}")),
+            Sink::Connect(url) => {
+                CliError::Viewer(format!("cannot stream to the viewer at {url}: {cause}"))
+            }
+        }
+    }
+}
+
+/// The innermost error of a chain, as text.
+fn root_cause(e: &dyn std::error::Error) -> String {
+    let mut e = e;
+    while let Some(inner) = e.source() {
+        e = inner;
+    }
+    e.to_string()
+}
+
+/// What to record: the sink and which frames.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct RecordOptions {
+    pub sink: Sink,
+    /// Log every `every`-th frame (1 = all); frame 0 and the last frame are always logged.
+    pub every: u64,
+}
+
+impl RecordOptions {
+    /// All frames into `path` (checked like `-o`).
+    pub fn file(path: &Path) -> Result<Self, CliError> {
+        Ok(RecordOptions {
+            sink: Sink::output(path)?,
+            every: 1,
+        })
+    }
+
+    fn logs(&self, frame: &FrameInfo) -> bool {
+        frame.last || frame.frame.is_multiple_of(self.every.max(1))
+    }
+}
+
 /// How a `record` command ended.
-#[derive(Clone, Copy, Debug)]
+#[derive(Debug)]
 pub struct RecordOutcome {
     pub outcome: Outcome,
     pub particles: usize,
     pub frames_logged: u64,
+    /// The simulation error that stopped the run early; the recording holds
+    /// the frames before it and is complete.
+    pub failure: Option<CliError>,
 }
 
-/// Records `scene` for `duration` seconds to `out`; `integrator` applies to
+/// Records `scene` for `duration` seconds; `integrator` applies to
 /// mass-spring scenes only.
 pub fn record(
     scene: &Scene,
     duration: f64,
-    out: &Path,
+    opts: &RecordOptions,
     integrator: &IntegratorArgs,
 ) -> Result<RecordOutcome, CliError> {
     match scene {
         Scene::Yarn(y) => {
             no_integrator_for_yarn(integrator)?;
-            record_yarn(&mut YarnSim::new(y)?, duration, out)
+            record_yarn(&mut YarnSim::new(y)?, duration, opts)
         }
         Scene::MassSpring(l) => {
-            record_massspring(&mut MassSpringRun::new(l, integrator)?, duration, out)
+            record_massspring(&mut MassSpringRun::new(l, integrator)?, duration, opts)
         }
     }
 }
 
-/// Opens the recording file, without the wall-clock `log_time` timeline.
-fn open(name: &str, blueprint: Blueprint, out: &Path) -> Result<RecordingStream, CliError> {
-    let rec = RecordingStreamBuilder::new(APP_ID)
+/// Opens the recording stream on its sink, without the wall-clock
+/// `log_time` timeline.
+fn open(name: &str, blueprint: Blueprint, sink: &Sink) -> Result<RecordingStream, CliError> {
+    let builder = RecordingStreamBuilder::new(APP_ID)
         .recording_name(name.to_string())
-        .with_blueprint(blueprint)
-        .save(out)
-        .map_err(|e| CliError::output(out, e))?;
+        .with_blueprint(blueprint);
+    let rec = match sink {
+        Sink::File(path) => {
+            // Rerun's own error repeats the path and nests the OS error.
+            std::fs::File::create(path).map_err(|e| CliError::output(path, e))?;
+            builder.save(path)
+        }
+        Sink::Stdout => {
+            if std::io::stdout().is_terminal() {
+                return Err(CliError::Usage(
+                    "`-o -` writes the recording to standard output, which is a terminal here; \
+                     pipe it into the viewer (`yarnsim record -o - | rerun -`) or give a file name"
+                        .into(),
+                ));
+            }
+            builder.stdout()
+        }
+        Sink::Spawn => builder.spawn(),
+        Sink::Connect(url) => builder.connect_grpc_opts(url.clone()),
+    }
+    .map_err(|e| sink.error(e))?;
     rec.set_log_time_enabled(false);
     Ok(rec)
 }
 
-/// Runs `schedule` on `sim`, logging each frame with `log`, then writes the
-/// file's end whatever happened (error, Ctrl-C), so the file stays readable.
+/// Runs `schedule` on `sim`, logging the frames `opts` selects with `log`,
+/// then flushes and closes the stream whatever happened (divergence,
+/// Ctrl-C, SIGTERM), so a file ends readable.
 fn record_frames<S: Stepper>(
     rec: RecordingStream,
     sim: &mut S,
     schedule: &Schedule,
     label: &str,
-    out: &Path,
+    opts: &RecordOptions,
     mut log: impl FnMut(&RecordingStream, &S, FrameInfo) -> rerun::RecordingStreamResult<()>,
 ) -> Result<RecordOutcome, CliError> {
     let progress = progress_bar(schedule.total_steps, label);
     let mut frames_logged = 0;
     let result = run_frames(sim, schedule, &interrupt_flag(), &progress, |sim, frame| {
-        log(&rec, sim, frame).map_err(|e| CliError::output(out, e))?;
-        frames_logged += 1;
+        if opts.logs(&frame) {
+            log(&rec, sim, frame).map_err(|e| opts.sink.error(e))?;
+            frames_logged += 1;
+        }
         Ok(())
     });
     let flushed = rec.flush_blocking();
     drop(rec);
-    let outcome = result?;
-    flushed.map_err(|e| CliError::output(out, e))?;
+    let FrameRun { outcome, failure } = result?;
+    flushed.map_err(|e| opts.sink.error(e))?;
     Ok(RecordOutcome {
         outcome,
         particles: sim.num_particles(),
         frames_logged,
+        failure,
     })
 }
 
@@ -239,14 +386,14 @@ fn record_frames<S: Stepper>(
 pub fn record_yarn(
     sim: &mut YarnSim,
     duration: f64,
-    out: &Path,
+    opts: &RecordOptions,
 ) -> Result<RecordOutcome, CliError> {
     let schedule = Schedule::new(duration, sim.dt(), sim.scene().time.frame_dt)?;
     let name = sim.scene().name.clone();
-    let rec = open(&name, yarn_blueprint(), out)?;
-    log_yarn_static(&rec, sim).map_err(|e| CliError::output(out, e))?;
+    let rec = open(&name, yarn_blueprint(), &opts.sink)?;
+    log_yarn_static(&rec, sim).map_err(|e| opts.sink.error(e))?;
     let t0 = sim.time();
-    record_frames(rec, sim, &schedule, &name, out, |rec, sim, frame| {
+    record_frames(rec, sim, &schedule, &name, opts, |rec, sim, frame| {
         log_yarn_frame(rec, sim, frame, sim.time() - t0)
     })
 }
@@ -255,66 +402,150 @@ pub fn record_yarn(
 pub fn record_massspring(
     run: &mut MassSpringRun,
     duration: f64,
-    out: &Path,
+    opts: &RecordOptions,
 ) -> Result<RecordOutcome, CliError> {
     let schedule = Schedule::new(duration, run.h, run.sim.system().frame_time)?;
     let name = run.name.clone();
-    let rec = open(&name, massspring_blueprint(), out)?;
-    log_massspring_static(&rec, run).map_err(|e| CliError::output(out, e))?;
+    let rec = open(&name, massspring_blueprint(), &opts.sink)?;
+    log_massspring_static(&rec, run).map_err(|e| opts.sink.error(e))?;
     let t0 = run.time();
-    record_frames(rec, run, &schedule, &name, out, |rec, run, frame| {
+    record_frames(rec, run, &schedule, &name, opts, |rec, run, frame| {
         log_massspring_frame(rec, run, frame, run.time() - t0)
     })
 }
 
-/// The layout the recording opens with: the 2D scene on the left, the plots on the right.
+/// A time-series view of the entities under `origin`.
+fn plot(name: &str, origin: &str) -> TimeSeriesView {
+    TimeSeriesView::new(name).with_origin(origin)
+}
+
+/// Blueprint and selection panels collapsed, so the scene gets the width;
+/// the time panel collapsed to its play bar, on the `sim_time` timeline.
+fn with_panels(b: Blueprint) -> Blueprint {
+    b.with_blueprint_panel(BlueprintPanel::new().with_state(PanelState::Collapsed))
+        .with_selection_panel(SelectionPanel::new().with_state(PanelState::Collapsed))
+        .with_time_panel(
+            TimePanel::new()
+                .with_timeline(TIMELINE_SIM_TIME)
+                .with_state(PanelState::Collapsed),
+        )
+}
+
+/// The layout the recording opens with: the 2D scene and the colour scales
+/// on the left, one plot per unit on the right.
 pub fn yarn_blueprint() -> Blueprint {
-    let plot = |name: &str, origin: &str| TimeSeriesView::new(name).with_origin(origin);
-    Blueprint::new(
+    with_panels(Blueprint::new(
         Horizontal::new([
-            Spatial2DView::new("scene").with_origin("/").into(),
             Vertical::new([
-                plot("energy", "/plots/energy").into(),
-                TimeSeriesView::new("momentum")
-                    .with_origin("/plots")
-                    .with_contents(["/plots/momentum/**", "/plots/angular_momentum"])
+                Spatial2DView::new("scene")
+                    .with_origin("/")
+                    .with_contents(["/world/**"])
                     .into(),
-                plot("stretch", "/plots/stretch").into(),
-                plot("step time (wall clock)", "/timing").into(),
+                TextDocumentView::new("colours")
+                    .with_origin(format!("/{}", paths::LEGEND))
+                    .into(),
+            ])
+            .with_row_shares([6.0, 1.0])
+            .into(),
+            Vertical::new([
+                plot("energy [J]", "/plots/energy").into(),
+                plot("momentum [kg m/s]", "/plots/momentum").into(),
+                plot("angular momentum [kg m^2/s]", "/plots/angular_momentum").into(),
+                plot("stretch l/l0", "/plots/stretch").into(),
+                plot("centre of mass [m]", "/plots/center_of_mass").into(),
+                plot("wall time per substep [s]", "/timing").into(),
             ])
             .into(),
         ])
         .with_column_shares([3.0, 2.0]),
-    )
-    .with_time_panel(TimePanel::new().with_timeline(TIMELINE_SIM_TIME))
+    ))
+}
+
+/// Where a library point `v` is drawn in a domain of side `size`: Rerun's 2D
+/// views draw +y downwards, so y is stored as `size - y` (+y shows up). The
+/// recording carries no mirror transform: labels under one landed at
+/// y-mirrored places.
+pub fn view2(v: &yarnsim::math::Vec2, size: f64) -> [f32; 2] {
+    [v.x as f32, (size - v.y) as f32]
 }
 
 fn p2(v: &yarnsim::math::Vec2) -> [f32; 2] {
     [v.x as f32, v.y as f32]
 }
 
-/// The layout of a mass-spring recording: the 3D scene on the left, the plots on the right.
+/// The layout of a mass-spring recording: the 3D scene and the colour
+/// scales on the left, one plot per unit on the right.
 pub fn massspring_blueprint() -> Blueprint {
-    let plot = |name: &str, origin: &str| TimeSeriesView::new(name).with_origin(origin);
-    Blueprint::new(
+    with_panels(Blueprint::new(
         Horizontal::new([
-            Spatial3DView::new("scene").with_origin("/world").into(),
             Vertical::new([
-                plot("energy", "/plots/energy").into(),
-                plot("momentum", "/plots/momentum").into(),
-                plot("angular momentum", "/plots/angular_momentum").into(),
-                TimeSeriesView::new("strain and solver")
-                    .with_origin("/plots")
-                    .with_contents(["/plots/strain/**", "/plots/cg_iterations"])
+                Spatial3DView::new("scene").with_origin("/world").into(),
+                TextDocumentView::new("colours")
+                    .with_origin(format!("/{}", paths::LEGEND))
                     .into(),
-                plot("step time (wall clock)", "/timing").into(),
+            ])
+            .with_row_shares([6.0, 1.0])
+            .into(),
+            Vertical::new([
+                plot("energy [J]", "/plots/energy").into(),
+                plot("momentum [kg m/s]", "/plots/momentum").into(),
+                plot("angular momentum [kg m^2/s]", "/plots/angular_momentum").into(),
+                plot("strain |l/l0 - 1|", "/plots/strain").into(),
+                plot("centre of mass [m]", "/plots/center_of_mass").into(),
+                plot("CG iterations", "/plots/cg_iterations").into(),
+                plot("wall time per substep [s]", "/timing").into(),
             ])
             .into(),
         ])
         .with_column_shares([3.0, 2.0]),
-    )
-    .with_time_panel(TimePanel::new().with_timeline(TIMELINE_SIM_TIME))
+    ))
 }
+
+/// Distinct colours for the series of one plot (Okabe-Ito palette, easy to
+/// tell apart, also for colour-blind readers).
+pub const SERIES_COLORS: [[u8; 3]; 4] = [
+    [0, 114, 178],   // blue
+    [213, 94, 0],    // vermillion
+    [0, 158, 115],   // green
+    [204, 121, 167], // purple
+];
+
+/// Colour of the `path`'s series: its rank among the series of its plot
+/// (the entities sharing its parent), in [`SERIES_COLORS`].
+pub fn series_color(series: &[(&str, &str)], path: &str) -> Color {
+    let parent = |p: &str| p.rsplit_once('/').map_or("", |(a, _)| a).to_string();
+    let rank = series
+        .iter()
+        .filter(|(p, _)| parent(p) == parent(path))
+        .position(|(p, _)| *p == path)
+        .unwrap_or(0);
+    let [r, g, b] = SERIES_COLORS[rank % SERIES_COLORS.len()];
+    Color::from_rgb(r, g, b)
+}
+
+/// The colour scales of a recording, in markdown.
+pub fn legend(yarn: bool) -> String {
+    let scale = "stretch `l/l0`: blue = 0.9 (10 % compressed) - light grey = 1.0 (rest length) \
+                 - red = 1.1 (10 % stretched), saturating beyond";
+    if yarn {
+        format!(
+            "**Yarns**: one colour per yarn (lines and vertices). **Quadrature points** \
+             (one per segment): {scale}. Plastic state, yield value, shear are values \
+             of `world/quadrature` (select a point)."
+        )
+    } else {
+        format!(
+            "**Springs**: {scale}. **Particles**: blue free, red pinned or driven. \
+             Y is up."
+        )
+    }
+}
+
+/// Radii in grid cells: the yarn lines are the widest, so they stay
+/// visible; the points sit on them, smaller.
+pub const STRIP_RADIUS: f32 = 0.3;
+pub const VERTEX_RADIUS: f32 = 0.15;
+pub const QUADRATURE_RADIUS: f32 = 0.12;
 
 /// Colour of a stretch value: blue when compressed, light grey at rest
 /// length, red when stretched; saturates at +-10 %.
@@ -369,29 +600,21 @@ fn log_yarn_static(rec: &RecordingStream, sim: &YarnSim) -> rerun::RecordingStre
     let sc = sim.scene();
     let size = sc.grid.size as f32;
     let dx = sc.dx() as f32;
-    // Rerun's 2D views draw +y downwards; mirror the world so +y is up.
-    rec.log_static(
-        paths::WORLD,
-        &Transform3D::from_translation_scale([0.0, size, 0.0], [1.0, -1.0, 1.0]),
-    )?;
+    let h = sc.grid.size;
+    // The domain and the wall band: shapes only; what they are is in the
+    // legend (box labels sit at the box centre, on top of each other and
+    // of the obstacles' labels).
     rec.log_static(
         paths::DOMAIN,
         &Boxes2D::from_mins_and_sizes([[0.0, 0.0]], [[size, size]])
-            .with_colors([Color::from_rgb(120, 120, 120)])
-            .with_labels([format!("grid {0}x{0}", sc.grid.resolution)]),
+            .with_colors([Color::from_rgb(120, 120, 120)]),
     )?;
     if sc.walls.mode != WallMode::None {
         let w = sc.walls.cells as f32 * dx;
-        let mode = match sc.walls.mode {
-            WallMode::Sticky => "sticky",
-            WallMode::Slip => "slip",
-            WallMode::None => "none",
-        };
         rec.log_static(
             paths::WALLS,
             &Boxes2D::from_mins_and_sizes([[w, w]], [[size - 2.0 * w, size - 2.0 * w]])
-                .with_colors([Color::from_rgb(160, 120, 60)])
-                .with_labels([format!("{mode} walls, {} cells", sc.walls.cells)]),
+                .with_colors([Color::from_rgb(160, 120, 60)]),
         )?;
     }
     if !sc.obstacles.is_empty() {
@@ -400,7 +623,7 @@ fn log_yarn_static(rec: &RecordingStream, sim: &YarnSim) -> rerun::RecordingStre
             &Ellipses2D::from_centers_and_half_sizes(
                 sc.obstacles
                     .iter()
-                    .map(|o| [o.center[0] as f32, o.center[1] as f32]),
+                    .map(|o| view2(&yarnsim::math::Vec2::from(o.center), h)),
                 sc.obstacles
                     .iter()
                     .map(|o| [o.radius as f32, o.radius as f32]),
@@ -409,7 +632,8 @@ fn log_yarn_static(rec: &RecordingStream, sim: &YarnSim) -> rerun::RecordingStre
             .with_labels(
                 sc.obstacles
                     .iter()
-                    .map(|o| format!("friction {}", o.friction)),
+                    .enumerate()
+                    .map(|(i, o)| format!("obstacle {i}, friction {}", o.friction)),
             ),
         )?;
     }
@@ -417,15 +641,33 @@ fn log_yarn_static(rec: &RecordingStream, sim: &YarnSim) -> rerun::RecordingStre
     if a.active {
         rec.log_static(
             paths::ATTRACTOR,
-            &Points2D::new([p2(&a.position)])
+            &Points2D::new([view2(&a.position, h)])
                 .with_radii([2.0 * dx])
                 .with_colors([Color::from_rgb(255, 220, 0)])
                 .with_labels([format!("attractor {} m/s^2", a.strength)]),
         )?;
     }
     for (path, name) in paths::SERIES {
-        rec.log_static(path, &SeriesLines::new().with_names([name]))?;
+        rec.log_static(
+            path,
+            &SeriesLines::new()
+                .with_names([name])
+                .with_colors([series_color(&paths::SERIES, path)]),
+        )?;
     }
+    let walls = match sc.walls.mode {
+        WallMode::Sticky => format!("brown: sticky walls, {} cells", sc.walls.cells),
+        WallMode::Slip => format!("brown: slip walls, {} cells", sc.walls.cells),
+        WallMode::None => "no walls".into(),
+    };
+    let geometry = format!(
+        " **Domain**: grey square, grid {0}x{0} over {1} m; {walls}. +y is up.",
+        sc.grid.resolution, sc.grid.size
+    );
+    rec.log_static(
+        paths::LEGEND,
+        &TextDocument::from_markdown(legend(true) + &geometry),
+    )?;
     Ok(())
 }
 
@@ -443,12 +685,17 @@ fn log_yarn_frame(
     let seg = sim.stretches();
     let vs = vertex_stretches(sim, &seg);
 
-    let positions: Vec<[f32; 2]> = p.vert.x.iter().map(p2).collect();
+    let h = sim.scene().grid.size;
+    let positions: Vec<[f32; 2]> = p.vert.x.iter().map(|x| view2(x, h)).collect();
+    let yv = &p.yarn_vertices;
+    let vertex_colors: Vec<Color> = (0..sim.num_yarns())
+        .flat_map(|y| std::iter::repeat_n(yarn_color(y), yv[y + 1] - yv[y]))
+        .collect();
     rec.log(
         paths::VERTICES,
         &Points2D::new(positions.iter().copied())
-            .with_radii([0.35 * dx])
-            .with_colors(vs.iter().map(|&s| stretch_color(s))),
+            .with_radii([VERTEX_RADIUS * dx])
+            .with_colors(vertex_colors),
     )?;
     rec.log(
         paths::VERTICES,
@@ -470,9 +717,9 @@ fn log_yarn_frame(
     }
     rec.log(
         paths::QUADRATURE,
-        &Points2D::new(p.quad.x.iter().map(p2))
-            .with_radii([0.2 * dx])
-            .with_colors(state.iter().map(|s| s.color())),
+        &Points2D::new(p.quad.x.iter().map(|x| view2(x, h)))
+            .with_radii([QUADRATURE_RADIUS * dx])
+            .with_colors(seg.iter().map(|&s| stretch_color(s))),
     )?;
     rec.log(
         paths::QUADRATURE,
@@ -485,11 +732,10 @@ fn log_yarn_frame(
             .with_component::<Scalar>(values::PLASTIC, state.iter().map(|&s| s as u8 as f64)),
     )?;
 
-    let yv = &p.yarn_vertices;
     rec.log(
         paths::YARNS,
         &LineStrips2D::new((0..sim.num_yarns()).map(|y| positions[yv[y]..yv[y + 1]].to_vec()))
-            .with_radii([0.15 * dx])
+            .with_radii([STRIP_RADIUS * dx])
             .with_colors((0..sim.num_yarns()).map(yarn_color)),
     )?;
 
@@ -501,8 +747,15 @@ fn log_yarn_frame(
         (paths::MOMENTUM_X, d.momentum.x),
         (paths::MOMENTUM_Y, d.momentum.y),
         (paths::ANGULAR_MOMENTUM, d.angular_momentum),
+        (
+            paths::TOTAL,
+            d.kinetic_energy + d.elastic_energy + d.potential_energy,
+        ),
         (paths::MAX_STRETCH, d.max_stretch),
         (paths::MIN_STRETCH, d.min_stretch),
+        (paths::MEAN_STRETCH, d.mean_stretch),
+        (paths::COM_X, d.center_of_mass.x),
+        (paths::COM_Y, d.center_of_mass.y),
     ];
     for (path, value) in scalars {
         rec.log(path, &Scalars::single(value))?;
@@ -537,8 +790,17 @@ fn log_massspring_static(
         )?;
     }
     for (path, name) in paths::MS_SERIES {
-        rec.log_static(path, &SeriesLines::new().with_names([name]))?;
+        rec.log_static(
+            path,
+            &SeriesLines::new()
+                .with_names([name])
+                .with_colors([series_color(&paths::MS_SERIES, path)]),
+        )?;
     }
+    rec.log_static(paths::LEGEND, &TextDocument::from_markdown(legend(false)))?;
+    // The scenes are Y-up (gravity along -y): without this the viewer lays
+    // them on its floor grid and frames them badly.
+    rec.log_static(paths::WORLD, &ViewCoordinates::RIGHT_HAND_Y_UP())?;
     Ok(())
 }
 
@@ -611,6 +873,13 @@ fn log_massspring_frame(
         (paths::ANGULAR_MOMENTUM_Y, d.angular_momentum.y),
         (paths::ANGULAR_MOMENTUM_Z, d.angular_momentum.z),
         (paths::MAX_STRAIN, d.max_strain),
+        (
+            paths::TOTAL,
+            d.kinetic_energy + d.elastic_energy + d.gravity_energy,
+        ),
+        (paths::COM_X, d.center_of_mass.x),
+        (paths::COM_Y, d.center_of_mass.y),
+        (paths::COM_Z, d.center_of_mass.z),
     ];
     for (path, value) in scalars {
         rec.log(path, &Scalars::single(value))?;

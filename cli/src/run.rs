@@ -9,7 +9,7 @@ use yarnsim::mpm::Diagnostics;
 use yarnsim::scene::Scene;
 use yarnsim::YarnSim;
 
-use crate::driver::{interrupt_flag, progress_bar, run_frames};
+use crate::driver::{interrupt_flag, progress_bar, run_frames, FrameRun};
 use crate::error::CliError;
 use crate::massspring::{IntegratorArgs, MassSpringRun, MsDiagnostics};
 use crate::schedule::Schedule;
@@ -51,7 +51,7 @@ pub fn run_massspring(
     let initial = run.diagnostics();
     let mut last = initial;
     let progress = progress_bar(schedule.total_steps, &run.name);
-    let outcome = run_frames(
+    let FrameRun { outcome, failure } = run_frames(
         run,
         &schedule,
         &interrupt_flag(),
@@ -78,6 +78,7 @@ pub fn run_massspring(
         sim_time: last.time - initial.time,
         wall_seconds: outcome.step_seconds,
         interrupted: outcome.interrupted,
+        failure: failure.map(|e| e.to_string()),
         diagnostics: ms_rows(&initial, &last),
     })
 }
@@ -135,7 +136,8 @@ pub fn run_yarn(sim: &mut YarnSim, duration: f64, csv: Option<&Path>) -> Result<
     let initial = sim.diagnostics();
     let mut last = initial;
     let progress = progress_bar(schedule.total_steps, &sc.name);
-    let outcome = run_frames(
+    let dt = sim.dt();
+    let FrameRun { outcome, failure } = run_frames(
         sim,
         &schedule,
         &interrupt_flag(),
@@ -143,7 +145,7 @@ pub fn run_yarn(sim: &mut YarnSim, duration: f64, csv: Option<&Path>) -> Result<
         |sim, frame| {
             last = sim.diagnostics();
             if let Some(w) = writer.as_mut() {
-                w.row(frame.frame, sim, &last)?;
+                w.row(frame.frame, sim, &last, dt)?;
             }
             Ok(())
         },
@@ -168,6 +170,7 @@ pub fn run_yarn(sim: &mut YarnSim, duration: f64, csv: Option<&Path>) -> Result<
         sim_time: last.time - initial.time,
         wall_seconds: outcome.step_seconds,
         interrupted: outcome.interrupted,
+        failure: failure.map(|e| e.to_string()),
         diagnostics: yarn_rows(&initial, &last),
     })
 }
@@ -180,6 +183,13 @@ pub fn csv_num(x: f64) -> String {
     } else {
         format!("{x:e}")
     }
+}
+
+/// A time for the CSV: `t` rounded to 15 significant digits, then printed
+/// shortest, so `steps * dt` prints `0.05`, not `0.05000000000000001`.
+pub fn csv_time(t: f64) -> String {
+    let tidy: f64 = format!("{t:.14e}").parse().unwrap_or(t);
+    csv_num(tidy)
 }
 
 /// The per-frame CSV: frame, time, diagnostics, then both endpoints of every yarn.
@@ -267,9 +277,20 @@ impl CsvWriter {
         })
     }
 
-    /// Writes one frame; numbers read back exactly (see [`csv_num`]).
-    pub fn row(&mut self, frame: u64, sim: &YarnSim, d: &Diagnostics) -> Result<(), CliError> {
-        let mut cols: Vec<String> = vec![frame.to_string(), csv_num(d.time), d.steps.to_string()];
+    /// Writes one frame; numbers read back exactly (see [`csv_num`]), the
+    /// time is `steps * dt` (see [`csv_time`]).
+    pub fn row(
+        &mut self,
+        frame: u64,
+        sim: &YarnSim,
+        d: &Diagnostics,
+        dt: f64,
+    ) -> Result<(), CliError> {
+        let mut cols: Vec<String> = vec![
+            frame.to_string(),
+            csv_time(d.steps as f64 * dt),
+            d.steps.to_string(),
+        ];
         cols.extend(
             [
                 d.kinetic_energy,
@@ -296,7 +317,7 @@ impl CsvWriter {
 
     /// Writes one mass-spring frame.
     pub fn ms_row(&mut self, frame: u64, d: &MsDiagnostics) -> Result<(), CliError> {
-        let mut cols: Vec<String> = vec![frame.to_string(), csv_num(d.time), d.steps.to_string()];
+        let mut cols: Vec<String> = vec![frame.to_string(), csv_time(d.time), d.steps.to_string()];
         cols.extend(
             [
                 d.kinetic_energy,
@@ -325,5 +346,18 @@ impl CsvWriter {
             path: self.path.clone(),
             message: e.to_string(),
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn csv_times_print_shortest() {
+        assert_eq!(csv_time(1250.0 * 4e-5), "0.05");
+        assert_eq!(csv_time(3.0 * 0.1), "0.3");
+        assert_eq!(csv_time(0.0), "0");
+        assert_eq!(csv_time(2.5e-5), "2.5e-5");
     }
 }

@@ -5,6 +5,7 @@ use std::fmt::Write as _;
 use yarnsim::scene::{builtin_names, Scene, DEFAULT_SCENE};
 
 use crate::error::CliError;
+use crate::table::MAX_WIDTH;
 
 /// One line per built-in scene: name, then description; the default is marked.
 pub fn list_scenes() -> String {
@@ -13,7 +14,18 @@ pub fn list_scenes() -> String {
     let mut out = String::new();
     for (name, description) in names {
         let mark = if name == DEFAULT_SCENE { "*" } else { " " };
-        let _ = writeln!(out, "{mark} {name:<width$}  {description}");
+        // Descriptions wrap within MAX_WIDTH, continuation lines indented.
+        let indent = width + 4;
+        let mut line = format!("{mark} {name:<width$} ");
+        for word in description.split(' ') {
+            if line.len() + 1 + word.len() > MAX_WIDTH && line.len() > indent {
+                let _ = writeln!(out, "{line}");
+                line = " ".repeat(indent - 1);
+            }
+            line.push(' ');
+            line.push_str(word);
+        }
+        let _ = writeln!(out, "{line}");
     }
     let _ = writeln!(out, "(* = default scene)");
     out

@@ -24,6 +24,9 @@ pub struct Summary {
     /// Wall-clock seconds spent stepping.
     pub wall_seconds: f64,
     pub interrupted: bool,
+    /// Why the run stopped early (divergence, solver failure); the final
+    /// column then holds the last frame before the failure.
+    pub failure: Option<String>,
     /// Diagnostics at the start and at the end of the run.
     pub diagnostics: Vec<DiagRow>,
 }
@@ -90,8 +93,10 @@ pub fn format_summary(s: &Summary, timing: Timing) -> String {
         ),
         Timing::Redact => ("[timing]".into(), "[timing]".into()),
     };
-    let status = if s.interrupted {
-        " (interrupted by Ctrl-C)"
+    let status = if s.failure.is_some() {
+        " (stopped: the simulation failed after the last one)"
+    } else if s.interrupted {
+        " (interrupted)"
     } else {
         ""
     };
@@ -112,9 +117,203 @@ pub fn format_summary(s: &Summary, timing: Timing) -> String {
         let _ = writeln!(out, "{k:<18} {v}");
     }
     let _ = writeln!(out);
-    let _ = writeln!(out, "{:<18} {:>16} {:>16}", "", "initial", "final");
+    let last = if s.failure.is_some() {
+        "last frame"
+    } else {
+        "final"
+    };
+    let _ = writeln!(out, "{:<18} {:>16} {:>16}", "", "initial", last);
     for (k, x, y) in &s.diagnostics {
         let _ = writeln!(out, "{k:<18} {:>16} {:>16}", num(*x), num(*y));
     }
     out
+}
+
+/// Widest line the CLI prints (tables and reports); the full data of the
+/// evidence studies stays in their CSV files.
+pub const MAX_WIDTH: usize = 100;
+
+/// Longest table cell shown; longer ones are cut with `~` (the CSV has them whole).
+const MAX_CELL: usize = 30;
+
+/// Fits a report into `width` columns: pipe tables (`| a | b |` with a
+/// `|---|` rule) wider than that are split into several tables of fewer
+/// columns, each repeating the first (key) column, with over-long cells
+/// cut; other long lines are wrapped at spaces. Text that fits is unchanged.
+pub fn fit_tables(text: &str, width: usize) -> String {
+    let mut out = String::new();
+    let lines: Vec<&str> = text.lines().collect();
+    let mut i = 0;
+    while i < lines.len() {
+        let is_row = |l: &str| l.starts_with('|') && l.ends_with('|') && l.len() > 1;
+        if is_row(lines[i]) {
+            let start = i;
+            while i < lines.len() && is_row(lines[i]) {
+                i += 1;
+            }
+            let block = &lines[start..i];
+            if block.iter().all(|l| l.chars().count() <= width) {
+                for l in block {
+                    let _ = writeln!(out, "{l}");
+                }
+            } else {
+                out += &split_table(block, width);
+            }
+            continue;
+        }
+        out += &wrap_line(lines[i], width);
+        i += 1;
+    }
+    if !text.ends_with('\n') {
+        out.pop();
+    }
+    out
+}
+
+/// Word-wraps one line (with its newline); continuation lines keep the indent.
+fn wrap_line(line: &str, width: usize) -> String {
+    if line.chars().count() <= width {
+        return format!("{line}\n");
+    }
+    let indent: String = line.chars().take_while(|c| *c == ' ').collect();
+    let mut out = String::new();
+    let mut cur = String::new();
+    for word in line.split(' ').filter(|w| !w.is_empty()) {
+        if !cur.is_empty() && cur.chars().count() + 1 + word.chars().count() > width {
+            let _ = writeln!(out, "{cur}");
+            cur.clear();
+        }
+        if cur.is_empty() {
+            cur.push_str(&indent);
+        } else {
+            cur.push(' ');
+        }
+        cur.push_str(word);
+    }
+    let _ = writeln!(out, "{cur}");
+    out
+}
+
+/// Splits a pipe table into column groups that fit `width`.
+fn split_table(block: &[&str], width: usize) -> String {
+    let cut = |c: &str| -> String {
+        let c = c.trim();
+        if c.chars().count() > MAX_CELL {
+            let mut s: String = c.chars().take(MAX_CELL - 1).collect();
+            s.push('~');
+            s
+        } else {
+            c.to_string()
+        }
+    };
+    let rows: Vec<Vec<String>> = block
+        .iter()
+        .filter(|l| !l.starts_with("|-"))
+        .map(|l| l[1..l.len() - 1].split(" | ").map(cut).collect())
+        .collect();
+    let n = rows.iter().map(Vec::len).max().unwrap_or(0);
+    let col_width = |j: usize| {
+        rows.iter()
+            .map(|r| r.get(j).map_or(0, |c| c.chars().count()))
+            .max()
+            .unwrap_or(0)
+    };
+    let w: Vec<usize> = (0..n).map(col_width).collect();
+    // Key columns, repeated in every part: the first column and the text
+    // columns right after it (scene, integrator, ...), within half the width.
+    let numeric = |j: usize| {
+        rows.iter().skip(1).all(|r| {
+            r.get(j).is_none_or(|c| {
+                c.starts_with(|ch: char| ch.is_ascii_digit() || "-+.><=".contains(ch))
+            })
+        })
+    };
+    let mut keys = 1.min(n);
+    let mut key_width = 4 + w.first().copied().unwrap_or(0);
+    while keys < n && !numeric(keys) && key_width + 3 + w[keys] <= width / 2 {
+        key_width += 3 + w[keys];
+        keys += 1;
+    }
+    // Column groups after the keys: as many as fit beside them.
+    let mut groups: Vec<Vec<usize>> = Vec::new();
+    let mut cur: Vec<usize> = Vec::new();
+    let mut used = key_width;
+    for (j, &wj) in w.iter().enumerate().skip(keys) {
+        if !cur.is_empty() && used + 3 + wj > width {
+            groups.push(std::mem::take(&mut cur));
+            used = key_width;
+        }
+        cur.push(j);
+        used += 3 + wj;
+    }
+    if !cur.is_empty() || groups.is_empty() {
+        groups.push(cur);
+    }
+    let mut out = String::new();
+    for (g, cols) in groups.iter().enumerate() {
+        if g > 0 {
+            let _ = writeln!(out);
+        }
+        let cols: Vec<usize> = (0..keys).chain(cols.iter().copied()).collect();
+        for (r, row) in rows.iter().enumerate() {
+            let cells: Vec<String> = cols
+                .iter()
+                .map(|&j| {
+                    let c = row.get(j).map_or("", String::as_str);
+                    format!("{c:<width$}", width = w[j])
+                })
+                .collect();
+            let _ = writeln!(out, "| {} |", cells.join(" | "));
+            if r == 0 {
+                let rule: Vec<String> = cols.iter().map(|&j| "-".repeat(w[j] + 2)).collect();
+                let _ = writeln!(out, "|{}|", rule.join("|"));
+            }
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn wide_tables_are_split_and_text_wrapped() {
+        let header: Vec<String> = (0..12).map(|j| format!("column number {j}")).collect();
+        let row: Vec<String> = (0..12).map(|j| format!("{}", j as f64 * 1.2345)).collect();
+        let table = format!(
+            "intro\n| {} |\n|{}|\n| {} |\n{}\n",
+            header.join(" | "),
+            ["---"; 12].join("|"),
+            row.join(" | "),
+            "word ".repeat(40).trim_end()
+        );
+        let fitted = fit_tables(&table, MAX_WIDTH);
+        assert!(
+            fitted.lines().all(|l| l.chars().count() <= MAX_WIDTH),
+            "{fitted}"
+        );
+        // Every header and value is still there, the key column in every part.
+        for h in header.iter().chain(&row) {
+            assert!(fitted.contains(h.as_str()), "{h} missing: {fitted}");
+        }
+        let parts = fitted.matches("| column number 0 ").count();
+        assert!(parts >= 2, "{fitted}");
+        assert_eq!(fitted.matches("word").count(), 40);
+        // What fits stays as it was.
+        let small = "| a | b |\n|---|---|\n| 1 | 2 |\n";
+        assert_eq!(fit_tables(small, MAX_WIDTH), small);
+    }
+
+    #[test]
+    fn long_cells_are_cut() {
+        let long = "x".repeat(80);
+        let t = format!("| k | {long} | {long} |\n|---|---|---|\n| 1 | 2 | 3 |\n");
+        let fitted = fit_tables(&t, MAX_WIDTH);
+        assert!(
+            fitted.lines().all(|l| l.chars().count() <= MAX_WIDTH),
+            "{fitted}"
+        );
+        assert!(fitted.contains(&format!("{}~", "x".repeat(MAX_CELL - 1))));
+    }
 }

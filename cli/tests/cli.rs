@@ -61,6 +61,9 @@ fn scenes_lists_every_builtin() {
     for (name, _) in yarnsim::scene::builtin_names() {
         assert!(text.contains(name), "{name} missing");
     }
+    for line in text.lines() {
+        assert!(line.chars().count() <= 100, "{line}");
+    }
     insta::assert_snapshot!("scenes", text);
 }
 
@@ -203,4 +206,154 @@ fn errors_have_clear_messages_and_exit_codes() {
         4,
         "cannot write output file",
     );
+}
+
+#[test]
+fn overlapping_bodies_at_the_start_are_refused_naming_both() {
+    // The small scene's obstacle moved onto its first yarn.
+    let text = std::fs::read_to_string(small_scene())
+        .unwrap()
+        .replace("center = [0.5, 0.45]", "center = [0.5, 0.60]");
+    let scene = tmp("overlap.toml");
+    std::fs::write(&scene, text).unwrap();
+    let out = yarnsim(&["run", scene.to_str().unwrap(), "-d", "1ms"]);
+    assert_eq!(out.status.code(), Some(3));
+    let err = stderr(&out);
+    assert!(err.contains("line 33"), "{err}");
+    assert!(
+        err.contains("obstacle 0 (centre (0.5, 0.6), radius 0.1) overlaps yarn 0"),
+        "{err}"
+    );
+    assert!(err.contains("m from the centre"), "{err}");
+
+    // The cloth's sphere moved up into the sheet.
+    let cloth = stdout(&yarnsim(&["scene", "show", "cloth"]));
+    let shown = yarnsim::Scene::from_toml_str(&cloth).unwrap();
+    let yarnsim::Scene::MassSpring(mut layout) = shown else {
+        panic!("mass-spring scene expected")
+    };
+    let x0 = layout.build().unwrap().positions[0];
+    layout.spheres[0].center = [x0.x + 0.1, x0.y, x0.z];
+    let scene = tmp("cloth-inside.toml");
+    std::fs::write(&scene, layout.to_toml_string()).unwrap();
+    let out = yarnsim(&["run", scene.to_str().unwrap(), "-d", "0.05"]);
+    assert_eq!(out.status.code(), Some(3));
+    let err = stderr(&out);
+    assert!(err.contains("start inside sphere 0"), "{err}");
+    assert!(err.contains("inside; move the sphere"), "{err}");
+}
+
+#[test]
+fn an_explicit_step_above_the_stability_bound_is_refused() {
+    let args = [
+        "run",
+        "wire",
+        "-d",
+        "1",
+        "--integrator",
+        "forward-euler",
+        "--option",
+        "dt=0.01",
+    ];
+    let out = yarnsim(&args);
+    assert_eq!(out.status.code(), Some(2));
+    let err = stderr(&out);
+    assert!(
+        err.contains("x the stability bound of forward-euler"),
+        "{err}"
+    );
+    assert!(err.contains("--allow-unstable"), "{err}");
+    assert!(stdout(&out).is_empty());
+
+    // Forced: it runs, diverges, and still prints the summary up to the
+    // last frame before the failure, then fails with exit code 1.
+    let mut forced = args.to_vec();
+    forced.push("--allow-unstable");
+    let out = yarnsim(&forced);
+    assert_eq!(out.status.code(), Some(1), "{}", stderr(&out));
+    let err = stderr(&out);
+    assert!(err.contains("running anyway (--allow-unstable)"), "{err}");
+    assert!(err.contains("error: "), "{err}");
+    let summary = stdout(&out);
+    assert!(
+        summary.contains("stopped: the simulation failed"),
+        "{summary}"
+    );
+    assert!(summary.contains("last frame"), "{summary}");
+}
+
+#[test]
+fn clamped_and_invalid_steps_say_so_briefly() {
+    let out = yarnsim(&["run", "wire", "-d", "0.1", "--option", "dt=10"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let err = stderr(&out);
+    assert!(
+        err.contains(
+            "--option dt=10 is longer than a frame of this scene; clamped to the frame time 0.05 s"
+        ),
+        "{err}"
+    );
+    for bad in ["dt=-1", "dt=1e999", "dt=0"] {
+        let out = yarnsim(&["run", "wire", "--option", bad]);
+        assert_eq!(out.status.code(), Some(2));
+        let err = stderr(&out);
+        assert!(err.contains("must be a positive, finite step"), "{err}");
+        assert!(err.len() < 120, "long error: {err}");
+    }
+}
+
+#[test]
+fn output_errors_state_their_cause_once() {
+    let out = yarnsim(&[
+        "record",
+        small_scene().to_str().unwrap(),
+        "-d",
+        "1ms",
+        "-o",
+        "/nonexistent-dir/x.rrd",
+    ]);
+    assert_eq!(out.status.code(), Some(4));
+    let err = stderr(&out);
+    assert_eq!(err.matches("No such file or directory").count(), 1, "{err}");
+    assert_eq!(err.matches("/nonexistent-dir/x.rrd").count(), 1, "{err}");
+}
+
+#[test]
+fn csv_times_are_steps_times_dt_printed_shortest() {
+    let csv = tmp("run-times.csv");
+    let out = yarnsim(&[
+        "run",
+        small_scene().to_str().unwrap(),
+        "--duration",
+        "2ms",
+        "--csv",
+        csv.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let text = std::fs::read_to_string(&csv).unwrap();
+    let times: Vec<&str> = text
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').nth(1).unwrap())
+        .collect();
+    assert_eq!(
+        times,
+        ["0", "0.0004", "0.0008", "0.0012", "0.0016", "0.002"]
+    );
+}
+
+#[test]
+fn bench_table_fits_100_columns() {
+    let out = yarnsim(&[
+        "bench",
+        small_scene().to_str().unwrap(),
+        "--steps",
+        "5",
+        "--warmup",
+        "1",
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    for line in stdout(&out).lines() {
+        assert!(line.chars().count() <= 100, "{line}");
+    }
 }

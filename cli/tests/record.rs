@@ -39,12 +39,17 @@ fn yarnsim(args: &[&str]) -> std::process::Output {
 
 /// The recording's data chunks (blueprint store left out), by entity path.
 fn decode(path: &Path) -> BTreeMap<String, Vec<Chunk>> {
+    decode_store(path, StoreKind::Recording)
+}
+
+/// The chunks of one store of a recording (data or blueprint), by entity path.
+fn decode_store(path: &Path, kind: StoreKind) -> BTreeMap<String, Vec<Chunk>> {
     let file = std::fs::File::open(path).expect("open rrd");
     let mut chunks: BTreeMap<String, Vec<Chunk>> = BTreeMap::new();
     for msg in DecoderApp::decode_eager(BufReader::new(file)).expect("rrd header") {
         let msg = msg.expect("decodable message");
         if let LogMsg::ArrowMsg(store, arrow) = &msg {
-            if store.kind() != StoreKind::Recording {
+            if store.kind() != kind {
                 continue;
             }
             let chunk = Chunk::from_arrow_msg(arrow).expect("chunk");
@@ -110,7 +115,7 @@ fn yarn_recording_holds_the_library_state_at_every_frame() {
     let chunks = decode(&rrd);
     let entities: BTreeSet<&str> = chunks.keys().map(String::as_str).collect();
     for e in [
-        "world",
+        "legend",
         "world/vertices",
         "world/quadrature",
         "world/yarns",
@@ -161,11 +166,21 @@ fn yarn_recording_holds_the_library_state_at_every_frame() {
         let p = sim.particles();
         assert_eq!(v.len(), p.vert.x.len());
         assert_eq!(q.len(), p.quad.x.len());
+        // Stored as (x, size - y): Rerun's 2D view is y-down.
+        let size = y.grid.size;
         for (logged, x) in v.iter().zip(&p.vert.x) {
-            assert_eq!(logged.0 .0, [x.x as f32, x.y as f32], "frame {frame}");
+            assert_eq!(
+                logged.0 .0,
+                [x.x as f32, (size - x.y) as f32],
+                "frame {frame}"
+            );
         }
         for (logged, x) in q.iter().zip(&p.quad.x) {
-            assert_eq!(logged.0 .0, [x.x as f32, x.y as f32], "frame {frame}");
+            assert_eq!(
+                logged.0 .0,
+                [x.x as f32, (size - x.y) as f32],
+                "frame {frame}"
+            );
         }
     }
     // The bundle moved (the test would be weak on a state at rest).
@@ -230,10 +245,11 @@ fn massspring_recording_holds_the_library_state_at_every_frame() {
     assert_ne!(pos[0].1, pos[3].1);
 }
 
+/// Starts a long recording, sends `signal` once the file has grown, and
+/// checks exit code 130 and a decodable file with contiguous frames.
 #[cfg(unix)]
-#[test]
-fn ctrl_c_finishes_the_recording_cleanly() {
-    let rrd = tmp("record-interrupted.rrd");
+fn signal_finishes_the_recording_cleanly(signal: &str) {
+    let rrd = tmp(&format!("record-interrupted-{signal}.rrd"));
     let _ = std::fs::remove_file(&rrd);
     let scene_file = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/small.toml");
     let child = Command::new(env!("CARGO_BIN_EXE_yarnsim"))
@@ -251,7 +267,7 @@ fn ctrl_c_finishes_the_recording_cleanly() {
         std::thread::sleep(std::time::Duration::from_millis(50));
     }
     let kill = Command::new("kill")
-        .args(["-INT", &child.id().to_string()])
+        .args([&format!("-{signal}"), &child.id().to_string()])
         .status()
         .unwrap();
     assert!(kill.success());
@@ -279,4 +295,264 @@ fn ctrl_c_finishes_the_recording_cleanly() {
         stdout.contains(&format!("recorded {} frames", frames.len())),
         "{stdout}"
     );
+}
+
+#[cfg(unix)]
+#[test]
+fn ctrl_c_finishes_the_recording_cleanly() {
+    signal_finishes_the_recording_cleanly("INT");
+}
+
+#[cfg(unix)]
+#[test]
+fn sigterm_finishes_the_recording_like_ctrl_c() {
+    signal_finishes_the_recording_cleanly("TERM");
+}
+
+fn small_scene() -> String {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/data/small.toml")
+        .to_str()
+        .unwrap()
+        .to_string()
+}
+
+/// Frames at which `world/vertices` was logged.
+fn vertex_frames(chunks: &BTreeMap<String, Vec<Chunk>>) -> Vec<i64> {
+    by_frame::<Position2D>(
+        &chunks["world/vertices"],
+        Points2D::descriptor_positions().component,
+    )
+    .iter()
+    .map(|(f, _)| *f)
+    .collect()
+}
+
+#[test]
+fn dash_o_dash_writes_the_recording_to_stdout() {
+    // `yarnsim record -o - | rerun -`: the bytes on stdout are the recording,
+    // the closing message goes to stderr.
+    let out = yarnsim(&["record", &small_scene(), "--duration", "2ms", "-o", "-"]);
+    let piped = tmp("record-stdout.rrd");
+    std::fs::write(&piped, &out.stdout).unwrap();
+    assert_eq!(vertex_frames(&decode(&piped)), (0..=5).collect::<Vec<_>>());
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(stderr.contains("recorded 6 frames"), "{stderr}");
+    assert!(stderr.contains("to standard output"), "{stderr}");
+    assert!(!Path::new("-").exists(), "wrote a file named -");
+}
+
+#[test]
+fn save_is_an_alias_of_output() {
+    let rrd = tmp("record-save.rrd");
+    let _ = std::fs::remove_file(&rrd);
+    yarnsim(&[
+        "record",
+        &small_scene(),
+        "-d",
+        "1ms",
+        "--save",
+        rrd.to_str().unwrap(),
+    ]);
+    assert_eq!(vertex_frames(&decode(&rrd)), (0..=3).collect::<Vec<_>>());
+}
+
+#[test]
+fn every_n_logs_every_nth_frame_and_the_last() {
+    let rrd = tmp("record-every.rrd");
+    let _ = std::fs::remove_file(&rrd);
+    let out = yarnsim(&[
+        "record",
+        &small_scene(),
+        "--duration",
+        "2ms",
+        "--every",
+        "2",
+        "-o",
+        rrd.to_str().unwrap(),
+    ]);
+    assert_eq!(vertex_frames(&decode(&rrd)), vec![0, 2, 4, 5]);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        stdout.contains("recorded 4 frames (1 in 2 of 6 frames)"),
+        "{stdout}"
+    );
+}
+
+fn fails(args: &[&str], env: &[(&str, &str)]) -> (i32, String) {
+    let mut cmd = Command::new(env!("CARGO_BIN_EXE_yarnsim"));
+    cmd.args(args);
+    for (k, v) in env {
+        cmd.env(k, v);
+    }
+    let out = cmd.output().expect("run yarnsim");
+    assert!(out.stdout.is_empty(), "{args:?} printed to stdout");
+    (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+#[test]
+fn sinks_refuse_clearly() {
+    let small = small_scene();
+    // Not an .rrd name: refused before anything runs.
+    let (code, err) = fails(&["record", &small, "-d", "1ms", "-o", "x.txt"], &[]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("`x.txt` does not end in .rrd"), "{err}");
+    assert!(!Path::new("x.txt").exists());
+    // One sink at a time.
+    let (code, err) = fails(&["record", &small, "--spawn", "-o", "a.rrd"], &[]);
+    assert_eq!(code, 2, "{err}");
+    // --serve is not built in, and says what to do instead.
+    let (code, err) = fails(&["record", &small, "--serve"], &[]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("rerun --serve-web"), "{err}");
+    // --spawn without a viewer on PATH.
+    let (code, err) = fails(
+        &["record", &small, "-d", "1ms", "--spawn"],
+        &[("PATH", "/nonexistent")],
+    );
+    assert_eq!(code, 4, "{err}");
+    assert!(err.contains("cannot start a Rerun viewer"), "{err}");
+    // A bad --connect URL.
+    let (code, err) = fails(
+        &["record", &small, "-d", "1ms", "--connect", "ftp://nowhere"],
+        &[],
+    );
+    assert_eq!(code, 4, "{err}");
+    assert!(
+        err.contains("cannot stream to the viewer at ftp://nowhere"),
+        "{err}"
+    );
+    // No viewer listening: Rerun gives up after 5 s, and the run says so.
+    let (code, err) = fails(
+        &["record", &small, "-d", "1ms", "--connect", "127.0.0.1:1"],
+        &[],
+    );
+    assert_eq!(code, 4, "{err}");
+    assert!(
+        err.contains("cannot stream to the viewer at rerun+http://127.0.0.1:1/proxy"),
+        "{err}"
+    );
+}
+
+/// Every value of component type `C` logged on these chunks, whatever its
+/// archetype field.
+fn all_values<C: rerun::Component + Clone>(chunks: &[Chunk]) -> Vec<C> {
+    let mut out = Vec::new();
+    for c in chunks {
+        let ids: Vec<rerun::ComponentIdentifier> = c
+            .component_descriptors()
+            .filter(|d| d.component_type == Some(C::name()))
+            .map(|d| d.component)
+            .collect();
+        for id in ids {
+            for values in c.iter_component::<C>(id) {
+                out.extend(values.iter().cloned());
+            }
+        }
+    }
+    out
+}
+
+#[test]
+fn recordings_read_at_a_glance() {
+    use rerun::blueprint::components::PanelState;
+    use rerun::components::{Color, Scalar, Text, ViewCoordinates};
+
+    // Yarn scene: one line strip per yarn, each in its own colour; the
+    // quadrature points coloured by their stretch; a legend stating the
+    // scale; every plot's series in distinct colours; total energy, mean
+    // stretch and centre of mass logged.
+    let rrd = tmp("record-look.rrd");
+    let _ = std::fs::remove_file(&rrd);
+    yarnsim(&[
+        "record",
+        &small_scene(),
+        "-d",
+        "2ms",
+        "-o",
+        rrd.to_str().unwrap(),
+    ]);
+    let chunks = decode(&rrd);
+    let strips = by_frame::<rerun::components::LineStrip2D>(
+        &chunks["world/yarns"],
+        rerun::LineStrips2D::descriptor_strips().component,
+    );
+    assert_eq!(strips.last().unwrap().1.len(), 2, "one strip per yarn");
+    let strip_colors = by_frame::<Color>(
+        &chunks["world/yarns"],
+        rerun::LineStrips2D::descriptor_colors().component,
+    );
+    let c = &strip_colors.last().unwrap().1;
+    assert_ne!(c[0], c[1], "yarns share a colour");
+    let quad_colors = by_frame::<Color>(
+        &chunks["world/quadrature"],
+        Points2D::descriptor_colors().component,
+    );
+    let stretch = by_frame::<Scalar>(
+        &chunks["world/quadrature"],
+        rerun::ComponentIdentifier::from("stretch"),
+    );
+    let (frame, colors) = quad_colors.last().unwrap();
+    let values = &stretch.iter().find(|(f, _)| f == frame).unwrap().1;
+    for (c, s) in colors.iter().zip(values) {
+        assert_eq!(*c, yarnsim_cli::record::stretch_color(s.0 .0));
+    }
+    let legend = all_values::<Text>(&chunks["legend"]);
+    assert!(legend[0].as_str().contains("blue = 0.9"), "{:?}", legend);
+    for e in [
+        "plots/energy/total",
+        "plots/stretch/mean",
+        "plots/center_of_mass/x",
+    ] {
+        assert!(chunks.contains_key(e), "missing {e}");
+    }
+    let energy_colors: BTreeSet<[u8; 4]> = [
+        "plots/energy/kinetic",
+        "plots/energy/elastic",
+        "plots/energy/potential",
+        "plots/energy/total",
+    ]
+    .iter()
+    .map(|e| all_values::<Color>(&chunks[*e])[0].to_array())
+    .collect();
+    assert_eq!(energy_colors.len(), 4, "energy series share colours");
+    // Blueprint, selection and time panels start collapsed.
+    let bp = decode_store(&rrd, StoreKind::Blueprint);
+    for panel in ["blueprint_panel", "selection_panel", "time_panel"] {
+        let states = all_values::<PanelState>(&bp[panel]);
+        assert_eq!(states, vec![PanelState::Collapsed], "{panel}");
+    }
+
+    // Labels at their objects: the obstacle's label is drawn at its centre
+    // (no transform anywhere in a 2D recording, so nothing can mirror it),
+    // and the boxes carry no labels that would cover it.
+    let Scene::Yarn(y) = Scene::from_toml_str(SCENE).unwrap() else {
+        unreachable!()
+    };
+    let centers = all_values::<Position2D>(&chunks["world/obstacles"]);
+    let labels = all_values::<Text>(&chunks["world/obstacles"]);
+    let o = &y.obstacles[0];
+    let want = [o.center[0] as f32, (y.grid.size - o.center[1]) as f32];
+    assert_eq!(
+        centers.iter().map(|c| c.0 .0).collect::<Vec<_>>(),
+        vec![want]
+    );
+    assert_eq!(labels.len(), 1);
+    assert!(labels[0].as_str().contains("friction 0.3"));
+    assert!(!chunks.contains_key("world"), "a transform on world");
+    for boxes in ["world/domain", "world/walls"] {
+        assert!(all_values::<Text>(&chunks[boxes]).is_empty(), "{boxes}");
+    }
+    assert!(legend[0].as_str().contains("grid 64x64"), "{:?}", legend);
+
+    // Mass-spring scene: Y-up view coordinates at the 3D view's origin.
+    let rrd = tmp("record-look-wire.rrd");
+    let _ = std::fs::remove_file(&rrd);
+    yarnsim(&["record", "wire", "-d", "0.1", "-o", rrd.to_str().unwrap()]);
+    let chunks = decode(&rrd);
+    let vc = all_values::<ViewCoordinates>(&chunks["world"]);
+    assert_eq!(vc, vec![rerun::components::ViewCoordinates::RUB]);
 }

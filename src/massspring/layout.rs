@@ -593,6 +593,7 @@ impl Layout {
                 ),
             ));
         }
+        crate::scene::overlap::check_particles_outside_spheres(&positions, &self.spheres, text)?;
         Ok(System {
             positions,
             velocities,

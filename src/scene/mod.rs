@@ -5,6 +5,7 @@
 
 pub mod builtin;
 pub mod error;
+pub mod overlap;
 pub(crate) mod readers;
 pub mod yarn;
 

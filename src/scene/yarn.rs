@@ -439,6 +439,7 @@ impl YarnScene {
                 ),
             });
         }
+        super::overlap::check_yarns_clear_of_obstacles(self, text)?;
         Ok(())
     }
 

@@ -255,9 +255,15 @@ impl IntegratorOptions {
         };
         match k.as_str() {
             "dt" => {
-                let v = num(0.0, f64::MAX)?;
-                if v == 0.0 {
-                    return Err("option dt: must be > 0".into());
+                let v: f64 = value
+                    .trim()
+                    .parse()
+                    .map_err(|_| format!("option {key}: {value:?} is not a number"))?;
+                if !(v > 0.0 && v.is_finite()) {
+                    return Err(format!(
+                        "option {key}: must be a positive, finite step in seconds, got {}",
+                        value.trim()
+                    ));
                 }
                 self.dt = Some(v)
             }
