@@ -14,10 +14,11 @@ const BLOCK_SHIFT: usize = 3;
 pub const CHUNKS: usize = 4;
 
 /// One node of a scatter buffer: momentum including the impulse of the
-/// internal forces `[PX, PY]`, mass `M`, the mass of particles touching an
-/// obstacle `MC`, and the impulse alone `[FX, FY]` (filled only by the FLIP
-/// transfer, which needs the grid velocity before the forces).
-pub type P2gNode = [f64; 6];
+/// internal forces `[PX, PY]`, mass `M` and the mass of particles touching
+/// an obstacle `MC`: one 32-byte SIMD register. The impulse alone (needed
+/// only by the FLIP transfer, for the grid velocity before the forces) is
+/// kept beside it in [`ScatterBuffer::impulse`], `[FX, FY]`.
+pub type P2gNode = [f64; 4];
 /// Lane of the x momentum in a [`P2gNode`].
 pub const PX: usize = 0;
 /// Lane of the y momentum.
@@ -26,10 +27,10 @@ pub const PY: usize = 1;
 pub const M: usize = 2;
 /// Lane of the mass of particles in contact with an obstacle.
 pub const MC: usize = 3;
-/// Lane of the x impulse `dt f`.
-pub const FX: usize = 4;
+/// Lane of the x impulse `dt f` in [`ScatterBuffer::impulse`].
+pub const FX: usize = 0;
 /// Lane of the y impulse.
-pub const FY: usize = 5;
+pub const FY: usize = 1;
 
 /// One node of the summed grid after the grid update: the new velocity
 /// `[VX, VY]` and its change over the substep `[DVX, DVY]` (forces, gravity,
@@ -113,6 +114,8 @@ impl GridGeom {
 #[derive(Clone, Debug)]
 pub struct ScatterBuffer {
     pub node: Vec<P2gNode>,
+    /// The impulse `dt f` alone per node (FLIP only; empty until first used).
+    pub impulse: Vec<[f64; 2]>,
     pub touched: Vec<bool>,
     pub touched_list: Vec<u32>,
 }
@@ -120,19 +123,28 @@ pub struct ScatterBuffer {
 impl ScatterBuffer {
     pub fn new(geom: &GridGeom) -> Self {
         ScatterBuffer {
-            node: vec![[0.0; 6]; geom.storage()],
+            node: vec![[0.0; 4]; geom.storage()],
+            impulse: Vec::new(),
             touched: vec![false; geom.blocks()],
             touched_list: Vec::new(),
         }
     }
 
-    /// Zeroes the blocks touched last time and forgets them.
-    pub fn clear(&mut self, geom: &GridGeom) {
+    /// Zeroes the blocks touched last time and forgets them; with
+    /// `impulse`, also (allocates and) zeroes the impulse lanes.
+    pub fn clear(&mut self, geom: &GridGeom, impulse: bool) {
+        if impulse && self.impulse.len() != self.node.len() {
+            self.impulse = vec![[0.0; 2]; self.node.len()];
+        }
+        let impulse = impulse || !self.impulse.is_empty();
         for &b in &self.touched_list {
             let (bi, bj) = (b as usize / geom.nb, b as usize % geom.nb);
             for r in 0..BLOCK {
                 let start = ((bi << BLOCK_SHIFT) + r) * geom.stride + (bj << BLOCK_SHIFT);
-                self.node[start..start + BLOCK].fill([0.0; 6]);
+                self.node[start..start + BLOCK].fill([0.0; 4]);
+                if impulse {
+                    self.impulse[start..start + BLOCK].fill([0.0; 2]);
+                }
             }
             self.touched[b as usize] = false;
         }

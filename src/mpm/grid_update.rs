@@ -90,15 +90,17 @@ multiversion! {
                 let gidx = bi * BLOCK * geom.stride + row;
                 for c in 0..BLOCK {
                     let j = j0 + c;
-                    let mut acc = [0.0; 6];
+                    let mut acc = [0.0; 4];
+                    let mut imp = [0.0; 2];
                     for s in srcs {
                         let n = &s.node[gidx + c];
                         for l in 0..4 {
                             acc[l] += n[l];
                         }
                         if FLIP {
-                            acc[FX] += n[FX];
-                            acc[FY] += n[FY];
+                            let f = &s.impulse[gidx + c];
+                            imp[FX] += f[FX];
+                            imp[FY] += f[FY];
                         }
                     }
                     let out = &mut band[row + c];
@@ -126,8 +128,8 @@ multiversion! {
                     }
                     *out = if FLIP {
                         let v_old = Vec2::new(
-                            (acc[PX] - acc[FX]) * inv_m,
-                            (acc[PY] - acc[FY]) * inv_m,
+                            (acc[PX] - imp[FX]) * inv_m,
+                            (acc[PY] - imp[FY]) * inv_m,
                         );
                         [v.x, v.y, v.x - v_old.x, v.y - v_old.y]
                     } else {

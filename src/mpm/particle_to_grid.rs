@@ -62,9 +62,13 @@ fn splat<const FLIP: bool>(buf: &mut ScatterBuffer, geom: &GridGeom, st: &Stenci
             for l in 0..4 {
                 n[l] += w * add[l];
             }
-            if FLIP {
-                n[4] += w * (fx + fay[j]);
-                n[5] += w * (fy + fby[j]);
+        }
+        if FLIP {
+            let row = &mut buf.impulse[start..start + 3];
+            for j in 0..3 {
+                let w = wi * st.w[1][j];
+                row[j][0] += w * (fx + fay[j]);
+                row[j][1] += w * (fy + fby[j]);
             }
         }
     }
@@ -167,7 +171,7 @@ multiversion! {
         let margin = super::particle_to_grid::CONTACT_CELLS * dx;
         // the normal force per unit of (w_i (x_i - x_p) / dx . d2): -dt dE/dd2 4 / dx
         let normal_scale = -dt * 4.0 * geom.inv_dx;
-        buf.clear(geom);
+        buf.clear(geom, FLIP);
         vertex_forces(vert, &quad.t1, ctx.bending, vr.clone(), fs);
         for ((i, st), f) in vr.zip(sts.iter_mut()).zip(fs.iter()) {
             *st = Stencil::new(vert.x[i], geom.inv_dx);
