@@ -137,8 +137,10 @@ total_energy = ["final", "series"]
     assert s["rows"] == 3 and s["failed"] == 1
     assert list(df["status"]) == ["ok", "discard", "ok"]
     bad = df.iloc[1]
-    assert "diverged" in bad["message"] and np.isnan(bad["total_energy:final"])
-    assert "fmi2GetReal" in bad["last_message"]  # the FMU's last log line
+    # the FMU returns Discard, keeps the last good state readable, and the row
+    # holds the outputs up to its last successful time
+    assert "diverged" in bad["message"] and bad["t_end"] < 1.0
+    assert bad["last_message"]  # the FMU's last log line
     assert np.isfinite(df["total_energy:final"][[0, 2]]).all()
     series = pd.read_parquet(str(tmp_path / "wire" / "series.parquet"))
     assert set(series["point"]) == set(df["point"][[0, 2]])
