@@ -7,7 +7,7 @@
 mod common;
 
 use common::scene;
-use yarnsim::math::{perp, Mat2, Vec2};
+use yarnsim::math::{bessel_j0, perp, Mat2, Vec2};
 use yarnsim::scene::builtin::small_yarn_scene;
 use yarnsim::scene::{SceneError, TransferScheme, WallMode, YarnScene};
 use yarnsim::YarnSim;
@@ -325,17 +325,6 @@ fn cantilever_tip_deflection_matches_euler_bernoulli_at_every_resolution() {
 }
 
 // ---- hanging chain ----------------------------------------------------------
-
-/// Bessel J0 by its power series (|x| < 3 here: 30 terms are exact to round-off).
-fn bessel_j0(x: f64) -> f64 {
-    let (mut term, mut sum) = (1.0, 1.0);
-    let q = -x * x / 4.0;
-    for k in 1..30 {
-        term *= q / (k * k) as f64;
-        sum += term;
-    }
-    sum
-}
 
 #[test]
 #[cfg_attr(debug_assertions, ignore = "release-mode test (cargo test --release)")]

@@ -36,6 +36,8 @@ use std::time::Instant;
 
 use crate::plot::{LinePlot, Marker, Series};
 use crate::{num, Table};
+use yarnsim::math::bessel_j0;
+use yarnsim::mpm::timestep::wave_speed;
 use yarnsim::mpm::YarnSim;
 use yarnsim::scene::{
     GridSpec, Material, PinSpec, TimeSpec, TransferScheme, TransferSpec, WallMode, Walls, YarnEnd,
@@ -66,22 +68,6 @@ pub const DT_LADDER_GRID: u32 = 32;
 pub const REPEAT_BELOW_S: f64 = 0.5;
 /// Relative error levels of the summary.
 pub const LEVELS: [f64; 3] = [1e-1, 1e-2, 1e-3];
-
-/// `J0(x)` by its power series `sum_k (-1)^k (x/2)^(2k) / (k!)^2` (to
-/// round-off for `|x| <= 10`).
-pub fn bessel_j0(x: f64) -> f64 {
-    let q = -(x * x) / 4.0;
-    let mut term = 1.0;
-    let mut sum = 1.0;
-    for k in 1..60 {
-        term *= q / (k * k) as f64;
-        sum += term;
-        if term.abs() < 1e-17 * sum.abs().max(1e-300) {
-            break;
-        }
-    }
-    sum
-}
 
 /// The oracle: first angular frequency (rad/s) of the uniform inextensible
 /// chain of length `l` hanging in gravity `g`.
@@ -204,12 +190,6 @@ pub fn chain_material() -> Material {
         density: DENSITY,
         plasticity: false,
     }
-}
-
-/// Elastic wave speed `sqrt(max(k, gamma, 2 mu + lambda) / rho)` of the material.
-pub fn wave_speed(m: &Material) -> f64 {
-    let normal = 2.0 * m.mu() + m.lambda();
-    (m.k.max(m.gamma).max(normal) / m.density).sqrt()
 }
 
 /// `dt = CFL dx / c` at `resolution`^2 on the unit domain.

@@ -11,7 +11,7 @@
 use nalgebra::Vector3;
 use serde::{Deserialize, Deserializer, Serialize};
 
-use crate::scene::error::{from_toml_error, line_of, SceneError};
+use crate::scene::error::{from_toml_error, table_line, SceneError};
 
 /// 3-vector of f64 used throughout the mass-spring model.
 pub type V3 = Vector3<f64>;
@@ -374,9 +374,7 @@ impl Layout {
     }
 
     fn build_with_source(&self, text: Option<&str>) -> Result<System, SceneError> {
-        let table_line = |header: &str, i: usize| {
-            text.and_then(|t| t.match_indices(header).nth(i).map(|(p, _)| line_of(t, p)))
-        };
+        let table_line = |header: &str, i: usize| table_line(text, header, i);
         let key_line = |key: &str| {
             text.and_then(|t| {
                 t.lines()

@@ -97,10 +97,6 @@ impl Pin {
     }
 }
 
-fn origin_first(vertices: &[usize], p: &Particles) -> Vec2 {
-    p.vert.x[vertices[0]]
-}
-
 /// The pins of a scene over its particles (validated).
 pub fn pins_of_scene(scene: &YarnScene, p: &Particles) -> Result<Vec<Pin>, SceneError> {
     let ranges = scene.pin_ranges()?;
@@ -111,7 +107,7 @@ pub fn pins_of_scene(scene: &YarnScene, p: &Particles) -> Result<Vec<Pin>, Scene
         .map(|(spec, (yarn, r))| {
             let base = p.yarn_vertices[yarn];
             let vertices: Vec<usize> = r.map(|i| base + i).collect();
-            let origin = vertices.iter().map(|&i| p.vert.x[i]).collect();
+            let origin: Vec<Vec2> = vertices.iter().map(|&i| p.vert.x[i]).collect();
             let motion = match spec.motion {
                 PinMotionKind::Fixed => PinMotion::Fixed,
                 PinMotionKind::Line => PinMotion::Line {
@@ -122,7 +118,7 @@ pub fn pins_of_scene(scene: &YarnScene, p: &Particles) -> Result<Vec<Pin>, Scene
                     omega: spec.angular_velocity.expect("validated"),
                 },
                 PinMotionKind::Input => PinMotion::Input {
-                    position: origin_first(&vertices, p),
+                    position: origin[0],
                     velocity: Vec2::zeros(),
                     since: 0.0,
                 },
@@ -237,25 +233,34 @@ pub fn constrain_grid(
     }
 }
 
-/// Puts every pinned vertex at its target at time `t` (position, velocity
-/// and the prescribed velocity gradient as its affine matrix: a FLIP
+/// Puts `pin`'s vertices at their targets at time `t` (position, velocity
+/// and the prescribed velocity gradient as their affine matrix: a FLIP
 /// vertex would otherwise keep adding the grid's change of `C` to a `C`
-/// that nothing resets, which diverges within 0.02 s at a pinned yarn end)
-/// and adds to `reactions[k]`, per pin, the force this exerted on the yarn
-/// over the last substep of length `dt`: `sum m (v_target - v) / dt` over
-/// its vertices, with `v` the velocity the vertex had from the grid.
+/// that nothing resets, which diverges within 0.02 s at a pinned yarn end);
+/// with `dt`, returns the force this exerted over a substep of that length,
+/// `sum m (v_target - v) / dt`.
+fn set_to_target(pin: &Pin, vert: &mut Vertices, t: f64, dt: Option<f64>) -> Vec2 {
+    let c = pin.velocity_gradient();
+    let mut force = Vec2::zeros();
+    for (k, &i) in pin.vertices.iter().enumerate() {
+        let (x, v) = pin.target(k, t);
+        if let Some(dt) = dt {
+            force += (v - vert.v[i]) * (vert.m[i] / dt);
+        }
+        vert.x[i] = x;
+        vert.v[i] = v;
+        vert.c[i] = c;
+    }
+    force
+}
+
+/// Puts every pinned vertex at its target at time `t` and adds to
+/// `reactions[k]`, per pin, the force this exerted on the yarn over the last
+/// substep of length `dt`: `sum m (v_target - v) / dt` over its vertices,
+/// with `v` the velocity the vertex had from the grid.
 pub fn apply(pins: &[Pin], vert: &mut Vertices, t: f64, dt: f64, reactions: &mut [Vec2]) {
     for (pin, reaction) in pins.iter().zip(reactions.iter_mut()) {
-        let mut force = Vec2::zeros();
-        let c = pin.velocity_gradient();
-        for (k, &i) in pin.vertices.iter().enumerate() {
-            let (x, v) = pin.target(k, t);
-            force += (v - vert.v[i]) * (vert.m[i] / dt);
-            vert.x[i] = x;
-            vert.v[i] = v;
-            vert.c[i] = c;
-        }
-        *reaction += force;
+        *reaction += set_to_target(pin, vert, t, Some(dt));
     }
 }
 
@@ -263,12 +268,6 @@ pub fn apply(pins: &[Pin], vert: &mut Vertices, t: f64, dt: f64, reactions: &mut
 /// a reaction (at the start, or after the state was set from outside).
 pub fn place(pins: &[Pin], vert: &mut Vertices, t: f64) {
     for pin in pins {
-        let c = pin.velocity_gradient();
-        for (k, &i) in pin.vertices.iter().enumerate() {
-            let (x, v) = pin.target(k, t);
-            vert.x[i] = x;
-            vert.v[i] = v;
-            vert.c[i] = c;
-        }
+        set_to_target(pin, vert, t, None);
     }
 }

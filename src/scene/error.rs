@@ -69,6 +69,12 @@ impl fmt::Display for SceneError {
 impl std::error::Error for SceneError {}
 
 /// 1-based line of byte offset `pos` in `text`.
+/// Line of the `i`-th `header` table (e.g. `[[yarns]]`) in `text`, when
+/// there is a text and it has that many.
+pub(crate) fn table_line(text: Option<&str>, header: &str, i: usize) -> Option<usize> {
+    text.and_then(|t| t.match_indices(header).nth(i).map(|(p, _)| line_of(t, p)))
+}
+
 pub fn line_of(text: &str, pos: usize) -> usize {
     text.as_bytes()[..pos.min(text.len())]
         .iter()

@@ -4,16 +4,11 @@
 //! 0.01 s; a cloth inside its sphere reached a strain of 28). The errors name
 //! both objects and the distances that triggered them.
 
-use super::error::{line_of, SceneError};
+use super::error::{table_line, SceneError};
 use super::yarn::YarnScene;
 use crate::massspring::layout::SphereSpec;
 use crate::massspring::V3;
 use crate::math::Vec2;
-
-/// Line of the `i`-th `header` table in `text`, when there is a text.
-fn table_line(text: Option<&str>, header: &str, i: usize) -> Option<usize> {
-    text.and_then(|t| t.match_indices(header).nth(i).map(|(p, _)| line_of(t, p)))
-}
 
 /// Distance from `c` to the segment `a`-`b`.
 fn segment_distance(c: Vec2, a: Vec2, b: Vec2) -> f64 {

@@ -4,7 +4,7 @@
 
 use serde::{Deserialize, Deserializer, Serialize};
 
-use super::error::{from_toml_error, line_of, SceneError};
+use super::error::{from_toml_error, table_line, SceneError};
 use crate::math::Vec2;
 
 /// A complete yarn-bundle scene. See the README section "Scene files" for
@@ -361,20 +361,8 @@ impl YarnScene {
     }
 
     fn validate_with_source(&self, text: Option<&str>) -> Result<(), SceneError> {
-        let yarn_line = |i: usize| {
-            text.and_then(|t| {
-                t.match_indices("[[yarns]]")
-                    .nth(i)
-                    .map(|(p, _)| line_of(t, p))
-            })
-        };
-        let obstacle_line = |i: usize| {
-            text.and_then(|t| {
-                t.match_indices("[[obstacles]]")
-                    .nth(i)
-                    .map(|(p, _)| line_of(t, p))
-            })
-        };
+        let yarn_line = |i: usize| table_line(text, "[[yarns]]", i);
+        let obstacle_line = |i: usize| table_line(text, "[[obstacles]]", i);
         if self.yarns.is_empty() {
             return Err(SceneError::Invalid {
                 field: "yarns".into(),
@@ -498,13 +486,7 @@ impl YarnScene {
     }
 
     fn validate_pins(&self, text: Option<&str>) -> Result<(), SceneError> {
-        let pin_line = |i: usize| {
-            text.and_then(|t| {
-                t.match_indices("[[pins]]")
-                    .nth(i)
-                    .map(|(p, _)| line_of(t, p))
-            })
-        };
+        let pin_line = |i: usize| table_line(text, "[[pins]]", i);
         let mut seen: Vec<(usize, std::ops::Range<usize>)> = Vec::new();
         for (i, p) in self.pins.iter().enumerate() {
             let (y, r) = self.pin_range(p).map_err(|message| SceneError::Invalid {
