@@ -55,7 +55,7 @@ vertices = 40
     p.quad.refresh_frames(); // d was set by hand
     grid_to_particle::quad_stress(&mut p.quad, &geom, &energy);
     let mut grid = Grid::new(geom);
-    particle_to_grid::scatter(p, &mut grid, 1.0, kb, &[], false); // v = 0, C = 0: momentum = 1 * force
+    particle_to_grid::scatter(p, &mut grid, 1.0, kb, &[]); // v = 0, C = 0: momentum = 1 * force
     let p = sim.particles();
 
     let total_energy = |node: (usize, usize), axis: usize, eps: f64| -> f64 {
@@ -452,9 +452,11 @@ fn bad_inputs_are_rejected() {
 }
 
 #[test]
-fn simd_and_portable_kernels_give_the_same_bits() {
+fn every_kernel_width_gives_the_same_bits() {
     // The reference scene's setting (obstacles, walls, plasticity, bending),
-    // smaller: the wide (AVX2) and portable kernels must agree exactly.
+    // smaller: the AVX-512, AVX2 and portable kernels must agree exactly,
+    // under both transfer schemes (widths the CPU lacks fall back to the
+    // next narrower, so they compare equal trivially).
     let mut scene = match yarnsim::scene::builtin("yarn-reference") {
         Some(yarnsim::Scene::Yarn(s)) => s,
         _ => unreachable!(),
@@ -462,14 +464,26 @@ fn simd_and_portable_kernels_give_the_same_bits() {
     scene.yarns.truncate(1);
     scene.yarns[0].count = 3;
     scene.attractor.active = true;
-    let run = |portable: bool| {
-        simd::set_portable_kernels(portable);
-        let mut sim = YarnSim::new(&scene).unwrap();
-        sim.steps_n(300).unwrap();
-        simd::set_portable_kernels(false);
-        sim.save_state()
-    };
-    assert!(run(true) == run(false));
+    for transfer in [
+        yarnsim::scene::TransferScheme::Flip,
+        yarnsim::scene::TransferScheme::Apic,
+    ] {
+        scene.transfer.scheme = transfer;
+        let run = |k: simd::Kernels| {
+            simd::set_widest_kernels(k);
+            let mut sim = YarnSim::new(&scene).unwrap();
+            sim.steps_n(300).unwrap();
+            simd::set_widest_kernels(simd::Kernels::Avx512);
+            sim.save_state()
+        };
+        let portable = run(simd::Kernels::Portable);
+        assert!(portable == run(simd::Kernels::Avx2), "{transfer:?}: AVX2");
+        assert!(
+            portable == run(simd::Kernels::Avx512),
+            "{transfer:?}: AVX-512"
+        );
+    }
+    eprintln!("widest kernels on this CPU: {:?}", simd::kernels());
 }
 
 /// A yarn hanging from a pinned top vertex under FLIP stays bounded: the

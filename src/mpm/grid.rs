@@ -13,12 +13,15 @@ const BLOCK_SHIFT: usize = 3;
 /// Number of scatter chunks (fixed for determinism).
 pub const CHUNKS: usize = 4;
 
-/// One node of a scatter buffer: momentum including the impulse of the
-/// internal forces `[PX, PY]`, mass `M` and the mass of particles touching
-/// an obstacle `MC`: one 32-byte SIMD register. The impulse alone (needed
-/// only by the FLIP transfer, for the grid velocity before the forces) is
-/// kept beside it in [`ScatterBuffer::impulse`], `[FX, FY]`.
-pub type P2gNode = [f64; 4];
+/// One node of a scatter buffer, one cache line (one AVX-512 register, two
+/// AVX2 ones): momentum including the impulse of the internal forces
+/// `[PX, PY]`, mass `M`, the mass of particles touching an obstacle `MC`,
+/// and the impulse `dt f` alone `[FX, FY]` (read only by the FLIP transfer,
+/// for the grid velocity before the forces; APIC leaves it zero). Two lanes
+/// pad the node to 64 bytes.
+pub type P2gNode = [f64; P2G_LANES];
+/// Lanes of a [`P2gNode`].
+pub const P2G_LANES: usize = 8;
 /// Lane of the x momentum in a [`P2gNode`].
 pub const PX: usize = 0;
 /// Lane of the y momentum.
@@ -27,10 +30,10 @@ pub const PY: usize = 1;
 pub const M: usize = 2;
 /// Lane of the mass of particles in contact with an obstacle.
 pub const MC: usize = 3;
-/// Lane of the x impulse `dt f` in [`ScatterBuffer::impulse`].
-pub const FX: usize = 0;
+/// Lane of the x impulse `dt f`.
+pub const FX: usize = 4;
 /// Lane of the y impulse.
-pub const FY: usize = 1;
+pub const FY: usize = 5;
 
 /// One node of the summed grid after the grid update: the new velocity
 /// `[VX, VY]` and its change over the substep `[DVX, DVY]` (forces, gravity,
@@ -109,13 +112,11 @@ impl GridGeom {
     }
 }
 
-/// One chunk's scatter target: momentum and mass per node,
-/// plus the blocks it touched (see [`P2gNode`]).
+/// One chunk's scatter target: a [`P2gNode`] per node, plus the blocks it
+/// touched.
 #[derive(Clone, Debug)]
 pub struct ScatterBuffer {
     pub node: Vec<P2gNode>,
-    /// The impulse `dt f` alone per node (FLIP only; empty until first used).
-    pub impulse: Vec<[f64; 2]>,
     pub touched: Vec<bool>,
     pub touched_list: Vec<u32>,
 }
@@ -123,29 +124,16 @@ pub struct ScatterBuffer {
 impl ScatterBuffer {
     pub fn new(geom: &GridGeom) -> Self {
         ScatterBuffer {
-            node: vec![[0.0; 4]; geom.storage()],
-            impulse: Vec::new(),
+            node: vec![[0.0; P2G_LANES]; geom.storage()],
             touched: vec![false; geom.blocks()],
             touched_list: Vec::new(),
         }
     }
 
-    /// Zeroes the blocks touched last time and forgets them; with
-    /// `impulse`, also (allocates and) zeroes the impulse lanes.
-    pub fn clear(&mut self, geom: &GridGeom, impulse: bool) {
-        if impulse && self.impulse.len() != self.node.len() {
-            self.impulse = vec![[0.0; 2]; self.node.len()];
-        }
-        let impulse = impulse || !self.impulse.is_empty();
+    /// Forgets the blocks touched last time (the grid update zeroed their
+    /// nodes as it summed them).
+    pub fn clear(&mut self) {
         for &b in &self.touched_list {
-            let (bi, bj) = (b as usize / geom.nb, b as usize % geom.nb);
-            for r in 0..BLOCK {
-                let start = ((bi << BLOCK_SHIFT) + r) * geom.stride + (bj << BLOCK_SHIFT);
-                self.node[start..start + BLOCK].fill([0.0; 4]);
-                if impulse {
-                    self.impulse[start..start + BLOCK].fill([0.0; 2]);
-                }
-            }
             self.touched[b as usize] = false;
         }
         self.touched_list.clear();

@@ -8,7 +8,9 @@
 use rayon::prelude::*;
 
 use super::contact::{obstacle_velocity, wall_velocity};
-use super::grid::{Grid, GridGeom, Node, ScatterBuffer, BLOCK, CHUNKS, FX, FY, M, MC, PX, PY};
+use super::grid::{
+    Grid, GridGeom, Node, P2gNode, ScatterBuffer, BLOCK, CHUNKS, FX, FY, M, MC, P2G_LANES, PX, PY,
+};
 use super::simd::multiversion;
 use crate::math::Vec2;
 use crate::scene::{Obstacle, WallMode};
@@ -24,21 +26,38 @@ pub struct GridForces<'a> {
     pub wall_cells: usize,
 }
 
+/// One band (block row) of a scatter buffer, as the grid update reads and
+/// zeroes it: its nodes and the buffer's touched flags.
+struct BandSrc<'a> {
+    node: &'a mut [P2gNode],
+    touched: &'a [bool],
+}
+
 /// Pass 2 (see the module documentation). `flip`: also store each node's
 /// velocity change (the buffers then hold the impulse alone, see
-/// [`super::particle_to_grid::scatter`]).
+/// [`super::particle_to_grid::scatter`]). The scatter buffers are consumed:
+/// each node is zeroed as it is summed, ready for the next scatter (so no
+/// separate clearing pass walks them again).
 pub fn grid_update(grid: &mut Grid, dt: f64, ext: &GridForces, flip: bool) {
     let geom = grid.geom;
-    let buffers = &grid.buffers;
+    let band_len = geom.stride * BLOCK;
+    let mut bands: Vec<Vec<BandSrc>> = (0..geom.nb).map(|_| Vec::with_capacity(CHUNKS)).collect();
+    for buf in grid.buffers.iter_mut() {
+        let ScatterBuffer { node, touched, .. } = buf;
+        for (band, node) in bands.iter_mut().zip(node.chunks_mut(band_len)) {
+            band.push(BandSrc { node, touched });
+        }
+    }
     let is_active = &grid.is_active;
     grid.node
-        .par_chunks_mut(geom.stride * BLOCK)
+        .par_chunks_mut(band_len)
+        .zip(bands)
         .enumerate()
-        .for_each(|(bi, band)| {
+        .for_each(|(bi, (band, mut srcs))| {
             if flip {
-                grid_band::<true>(bi, band, buffers, is_active, &geom, dt, ext)
+                grid_band::<true>(bi, band, &mut srcs, is_active, &geom, dt, ext)
             } else {
-                grid_band::<false>(bi, band, buffers, is_active, &geom, dt, ext)
+                grid_band::<false>(bi, band, &mut srcs, is_active, &geom, dt, ext)
             }
         });
 }
@@ -48,7 +67,7 @@ multiversion! {
     fn grid_band<const FLIP: bool>(
         bi: usize,
         band: &mut [Node],
-        buffers: &[ScatterBuffer],
+        buffers: &mut [BandSrc],
         is_active: &[bool],
         geom: &GridGeom,
         dt: f64,
@@ -65,11 +84,13 @@ multiversion! {
                 continue;
             }
             let (i0, j0) = (bi * BLOCK, bj * BLOCK);
-            let mut srcs: [&ScatterBuffer; CHUNKS] = [&buffers[0]; CHUNKS];
+            let mut srcs: [usize; CHUNKS] = [0; CHUNKS];
             let mut nsrc = 0;
-            for s in buffers.iter().filter(|s| s.touched[b]) {
-                srcs[nsrc] = s;
-                nsrc += 1;
+            for (k, s) in buffers.iter().enumerate() {
+                if s.touched[b] {
+                    srcs[nsrc] = k;
+                    nsrc += 1;
+                }
             }
             let srcs = &srcs[..nsrc];
             let lo = Vec2::new(i0 as f64, j0 as f64) * dx;
@@ -87,21 +108,15 @@ multiversion! {
             for r in 0..BLOCK {
                 let i = i0 + r;
                 let row = r * geom.stride + j0;
-                let gidx = bi * BLOCK * geom.stride + row;
                 for c in 0..BLOCK {
                     let j = j0 + c;
-                    let mut acc = [0.0; 4];
-                    let mut imp = [0.0; 2];
-                    for s in srcs {
-                        let n = &s.node[gidx + c];
-                        for l in 0..4 {
+                    let mut acc = [0.0; P2G_LANES];
+                    for &k in srcs {
+                        let n = &mut buffers[k].node[row + c];
+                        for l in 0..P2G_LANES {
                             acc[l] += n[l];
                         }
-                        if FLIP {
-                            let f = &s.impulse[gidx + c];
-                            imp[FX] += f[FX];
-                            imp[FY] += f[FY];
-                        }
+                        *n = [0.0; P2G_LANES];
                     }
                     let out = &mut band[row + c];
                     if acc[M] <= 0.0 {
@@ -128,8 +143,8 @@ multiversion! {
                     }
                     *out = if FLIP {
                         let v_old = Vec2::new(
-                            (acc[PX] - imp[FX]) * inv_m,
-                            (acc[PY] - imp[FY]) * inv_m,
+                            (acc[PX] - acc[FX]) * inv_m,
+                            (acc[PY] - acc[FY]) * inv_m,
                         );
                         [v.x, v.y, v.x - v_old.x, v.y - v_old.y]
                     } else {

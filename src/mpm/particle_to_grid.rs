@@ -8,7 +8,9 @@
 
 use rayon::prelude::*;
 
-use super::grid::{Grid, GridGeom, ScatterBuffer, CHUNKS};
+use super::grid::{
+    Grid, GridGeom, P2gNode, ScatterBuffer, CHUNKS, FX, FY, M, MC, P2G_LANES, PX, PY,
+};
 use super::particles::{Particles, Quads, Vertices};
 use super::simd::{chunk_range, multiversion};
 use super::vertex_forces::vertex_forces;
@@ -20,55 +22,61 @@ use crate::scene::Obstacle;
 /// inside it) counts as touching it: its grid weight gets Coulomb friction.
 pub const CONTACT_CELLS: f64 = 0.5;
 
-/// What one particle adds to the grid: node `i` of the stencil gets mass
-/// `w_i m`, momentum `w_i (p0 + A (x_i - x_p) / dx)` and, for FLIP, the
-/// impulse `w_i (f0 + Af (x_i - x_p) / dx)` alone (`p0`, `A` include it).
+/// What one particle adds to the grid, as an affine function of the node
+/// offset `o = (x_i - x_p) / dx`: node `i` of the stencil gets
+/// `w_i (base + o.x cx + o.y cy)` in every lane of its [`P2gNode`]: mass
+/// `m`, contact mass `mc`, momentum `p0 + A o` (including the impulse) and
+/// the impulse `f0 + Af o` alone.
 struct Splat {
-    m: f64,
-    /// Mass in contact with an obstacle (`m` or 0).
-    mc: f64,
-    p0: Vec2,
-    a: Mat2,
-    f0: Vec2,
-    af: Mat2,
+    base: P2gNode,
+    cx: P2gNode,
+    cy: P2gNode,
+}
+
+impl Splat {
+    /// From mass `m`, contact mass `mc`, momentum `p0` and affine momentum
+    /// `a` (impulse included), impulse `f0` and affine impulse `af`.
+    #[inline(always)]
+    fn new(m: f64, mc: f64, p0: Vec2, a: Mat2, f0: Vec2, af: Mat2) -> Self {
+        let mut s = Splat {
+            base: [0.0; P2G_LANES],
+            cx: [0.0; P2G_LANES],
+            cy: [0.0; P2G_LANES],
+        };
+        s.base[PX] = p0.x;
+        s.base[PY] = p0.y;
+        s.base[M] = m;
+        s.base[MC] = mc;
+        s.base[FX] = f0.x;
+        s.base[FY] = f0.y;
+        s.cx[PX] = a[(0, 0)];
+        s.cx[PY] = a[(1, 0)];
+        s.cx[FX] = af[(0, 0)];
+        s.cx[FY] = af[(1, 0)];
+        s.cy[PX] = a[(0, 1)];
+        s.cy[PY] = a[(1, 1)];
+        s.cy[FX] = af[(0, 1)];
+        s.cy[FY] = af[(1, 1)];
+        s
+    }
 }
 
 #[inline(always)]
-fn splat<const FLIP: bool>(buf: &mut ScatterBuffer, geom: &GridGeom, st: &Stencil, s: &Splat) {
+fn splat(buf: &mut ScatterBuffer, geom: &GridGeom, st: &Stencil, s: &Splat) {
     buf.touch_stencil(geom, st.base);
-    let (a, af) = (&s.a, &s.af);
     let oy = [-st.fx[1], 1.0 - st.fx[1], 2.0 - st.fx[1]];
-    let ay = [a[(0, 1)] * oy[0], a[(0, 1)] * oy[1], a[(0, 1)] * oy[2]];
-    let by = [a[(1, 1)] * oy[0], a[(1, 1)] * oy[1], a[(1, 1)] * oy[2]];
-    let fay = [af[(0, 1)] * oy[0], af[(0, 1)] * oy[1], af[(0, 1)] * oy[2]];
-    let fby = [af[(1, 1)] * oy[0], af[(1, 1)] * oy[1], af[(1, 1)] * oy[2]];
     let (bi, bj) = (st.base[0] as usize, st.base[1] as usize);
     for i in 0..3 {
         let ox = i as f64 - st.fx[0];
-        let rx = s.p0.x + a[(0, 0)] * ox;
-        let ry = s.p0.y + a[(1, 0)] * ox;
-        let (fx, fy) = if FLIP {
-            (s.f0.x + af[(0, 0)] * ox, s.f0.y + af[(1, 0)] * ox)
-        } else {
-            (0.0, 0.0)
-        };
+        let rb: P2gNode = std::array::from_fn(|l| s.base[l] + s.cx[l] * ox);
         let wi = st.w[0][i];
         let start = geom.index(bi + i, bj);
-        let row = &mut buf.node[start..start + 3];
+        let row: &mut [P2gNode; 3] = (&mut buf.node[start..start + 3]).try_into().unwrap();
         for j in 0..3 {
             let w = wi * st.w[1][j];
             let n = &mut row[j];
-            let add: [f64; 4] = [rx + ay[j], ry + by[j], s.m, s.mc];
-            for l in 0..4 {
-                n[l] += w * add[l];
-            }
-        }
-        if FLIP {
-            let row = &mut buf.impulse[start..start + 3];
-            for j in 0..3 {
-                let w = wi * st.w[1][j];
-                row[j][0] += w * (fx + fay[j]);
-                row[j][1] += w * (fy + fby[j]);
+            for l in 0..P2G_LANES {
+                n[l] += w * (rb[l] + s.cy[l] * oy[j]);
             }
         }
     }
@@ -112,15 +120,9 @@ fn split_chunks<T>(v: &mut [T], n: usize) -> Vec<&mut [T]> {
 /// force. Vertex stencils and forces are computed here, chunk by chunk;
 /// quadrature stencils and stress come from the previous gather (or
 /// [`super::grid_to_particle::quad_stress`]). `flip` keeps the impulse
-/// alone too; `obstacles` are the ones whose contact mass is marked.
-pub fn scatter(
-    p: &mut Particles,
-    grid: &mut Grid,
-    dt: f64,
-    bending: f64,
-    obstacles: &[Obstacle],
-    flip: bool,
-) {
+/// alone too (in lanes that only FLIP reads); `obstacles` are the ones
+/// whose contact mass is marked.
+pub fn scatter(p: &mut Particles, grid: &mut Grid, dt: f64, bending: f64, obstacles: &[Obstacle]) {
     let geom = grid.geom;
     let (nv, nq) = (p.vert.x.len(), p.quad.x.len());
     // Each chunk writes the stencils and forces of its own vertex range
@@ -144,11 +146,7 @@ pub fn scatter(
         .enumerate()
         .for_each(|(k, ((buf, sts), fs))| {
             let (vr, qr) = (chunk_range(nv, k), chunk_range(nq, k));
-            if flip {
-                scatter_chunk::<true>(buf, sts, fs, vr, qr, &ctx)
-            } else {
-                scatter_chunk::<false>(buf, sts, fs, vr, qr, &ctx)
-            }
+            scatter_chunk(buf, sts, fs, vr, qr, &ctx)
         });
     p.vert.stencil = vert_stencils;
     p.vert.f = vert_forces;
@@ -158,7 +156,7 @@ pub fn scatter(
 multiversion! {
     /// Scatters vertices `vr` (writing their stencils to `sts` and forces to
     /// `fs`) and quadrature particles `qr` into one chunk's buffer.
-    fn scatter_chunk<const FLIP: bool>(
+    fn scatter_chunk(
         buf: &mut ScatterBuffer,
         sts: &mut [Stencil],
         fs: &mut [Vec2],
@@ -171,35 +169,25 @@ multiversion! {
         let margin = super::particle_to_grid::CONTACT_CELLS * dx;
         // the normal force per unit of (w_i (x_i - x_p) / dx . d2): -dt dE/dd2 4 / dx
         let normal_scale = -dt * 4.0 * geom.inv_dx;
-        buf.clear(geom, FLIP);
+        buf.clear();
         vertex_forces(vert, &quad.t1, ctx.bending, vr.clone(), fs);
         for ((i, st), f) in vr.zip(sts.iter_mut()).zip(fs.iter()) {
             *st = Stencil::new(vert.x[i], geom.inv_dx);
             let m = vert.m[i];
             let f0 = f * dt;
-            let s = Splat {
-                m,
-                mc: contact_mass(ctx.obstacles, margin, vert.x[i], m),
-                p0: vert.v[i] * m + f0,
-                a: vert.c[i] * (m * dx),
-                f0,
-                af: Mat2::zeros(),
-            };
-            splat::<FLIP>(buf, geom, st, &s);
+            let mc = contact_mass(ctx.obstacles, margin, vert.x[i], m);
+            let a = vert.c[i] * (m * dx);
+            let s = Splat::new(m, mc, vert.v[i] * m + f0, a, f0, Mat2::zeros());
+            splat(buf, geom, st, &s);
         }
         for q in qr {
             let m = quad.m[q];
             let d2 = quad.d[q].column(1).into_owned();
             let af = quad.t2[q] * normal_scale * d2.transpose();
-            let s = Splat {
-                m,
-                mc: contact_mass(ctx.obstacles, margin, quad.x[q], m),
-                p0: quad.v[q] * m,
-                a: quad.c[q] * (m * dx) + af,
-                f0: Vec2::zeros(),
-                af,
-            };
-            splat::<FLIP>(buf, geom, &quad.stencil[q], &s);
+            let mc = contact_mass(ctx.obstacles, margin, quad.x[q], m);
+            let a = quad.c[q] * (m * dx) + af;
+            let s = Splat::new(m, mc, quad.v[q] * m, a, Vec2::zeros(), af);
+            splat(buf, geom, &quad.stencil[q], &s);
         }
     }
 }

@@ -138,37 +138,31 @@ pub fn pins_of_scene(scene: &YarnScene, p: &Particles) -> Result<Vec<Pin>, Scene
 /// velocity is its target to round-off).
 const PIN_SWEEPS: usize = 200;
 
-/// Pin constraint on the grid after the grid update of the substep ending
-/// at time `t`: for each pinned vertex (stencil `st` of its start-of-step
-/// position, weights `w_i`, node masses `m_i`) the impulse
-/// `J = (v_target - sum w_i v_i) / sum (w_i^2 / m_i)` is added to its nodes
-/// as `w_i J / m_i` (to the velocity and, for FLIP, to its change), in
-/// Gauss-Seidel sweeps over all pinned vertices. Sets `forces[k]` to
-/// `sum J / dt` of pin `k`.
-pub fn constrain_grid(
-    pins: &[Pin],
-    vert: &Vertices,
-    grid: &mut Grid,
-    t: f64,
-    dt: f64,
-    forces: &mut Vec<Vec2>,
-) {
-    struct Entry {
-        pin: usize,
-        idx: [usize; 9],
-        w: [f64; 9],
-        /// `w_i / m_i` (0 where the node has no mass).
-        w_inv_m: [f64; 9],
-        denom: f64,
-        target: Vec2,
-    }
+/// One pinned vertex's stencil on the grid: node indices, weights, the
+/// weights over the node masses and the target velocity at the end of the
+/// substep (see [`constrain_grid`]).
+#[derive(Clone, Debug)]
+pub struct PinEntry {
+    pin: usize,
+    idx: [usize; 9],
+    w: [f64; 9],
+    /// `w_i / m_i` (0 where the node has no mass).
+    w_inv_m: [f64; 9],
+    denom: f64,
+    target: Vec2,
+}
+
+/// The stencils of every pinned vertex with the node masses of this
+/// substep's scatter: read after the scatter and before the grid update
+/// (which consumes the scatter buffers), for the substep ending at `t`.
+pub fn stencil_masses(pins: &[Pin], vert: &Vertices, grid: &Grid, t: f64) -> Vec<PinEntry> {
     let geom = grid.geom;
     let mut entries = Vec::new();
     for (k, pin) in pins.iter().enumerate() {
         for (j, &i) in pin.vertices.iter().enumerate() {
             let st = &vert.stencil[i];
             let (bi, bj) = (st.base[0] as usize, st.base[1] as usize);
-            let mut e = Entry {
+            let mut e = PinEntry {
                 pin: k,
                 idx: [0; 9],
                 w: [0.0; 9],
@@ -202,12 +196,29 @@ pub fn constrain_grid(
             }
         }
     }
+    entries
+}
+
+/// Pin constraint on the grid after the grid update of the substep: for
+/// each pinned vertex (the `entries` of [`stencil_masses`]: weights `w_i`
+/// of its start-of-step stencil, node masses `m_i`) the impulse
+/// `J = (v_target - sum w_i v_i) / sum (w_i^2 / m_i)` is added to its nodes
+/// as `w_i J / m_i` (to the velocity and, for FLIP, to its change), in
+/// Gauss-Seidel sweeps over all pinned vertices. Sets `forces[k]` to
+/// `sum J / dt` of pin `k` (`n_pins` pins).
+pub fn constrain_grid(
+    entries: &[PinEntry],
+    n_pins: usize,
+    grid: &mut Grid,
+    dt: f64,
+    forces: &mut Vec<Vec2>,
+) {
     forces.clear();
-    forces.resize(pins.len(), Vec2::zeros());
+    forces.resize(n_pins, Vec2::zeros());
     for _ in 0..PIN_SWEEPS {
         let mut worst: f64 = 0.0;
         let mut scale: f64 = 0.0;
-        for e in &entries {
+        for e in entries {
             let mut v = Vec2::zeros();
             for n in 0..9 {
                 let node = &grid.node[e.idx[n]];

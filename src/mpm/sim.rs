@@ -427,14 +427,7 @@ impl YarnSim {
             self.frames_stale = false;
         }
         let t1 = Instant::now();
-        particle_to_grid::scatter(
-            &mut self.particles,
-            &mut self.grid,
-            dt,
-            bending,
-            obstacles,
-            flip,
-        );
+        particle_to_grid::scatter(&mut self.particles, &mut self.grid, dt, bending, obstacles);
         let t2 = Instant::now();
         let ext = GridForces {
             gravity: self.gravity,
@@ -445,13 +438,17 @@ impl YarnSim {
             walls: self.scene.walls.mode,
             wall_cells: self.scene.walls.cells as usize,
         };
+        let pin_entries = if self.pins.is_empty() {
+            Vec::new()
+        } else {
+            pins::stencil_masses(&self.pins, &self.particles.vert, &self.grid, self.time + dt)
+        };
         grid_update::grid_update(&mut self.grid, dt, &ext, flip);
         if !self.pins.is_empty() {
             pins::constrain_grid(
-                &self.pins,
-                &self.particles.vert,
+                &pin_entries,
+                self.pins.len(),
                 &mut self.grid,
-                self.time + dt,
                 dt,
                 &mut self.pin_reactions,
             );

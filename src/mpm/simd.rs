@@ -1,46 +1,74 @@
-//! Kernel dispatch: every per-chunk kernel of the substep is compiled twice,
-//! for AVX2 + FMA (run when the CPU has them) and as built, with the same
-//! bits; plus the fixed chunking that keeps results independent of the
-//! number of threads.
+//! Kernel dispatch: every per-chunk kernel of the substep is compiled three
+//! times, for AVX-512 (F + VL, with AVX2 and FMA), for AVX2 + FMA, and as
+//! built, and runs the widest the CPU has; all three give the same bits.
+//! Plus the fixed chunking that keeps results independent of the number of
+//! threads.
 
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::{AtomicU8, Ordering};
 
 use super::grid::CHUNKS;
 
 /// Particles per parallel task in the gathers.
 pub(crate) const PAR_MIN: usize = 256;
 
-/// Set to run the portable kernels even where AVX2 is available.
-static PORTABLE_ONLY: AtomicBool = AtomicBool::new(false);
-
-/// Makes every simulation in the process use the portable kernels (`true`)
-/// or the AVX2 + FMA ones where the CPU has them (`false`, the default).
-/// Results are bitwise the same; this exists to test exactly that.
-pub fn set_portable_kernels(portable: bool) {
-    PORTABLE_ONLY.store(portable, Ordering::Relaxed);
+/// The kernel versions, narrowest first.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
+pub enum Kernels {
+    /// As built for the target (SSE2 on x86-64).
+    Portable = 0,
+    /// AVX2 + FMA.
+    Avx2 = 1,
+    /// AVX-512 F + VL (with AVX2 and FMA).
+    Avx512 = 2,
 }
 
-/// Whether the CPU runs the AVX2 + FMA versions of the kernels (detected
-/// once by std, cached).
+/// The widest kernels a simulation may use (tests lower it).
+static WIDEST: AtomicU8 = AtomicU8::new(Kernels::Avx512 as u8);
+
+/// Limits every simulation in the process to kernels no wider than `k`
+/// (default: [`Kernels::Avx512`], i.e. the widest the CPU has). Results are
+/// bitwise the same for every choice; this exists to test exactly that.
+pub fn set_widest_kernels(k: Kernels) {
+    WIDEST.store(k as u8, Ordering::Relaxed);
+}
+
+/// Same as `set_widest_kernels(Portable)` (`true`) or the default (`false`).
+pub fn set_portable_kernels(portable: bool) {
+    set_widest_kernels(if portable {
+        Kernels::Portable
+    } else {
+        Kernels::Avx512
+    });
+}
+
+/// The kernels this CPU runs, within the limit of [`set_widest_kernels`]
+/// (features detected once by std, cached).
 #[inline(always)]
-pub(crate) fn wide_simd() -> bool {
+pub fn kernels() -> Kernels {
+    let widest = WIDEST.load(Ordering::Relaxed);
     #[cfg(target_arch = "x86_64")]
     {
-        std::is_x86_feature_detected!("avx2")
-            && std::is_x86_feature_detected!("fma")
-            && !PORTABLE_ONLY.load(Ordering::Relaxed)
+        let avx2 = std::is_x86_feature_detected!("avx2") && std::is_x86_feature_detected!("fma");
+        if avx2
+            && widest >= Kernels::Avx512 as u8
+            && std::is_x86_feature_detected!("avx512f")
+            && std::is_x86_feature_detected!("avx512vl")
+        {
+            return Kernels::Avx512;
+        }
+        if avx2 && widest >= Kernels::Avx2 as u8 {
+            return Kernels::Avx2;
+        }
     }
-    #[cfg(not(target_arch = "x86_64"))]
-    {
-        false
-    }
+    let _ = widest;
+    Kernels::Portable
 }
 
 /// `multiversion! { fn name(args) -> R { body } }` defines `name`, whose body
-/// (an `#[inline(always)]` inner function) is compiled twice: for AVX2 + FMA,
-/// run when the CPU has them, and as built otherwise. Both give the same
-/// bits: Rust never contracts `a * b + c` into an FMA by itself, so only the
-/// register width differs.
+/// (an `#[inline(always)]` inner function) is compiled three times: for
+/// AVX-512 and for AVX2 + FMA, run when the CPU has them (see [`kernels`]),
+/// and as built otherwise. All give the same bits: Rust never contracts
+/// `a * b + c` into an FMA by itself, so only the register width differs.
 macro_rules! multiversion {
     ($(#[$m:meta])* fn $name:ident$(<$(const $cn:ident: $ct:ty),*>)?($($a:ident: $t:ty),* $(,)?) $(-> $r:ty)? $body:block) => {
         $(#[$m])*
@@ -49,13 +77,24 @@ macro_rules! multiversion {
             fn imp$(<$(const $cn: $ct),*>)?($($a: $t),*) $(-> $r)? $body
             #[cfg(target_arch = "x86_64")]
             {
+                #[target_feature(enable = "avx512f,avx512vl,avx2,fma")]
+                unsafe fn avx512$(<$(const $cn: $ct),*>)?($($a: $t),*) $(-> $r)? {
+                    imp$(::<$($cn),*>)?($($a),*)
+                }
                 #[target_feature(enable = "avx2,fma")]
                 unsafe fn wide$(<$(const $cn: $ct),*>)?($($a: $t),*) $(-> $r)? {
                     imp$(::<$($cn),*>)?($($a),*)
                 }
-                if $crate::mpm::simd::wide_simd() {
-                    // SAFETY: the CPU has the features `wide` is compiled for.
-                    return unsafe { wide$(::<$($cn),*>)?($($a),*) };
+                match $crate::mpm::simd::kernels() {
+                    // SAFETY: `kernels()` reports AVX-512 F + VL, AVX2 and FMA.
+                    $crate::mpm::simd::Kernels::Avx512 => {
+                        return unsafe { avx512$(::<$($cn),*>)?($($a),*) }
+                    }
+                    // SAFETY: `kernels()` reports AVX2 and FMA.
+                    $crate::mpm::simd::Kernels::Avx2 => {
+                        return unsafe { wide$(::<$($cn),*>)?($($a),*) }
+                    }
+                    $crate::mpm::simd::Kernels::Portable => {}
                 }
             }
             imp$(::<$($cn),*>)?($($a),*)
