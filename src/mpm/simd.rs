@@ -22,8 +22,20 @@ pub enum Kernels {
     Avx512 = 2,
 }
 
-/// The widest kernels a simulation may use (tests lower it).
-static WIDEST: AtomicU8 = AtomicU8::new(Kernels::Avx512 as u8);
+/// The widest kernels a simulation may use (tests lower it); 255 until
+/// first read, then the limit from `YARNSIM_KERNELS` or [`Kernels::Avx512`].
+static WIDEST: AtomicU8 = AtomicU8::new(u8::MAX);
+
+/// The limit the environment sets: `YARNSIM_KERNELS=portable|avx2|avx512`
+/// (for benchmarks that compare kernel widths; unset means the widest).
+fn widest_from_env() -> u8 {
+    let k = match std::env::var("YARNSIM_KERNELS").as_deref() {
+        Ok("portable") => Kernels::Portable,
+        Ok("avx2") => Kernels::Avx2,
+        _ => Kernels::Avx512,
+    };
+    k as u8
+}
 
 /// Limits every simulation in the process to kernels no wider than `k`
 /// (default: [`Kernels::Avx512`], i.e. the widest the CPU has). Results are
@@ -45,7 +57,12 @@ pub fn set_portable_kernels(portable: bool) {
 /// (features detected once by std, cached).
 #[inline(always)]
 pub fn kernels() -> Kernels {
-    let widest = WIDEST.load(Ordering::Relaxed);
+    let mut widest = WIDEST.load(Ordering::Relaxed);
+    if widest == u8::MAX {
+        widest = widest_from_env();
+        // a concurrent `set_widest_kernels` wins
+        let _ = WIDEST.compare_exchange(u8::MAX, widest, Ordering::Relaxed, Ordering::Relaxed);
+    }
     #[cfg(target_arch = "x86_64")]
     {
         let avx2 = std::is_x86_feature_detected!("avx2") && std::is_x86_feature_detected!("fma");
