@@ -742,18 +742,18 @@ impl FmuModel for YarnModel {
     fn outputs_finite(&mut self) -> bool {
         YarnModel::outputs_finite(self)
     }
-    /// The library's state bytes: a clone of the whole `YarnSim` with its
-    /// grid costs far more than its particles.
+    /// The library's dynamic state (`YarnSim::dynamic_state`: particles,
+    /// clock, inputs; not the grid) and the pin force sums.
     fn checkpoint(&self) -> Checkpoint {
-        Box::new((self.sim.save_state(), self.forces.clone()))
+        Box::new((self.sim.dynamic_state(), self.forces.clone()))
     }
     fn restore(&mut self, c: Checkpoint) {
-        let (bytes, forces) = *c
-            .downcast::<(Vec<u8>, PinForces)>()
+        let (state, forces) = *c
+            .downcast::<(DynamicState, PinForces)>()
             .expect("a checkpoint of a yarn model");
         self.sim
-            .load_state(&bytes)
-            .expect("the simulation's own state bytes load");
+            .set_dynamic_state(&state)
+            .expect("the simulation's own dynamic state fits it");
         self.forces = forces;
         self.diag = None;
     }
