@@ -62,6 +62,12 @@ pub struct SetContext<'a> {
 /// ([`FmuModel::checkpoint`]); only the model that made it reads it.
 pub type Checkpoint = Box<dyn Any + Send>;
 
+/// A model's part of an FMU state (`fmi2GetFMUstate`,
+/// [`FmuModel::save`]): what determines its future outputs, bit for bit
+/// (the simulated state, inputs, parameters), never scratch such as the
+/// MPM grid; only a model of the kind that made it reads it.
+pub type ModelState = Box<dyn Any + Send>;
+
 /// A model behind the FMU: its outputs, inputs and parameters by value
 /// reference, its substeps and its part of the FMU state.
 pub trait FmuModel: fmt::Debug + Send {
@@ -113,13 +119,22 @@ pub trait FmuModel: fmt::Debug + Send {
         check: ParamCheck,
         ctx: &SetContext,
     ) -> ModelResult<bool>;
-    /// This model's part of a serialized FMU state.
-    fn write(&self, w: &mut Writer);
-    /// Reads what [`Self::write`] wrote into a model of the same kind;
+    /// This model's part of an FMU state (`fmi2GetFMUstate`).
+    fn save(&self) -> ModelState;
+    /// Puts back a [`Self::save`] of a model of this kind (`fmi2SetFMUstate`),
+    /// reusing this model's simulation where the state's scene and
+    /// parameters are those it was built from. A refused state changes
+    /// nothing.
+    fn load(&mut self, s: &ModelState) -> ModelResult;
+    /// A saved state's part of a serialized FMU state; `self` (the
+    /// instance's current model) may lend what the state shares with its
+    /// scene.
+    fn write(&self, s: &ModelState, w: &mut Writer) -> Result<(), String>;
+    /// Reads what [`Self::write`] wrote into a state of this model's kind;
     /// `self` (with `built`: its simulation matches its scene and
-    /// parameters) is reused where the stored scene and parameters match.
-    fn read(&self, r: &mut Reader, built: bool, count: usize) -> Result<Box<dyn FmuModel>, String>;
-    /// A boxed copy (FMU state snapshots).
+    /// parameters) is used where the stored scene and parameters match.
+    fn read(&self, r: &mut Reader, built: bool, count: usize) -> Result<ModelState, String>;
+    /// A boxed copy.
     fn box_clone(&self) -> Box<dyn FmuModel>;
 }
 

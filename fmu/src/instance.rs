@@ -10,7 +10,7 @@ use std::ffi::{c_int, c_void, CString};
 use std::path::PathBuf;
 
 pub use crate::fmu_model::{
-    new_model, FmuModel, ModelError, ModelResult, ParamCheck, SetContext, StepFailure,
+    new_model, FmuModel, ModelError, ModelResult, ModelState, ParamCheck, SetContext, StepFailure,
 };
 pub use crate::logging::*;
 use crate::resources::read_scene;
@@ -23,8 +23,9 @@ use crate::model::{
     VR_MAX_SUBSTEPS, VR_SUBSTEPS, VR_THREADS,
 };
 
-/// Everything an FMU state holds: what `fmi2GetFMUstate` copies and
-/// `fmi2Reset` rebuilds.
+/// The simulation and the wrapper's time keeping: what `fmi2Reset`
+/// rebuilds. An FMU state holds its [`Clock`] and the model's
+/// [`FmuModel::save`].
 #[derive(Clone, Debug)]
 pub struct Model {
     pub physics: Box<dyn FmuModel>,
@@ -45,7 +46,43 @@ pub struct Model {
     pub outputs_checked: bool,
 }
 
+/// The wrapper's time keeping and flags, as an FMU state holds them.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Clock {
+    pub dirty: bool,
+    pub start_time: f64,
+    pub stop_time: Option<f64>,
+    pub time: f64,
+    pub last_successful_time: f64,
+    pub substeps: u64,
+    pub terminated: bool,
+}
+
 impl Model {
+    /// The time keeping and flags of an FMU state.
+    pub fn clock(&self) -> Clock {
+        Clock {
+            dirty: self.dirty,
+            start_time: self.start_time,
+            stop_time: self.stop_time,
+            time: self.time,
+            last_successful_time: self.last_successful_time,
+            substeps: self.substeps,
+            terminated: self.terminated,
+        }
+    }
+
+    fn set_clock(&mut self, c: &Clock) {
+        self.dirty = c.dirty;
+        self.start_time = c.start_time;
+        self.stop_time = c.stop_time;
+        self.time = c.time;
+        self.last_successful_time = c.last_successful_time;
+        self.substeps = c.substeps;
+        self.terminated = c.terminated;
+        self.outputs_checked = false;
+    }
+
     fn new(scene: &FmuScene) -> Res<Self> {
         Ok(Model {
             physics: new_model(scene)?,
@@ -606,35 +643,51 @@ impl Instance {
         })
     }
 
+    /// Saves the clock and the model's dynamic state (no scratch such as
+    /// the MPM grid), into `into` or a new snapshot.
     pub fn get_fmu_state(&mut self, into: Option<&mut Snapshot>) -> Res<Option<Box<Snapshot>>> {
         self.require("fmi2GetFMUstate")?;
-        // A snapshot always holds a simulation built from its parameters.
+        // A snapshot always holds the state of a simulation built from its
+        // parameters.
         self.model.ensure_built(self.count)?;
+        let physics = self.model.physics.save();
         match into {
             Some(s) => {
                 s.phase = self.phase;
-                s.model = self.model.clone();
+                s.clock = self.model.clock();
+                s.physics = physics;
+                s.kind = self.model.physics.state_magic();
+                s.count = self.count;
                 s.bytes = None;
                 Ok(None)
             }
             None => Ok(Some(Box::new(Snapshot {
                 magic: SNAPSHOT_MAGIC,
                 phase: self.phase,
-                model: self.model.clone(),
+                clock: self.model.clock(),
+                physics,
+                kind: self.model.physics.state_magic(),
+                count: self.count,
                 bytes: None,
             }))),
         }
     }
 
+    /// Puts a snapshot back: the model reuses its simulation (and its
+    /// scratch) when the snapshot's scene and parameters are those it was
+    /// built from, else builds one of them first.
     pub fn set_fmu_state(&mut self, s: &Snapshot) -> Res {
         self.require("fmi2SetFMUstate")?;
-        let same_kind = s.model.physics.state_magic() == self.model.physics.state_magic();
-        if !same_kind || s.model.physics.count() != self.count {
+        if s.kind != self.model.physics.state_magic() || s.count != self.count {
             return error(
                 "fmi2SetFMUstate: the state belongs to another FMU (other model or number of outputs)",
             );
         }
-        self.model = s.model.clone();
+        self.model
+            .physics
+            .load(&s.physics)
+            .or_else(|e| error(format!("fmi2SetFMUstate: {e}")))?;
+        self.model.set_clock(&s.clock);
         self.phase = s.phase;
         self.log(
             Status::Ok,
@@ -648,19 +701,30 @@ impl Instance {
     pub fn serialize<'a>(&self, func: &str, s: &'a mut Snapshot) -> Res<&'a [u8]> {
         self.require(func)?;
         if s.bytes.is_none() {
-            s.bytes = Some(serialize(s.phase, &s.model));
+            if s.kind != self.model.physics.state_magic() || s.count != self.count {
+                return error(format!(
+                    "{func}: the state belongs to another FMU (other model or number of outputs)"
+                ));
+            }
+            let bytes = serialize(s.phase, &s.clock, self.model.physics.as_ref(), &s.physics)
+                .or_else(|e| error(format!("{func}: {e}")))?;
+            s.bytes = Some(bytes);
         }
         Ok(s.bytes.as_deref().unwrap())
     }
 
     pub fn deserialize(&mut self, bytes: &[u8]) -> Res<Box<Snapshot>> {
         self.require("fmi2DeSerializeFMUstate")?;
-        let (phase, model) = deserialize(bytes, &self.model, self.count)
+        let m = &self.model;
+        let (phase, clock, physics) = deserialize(bytes, m.physics.as_ref(), !m.dirty, self.count)
             .or_else(|e| error(format!("fmi2DeSerializeFMUstate: {e}")))?;
         Ok(Box::new(Snapshot {
             magic: SNAPSHOT_MAGIC,
             phase,
-            model,
+            clock,
+            physics,
+            kind: m.physics.state_magic(),
+            count: self.count,
             bytes: Some(bytes.to_vec()),
         }))
     }

@@ -11,7 +11,7 @@
 use yarnsim::massspring::{Integrator, IntegratorOptions, Layout, Simulation, V3};
 
 use crate::fmu_model::{
-    refuse, Checkpoint, FmuModel, ModelResult, ParamCheck, SetContext, StepFailure,
+    refuse, Checkpoint, FmuModel, ModelResult, ModelState, ParamCheck, SetContext, StepFailure,
 };
 use crate::model::{input, output, parameter, Description, Start, VarSpec, VarType, Variable};
 use crate::state_bytes::{Reader, Writer};
@@ -485,10 +485,26 @@ impl FmuModel for MsModel {
     ) -> ModelResult<bool> {
         MsModel::set_string(self, vrs, vals, check)
     }
-    fn write(&self, w: &mut Writer) {
-        MsModel::write(self, w)
+    /// A clone of the model: the mass-spring simulation has no scratch
+    /// worth leaving out.
+    fn save(&self) -> ModelState {
+        Box::new(self.clone())
     }
-    fn read(&self, r: &mut Reader, built: bool, count: usize) -> Result<Box<dyn FmuModel>, String> {
+    fn load(&mut self, s: &ModelState) -> ModelResult {
+        let Some(s) = s.downcast_ref::<MsModel>() else {
+            return refuse("not the state of a mass-spring model");
+        };
+        self.clone_from(s);
+        Ok(())
+    }
+    fn write(&self, s: &ModelState, w: &mut Writer) -> Result<(), String> {
+        let s = s
+            .downcast_ref::<MsModel>()
+            .ok_or("not the state of a mass-spring model")?;
+        s.write(w);
+        Ok(())
+    }
+    fn read(&self, r: &mut Reader, built: bool, count: usize) -> Result<ModelState, String> {
         Ok(Box::new(MsModel::read(r, self, built, count)?))
     }
     fn box_clone(&self) -> Box<dyn FmuModel> {

@@ -1,19 +1,27 @@
-//! FMU states: the snapshots `fmi2GetFMUstate` hands out and their bytes
-//! (`fmi2SerializeFMUstate`): header, checksum, the wrapper's clock and the
-//! model's part, with a bounds-checked reader.
+//! FMU states: the snapshots `fmi2GetFMUstate` hands out (the wrapper's
+//! clock and the model's dynamic state, [`FmuModel::save`]; no scratch) and
+//! their bytes (`fmi2SerializeFMUstate`): header, checksum, the clock and
+//! the model's part, with a bounds-checked reader.
 
 use std::ffi::c_void;
 
 use yarnsim::mpm::state::fnv1a;
 
-use crate::instance::Model;
+use crate::fmu_model::{FmuModel, ModelState};
+use crate::instance::Clock;
 use crate::state_machine::Phase;
 
 /// A saved FMU state (`fmi2FMUstate`).
 pub struct Snapshot {
     pub(crate) magic: u64,
     pub(crate) phase: Phase,
-    pub(crate) model: Model,
+    pub(crate) clock: Clock,
+    /// The model's part ([`FmuModel::save`]).
+    pub(crate) physics: ModelState,
+    /// The state magic of the model that made it ([`FmuModel::state_magic`]).
+    pub(crate) kind: &'static [u8; 8],
+    /// Its number of output objects ([`FmuModel::count`]).
+    pub(crate) count: usize,
     /// Serialized form, made on first request.
     pub(crate) bytes: Option<Vec<u8>>,
 }
@@ -75,6 +83,18 @@ impl Writer {
     pub fn bytes(&mut self, b: &[u8]) {
         self.u64(b.len() as u64);
         self.0.extend_from_slice(b);
+    }
+    /// Like [`Self::bytes`] for the `len` bytes `write` appends (no copy).
+    pub fn bytes_with<E>(
+        &mut self,
+        len: usize,
+        write: impl FnOnce(&mut Vec<u8>) -> Result<(), E>,
+    ) -> Result<(), E> {
+        self.u64(len as u64);
+        let start = self.0.len();
+        write(&mut self.0)?;
+        assert_eq!(self.0.len() - start, len, "declared length of a byte field");
+        Ok(())
     }
 }
 
@@ -147,39 +167,56 @@ impl<'a> Reader<'a> {
 /// The FMU state as bytes: magic (one per model), version, body length,
 /// FNV-1a checksum of the body; the body holds the state machine state and
 /// the wrapper's time keeping, then the model's part ([`YarnModel::write`],
-/// [`MsModel::write`]). No pointers.
-pub fn serialize(phase: Phase, m: &Model) -> Vec<u8> {
-    let mut w = Writer(Vec::new());
+/// [`MsModel::write`]) of `physics`, a state saved by a model of the kind of
+/// `current` (the instance's model). No pointers.
+///
+/// [`YarnModel::write`]: crate::yarn::YarnModel::write
+/// [`MsModel::write`]: crate::massspring::MsModel::write
+pub fn serialize(
+    phase: Phase,
+    c: &Clock,
+    current: &dyn FmuModel,
+    physics: &ModelState,
+) -> Result<Vec<u8>, String> {
+    // The header goes in front once the body is written.
+    let mut w = Writer(vec![0; STATE_HEADER]);
     w.u8(phase.code());
-    w.u8(m.terminated as u8);
-    w.u8(m.dirty as u8);
-    w.f64(m.start_time);
-    w.opt_f64(m.stop_time);
-    w.f64(m.time);
-    w.f64(m.last_successful_time);
-    w.u64(m.substeps);
-    m.physics.write(&mut w);
-    let body = w.0;
-    let mut out = Vec::with_capacity(STATE_HEADER + body.len());
-    out.extend_from_slice(m.physics.state_magic());
-    out.extend_from_slice(&STATE_VERSION.to_le_bytes());
-    out.extend_from_slice(&(body.len() as u64).to_le_bytes());
-    out.extend_from_slice(&fnv1a(&body).to_le_bytes());
-    out.extend_from_slice(&body);
-    out
+    w.u8(c.terminated as u8);
+    w.u8(c.dirty as u8);
+    w.f64(c.start_time);
+    w.opt_f64(c.stop_time);
+    w.f64(c.time);
+    w.f64(c.last_successful_time);
+    w.u64(c.substeps);
+    current.write(physics, &mut w)?;
+    let mut out = w.0;
+    let body = out.len() - STATE_HEADER;
+    let sum = fnv1a(&out[STATE_HEADER..]);
+    out[..8].copy_from_slice(current.state_magic());
+    out[8..12].copy_from_slice(&STATE_VERSION.to_le_bytes());
+    out[12..20].copy_from_slice(&(body as u64).to_le_bytes());
+    out[20..28].copy_from_slice(&sum.to_le_bytes());
+    Ok(out)
 }
 
 /// Reads bytes written by [`serialize`] for an FMU of the same model with
-/// `count` outputs objects; `current`'s simulation is reused when its scene
-/// and parameters match, else it is rebuilt from the stored scene.
-pub fn deserialize(bytes: &[u8], current: &Model, count: usize) -> Result<(Phase, Model), String> {
+/// `count` outputs objects; `current` (with `built`: its simulation matches
+/// its scene and parameters) is used to check and decode the model's part
+/// when the stored scene and parameters match, else a simulation of the
+/// stored scene is built for that.
+pub fn deserialize(
+    bytes: &[u8],
+    current: &dyn FmuModel,
+    built: bool,
+    count: usize,
+) -> Result<(Phase, Clock, ModelState), String> {
     if bytes.len() < STATE_HEADER {
         return Err(format!(
             "state has {} bytes, at least {STATE_HEADER} needed",
             bytes.len()
         ));
     }
-    let magic = current.physics.state_magic();
+    let magic = current.state_magic();
     if &bytes[..8] != magic {
         let what = if STATE_MAGICS.iter().any(|m| &bytes[..8] == *m) {
             "is the state of the other kind of FMU"
@@ -216,25 +253,15 @@ pub fn deserialize(bytes: &[u8], current: &Model, count: usize) -> Result<(Phase
     }
     let terminated = r.bool()?;
     let dirty = r.bool()?;
-    let start_time = r.f64()?;
-    let stop_time = r.opt_f64()?;
-    let time = r.f64()?;
-    let last_successful_time = r.f64()?;
-    let substeps = r.u64()?;
-    let built = !current.dirty;
-    let physics = current.physics.read(&mut r, built, count)?;
-    Ok((
-        phase,
-        Model {
-            physics,
-            dirty,
-            start_time,
-            stop_time,
-            time,
-            last_successful_time,
-            substeps,
-            terminated,
-            outputs_checked: false,
-        },
-    ))
+    let clock = Clock {
+        dirty,
+        start_time: r.f64()?,
+        stop_time: r.opt_f64()?,
+        time: r.f64()?,
+        last_successful_time: r.f64()?,
+        substeps: r.u64()?,
+        terminated,
+    };
+    let physics = current.read(&mut r, built, count)?;
+    Ok((phase, clock, physics))
 }

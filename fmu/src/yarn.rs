@@ -5,11 +5,13 @@
 use std::path::Path;
 
 use yarnsim::math::Vec2;
+use yarnsim::mpm::state::DynamicState;
 use yarnsim::mpm::{Attractor, Diagnostics, SimError, YarnSim};
 use yarnsim::scene::{TransferScheme, YarnScene};
 
 use crate::fmu_model::{
-    refuse, Checkpoint, FmuModel, ModelError, ModelResult, ParamCheck, SetContext, StepFailure,
+    refuse, Checkpoint, FmuModel, ModelError, ModelResult, ModelState, ParamCheck, SetContext,
+    StepFailure,
 };
 use crate::model::*;
 use crate::state_bytes::{Reader, Writer};
@@ -211,6 +213,25 @@ impl PinForces {
         } else {
             self.sum[i] / self.substeps as f64
         }
+    }
+}
+
+/// The yarn bundle's part of an FMU state ([`YarnModel::save`]): the
+/// parameters, the scene, the inputs, the pin force sums and the
+/// simulation's dynamic state, without its grid or other scratch.
+#[derive(Clone, Debug)]
+pub struct YarnState {
+    pub config: Config,
+    pub base: YarnScene,
+    pub inputs: Inputs,
+    pub forces: PinForces,
+    pub sim: DynamicState,
+}
+
+impl YarnState {
+    /// The scene its simulation runs: the base scene with the parameters.
+    fn scene(&self) -> YarnScene {
+        effective_scene(&self.base, &self.config)
     }
 }
 
@@ -530,11 +551,51 @@ impl YarnModel {
         Ok(changed)
     }
 
-    /// This model's part of a serialized FMU state: the inputs, the
+    /// This model's part of an FMU state: no grid, no scratch.
+    pub fn save(&self) -> YarnState {
+        YarnState {
+            config: self.config.clone(),
+            base: self.base.clone(),
+            inputs: self.inputs.clone(),
+            forces: self.forces.clone(),
+            sim: self.sim.dynamic_state(),
+        }
+    }
+
+    /// Puts back a [`Self::save`]: into this model's simulation when it runs
+    /// the state's scene (the usual case: same parameters), else into a new
+    /// simulation of that scene. A refused state changes nothing.
+    pub fn load(&mut self, s: &YarnState) -> ModelResult {
+        let scene = s.scene();
+        if *self.sim.scene() == scene {
+            self.sim
+                .set_dynamic_state(&s.sim)
+                .or_else(|e| refuse(e.to_string()))?;
+        } else {
+            let mut sim = YarnSim::new(&scene).or_else(|e| refuse(format!("state: {e}")))?;
+            sim.set_dynamic_state(&s.sim)
+                .or_else(|e| refuse(e.to_string()))?;
+            self.sim = sim;
+        }
+        if self.config != s.config {
+            self.config = s.config.clone();
+        }
+        if self.base != s.base {
+            self.base = s.base.clone();
+        }
+        self.inputs.clone_from(&s.inputs);
+        self.forces.clone_from(&s.forces);
+        self.diag = None;
+        Ok(())
+    }
+
+    /// A saved state's part of a serialized FMU state: the inputs, the
     /// parameters, the scene text and the library's own state bytes (which
-    /// carry their own header and checksum).
-    pub fn write(&self, w: &mut Writer) {
-        let i = &self.inputs;
+    /// carry their own header and checksum; encoded by this model's
+    /// simulation when it runs the state's scene, else by one built for
+    /// it).
+    pub fn write(&self, s: &YarnState, w: &mut Writer) -> Result<(), String> {
+        let i = &s.inputs;
         w.f64(i.attractor[0]);
         w.f64(i.attractor[1]);
         w.f64(i.strength);
@@ -547,35 +608,39 @@ impl YarnModel {
             w.f64(p.velocity[0]);
             w.f64(p.velocity[1]);
         }
-        w.bytes(self.config.scene_path.as_bytes());
-        for v in self.config.reals {
+        w.bytes(s.config.scene_path.as_bytes());
+        for v in s.config.reals {
             w.opt_f64(v);
         }
-        w.u8(self.config.plasticity.is_some() as u8);
-        w.u8(self.config.plasticity.unwrap_or(false) as u8);
-        w.u8(match self.config.scheme {
+        w.u8(s.config.plasticity.is_some() as u8);
+        w.u8(s.config.plasticity.unwrap_or(false) as u8);
+        w.u8(match s.config.scheme {
             None => 0,
             Some(TransferScheme::Flip) => 1,
             Some(TransferScheme::Apic) => 2,
         });
-        w.u64(self.forces.substeps);
-        for f in &self.forces.sum {
+        w.u64(s.forces.substeps);
+        for f in &s.forces.sum {
             w.f64(f.x);
             w.f64(f.y);
         }
-        w.bytes(self.base.to_toml_string().as_bytes());
-        w.bytes(&self.sim.save_state());
+        w.bytes(s.base.to_toml_string().as_bytes());
+        let scene = s.scene();
+        let built;
+        let sim = if *self.sim.scene() == scene {
+            &self.sim
+        } else {
+            built = YarnSim::new(&scene).map_err(|e| format!("stored scene: {e}"))?;
+            &built
+        };
+        w.bytes_with(sim.state_size(), |out| sim.encode_state_into(&s.sim, out))
+            .map_err(|e| e.to_string())
     }
 
-    /// Reads what [`Self::write`] wrote; `current` (with `current_built`: its
-    /// simulation matches its scene and parameters) is reused when the stored
-    /// scene and parameters match, else the simulation is rebuilt.
-    pub fn read(
-        r: &mut Reader,
-        current: &YarnModel,
-        current_built: bool,
-        yarns: usize,
-    ) -> Result<YarnModel, String> {
+    /// Reads what [`Self::write`] wrote; the library's state bytes are
+    /// checked and decoded by `current`'s simulation when it runs the
+    /// stored scene with the stored parameters, else by one built for them.
+    pub fn read(r: &mut Reader, current: &YarnModel, yarns: usize) -> Result<YarnState, String> {
         let mut inputs = Inputs {
             attractor: [r.f64()?, r.f64()?],
             strength: r.f64()?,
@@ -628,26 +693,26 @@ impl YarnModel {
         } else {
             YarnScene::from_toml_str(&scene_text).map_err(|e| format!("stored scene: {e}"))?
         };
-        let mut sim = if current_built && base == current.base && config == current.config {
-            current.sim.clone()
+        let scene = effective_scene(&base, &config);
+        let sim = if *current.sim.scene() == scene {
+            current.sim.decode_state(sim_bytes)
         } else {
-            YarnSim::new(&effective_scene(&base, &config))
-                .map_err(|e| format!("stored scene: {e}"))?
-        };
-        if sim.num_yarns() != yarns {
-            return Err(format!(
-                "state has {} yarns, this FMU {yarns}",
-                sim.num_yarns()
-            ));
+            let sim = YarnSim::new(&scene).map_err(|e| format!("stored scene: {e}"))?;
+            if sim.num_yarns() != yarns {
+                return Err(format!(
+                    "state has {} yarns, this FMU {yarns}",
+                    sim.num_yarns()
+                ));
+            }
+            sim.decode_state(sim_bytes)
         }
-        sim.load_state(sim_bytes).map_err(|e| e.to_string())?;
-        Ok(YarnModel {
+        .map_err(|e| e.to_string())?;
+        Ok(YarnState {
             config,
             base,
-            sim,
             inputs,
-            diag: None,
             forces,
+            sim,
         })
     }
 }
@@ -677,18 +742,18 @@ impl FmuModel for YarnModel {
     fn outputs_finite(&mut self) -> bool {
         YarnModel::outputs_finite(self)
     }
-    /// The library's state bytes: a clone of the whole `YarnSim` with its
-    /// grid costs far more than its particles.
+    /// The library's dynamic state (`YarnSim::dynamic_state`: particles,
+    /// clock, inputs; not the grid) and the pin force sums.
     fn checkpoint(&self) -> Checkpoint {
-        Box::new((self.sim.save_state(), self.forces.clone()))
+        Box::new((self.sim.dynamic_state(), self.forces.clone()))
     }
     fn restore(&mut self, c: Checkpoint) {
-        let (bytes, forces) = *c
-            .downcast::<(Vec<u8>, PinForces)>()
+        let (state, forces) = *c
+            .downcast::<(DynamicState, PinForces)>()
             .expect("a checkpoint of a yarn model");
         self.sim
-            .load_state(&bytes)
-            .expect("the simulation's own state bytes load");
+            .set_dynamic_state(&state)
+            .expect("the simulation's own dynamic state fits it");
         self.forces = forces;
         self.diag = None;
     }
@@ -722,11 +787,23 @@ impl FmuModel for YarnModel {
         };
         YarnModel::set_string(self, vrs, vals, check, ctx.resources, bundled)
     }
-    fn write(&self, w: &mut Writer) {
-        YarnModel::write(self, w)
+    fn save(&self) -> ModelState {
+        Box::new(YarnModel::save(self))
     }
-    fn read(&self, r: &mut Reader, built: bool, count: usize) -> Result<Box<dyn FmuModel>, String> {
-        Ok(Box::new(YarnModel::read(r, self, built, count)?))
+    fn load(&mut self, s: &ModelState) -> ModelResult {
+        let Some(s) = s.downcast_ref::<YarnState>() else {
+            return refuse("not the state of a yarn model");
+        };
+        YarnModel::load(self, s)
+    }
+    fn write(&self, s: &ModelState, w: &mut Writer) -> Result<(), String> {
+        let s = s
+            .downcast_ref::<YarnState>()
+            .ok_or("not the state of a yarn model")?;
+        YarnModel::write(self, s, w)
+    }
+    fn read(&self, r: &mut Reader, _built: bool, count: usize) -> Result<ModelState, String> {
+        Ok(Box::new(YarnModel::read(r, self, count)?))
     }
     fn box_clone(&self) -> Box<dyn FmuModel> {
         Box::new(self.clone())

@@ -110,6 +110,43 @@ impl Reader<'_> {
     }
 }
 
+/// Everything that determines a [`YarnSim`]'s future (bit for bit): the
+/// clock, the inputs (gravity, attractor, the targets of the input pins) and
+/// per particle position, velocity, APIC matrix and, for the quadrature
+/// particles, the frame `d`. No grid and no other scratch: what
+/// [`YarnSim::dynamic_state`] copies, [`YarnSim::set_dynamic_state`] puts
+/// back and [`YarnSim::save_state`] writes (through
+/// [`YarnSim::encode_state`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct DynamicState {
+    time: f64,
+    steps: u64,
+    gravity: Vec2,
+    attractor: Attractor,
+    dt: f64,
+    /// Per input pin: its index, target position, velocity, reference time.
+    targets: Vec<(usize, Vec2, Vec2, f64)>,
+    vert_x: Vec<Vec2>,
+    vert_v: Vec<Vec2>,
+    vert_c: Vec<Mat2>,
+    quad_x: Vec<Vec2>,
+    quad_v: Vec<Vec2>,
+    quad_c: Vec<Mat2>,
+    quad_d: Vec<Mat2>,
+}
+
+impl DynamicState {
+    /// Simulated time in s.
+    pub fn time(&self) -> f64 {
+        self.time
+    }
+
+    /// Substeps taken.
+    pub fn steps(&self) -> u64 {
+        self.steps
+    }
+}
+
 impl YarnSim {
     /// Fingerprint of the scene, stored in serialized states.
     pub fn scene_fingerprint(&self) -> u64 {
@@ -135,57 +172,171 @@ impl YarnSim {
             .map(|(i, _)| i)
     }
 
+    /// A copy of the dynamic state (no grid, no scratch).
+    pub fn dynamic_state(&self) -> DynamicState {
+        let p = self.particles();
+        DynamicState {
+            time: self.time,
+            steps: self.steps,
+            gravity: self.gravity,
+            attractor: self.attractor,
+            dt: self.dt,
+            targets: self
+                .input_pins()
+                .filter_map(|k| match self.pins()[k].motion {
+                    PinMotion::Input {
+                        position,
+                        velocity,
+                        since,
+                    } => Some((k, position, velocity, since)),
+                    _ => None,
+                })
+                .collect(),
+            vert_x: p.vert.x.clone(),
+            vert_v: p.vert.v.clone(),
+            vert_c: p.vert.c.clone(),
+            quad_x: p.quad.x.clone(),
+            quad_v: p.quad.v.clone(),
+            quad_c: p.quad.c.clone(),
+            quad_d: p.quad.d.clone(),
+        }
+    }
+
+    /// Fails unless `s` has this simulation's particle counts and input pins.
+    fn check_fits(&self, s: &DynamicState) -> Result<(), StateError> {
+        let p = self.particles();
+        let (nv, nq) = (p.vert.x.len(), p.quad.x.len());
+        let sizes = [&s.vert_x, &s.vert_v, &s.quad_x, &s.quad_v]
+            .map(|v| v.len())
+            .into_iter()
+            .zip([nv, nv, nq, nq])
+            .chain(
+                [&s.vert_c, &s.quad_c, &s.quad_d]
+                    .map(|v| v.len())
+                    .into_iter()
+                    .zip([nv, nq, nq]),
+            )
+            .all(|(a, b)| a == b);
+        if !sizes {
+            return Err(StateError::CountMismatch {
+                vertices: s.vert_x.len() as u64,
+                quads: s.quad_x.len() as u64,
+            });
+        }
+        if !s.targets.iter().map(|t| t.0).eq(self.input_pins()) {
+            return Err(StateError::OtherScene);
+        }
+        Ok(())
+    }
+
+    /// Puts back a [`YarnSim::dynamic_state`] of a simulation of the same
+    /// scene (the arrays are copied into the existing ones). Nothing changes
+    /// when it does not fit (other particle counts or input pins). Restoring
+    /// clears a previous divergence.
+    pub fn set_dynamic_state(&mut self, s: &DynamicState) -> Result<(), StateError> {
+        self.check_fits(s)?;
+        for &(k, position, velocity, since) in &s.targets {
+            self.restore_pin_target(
+                k,
+                PinMotion::Input {
+                    position,
+                    velocity,
+                    since,
+                },
+            );
+        }
+        self.time = s.time;
+        self.steps = s.steps;
+        self.gravity = s.gravity;
+        self.attractor = s.attractor;
+        self.dt = s.dt;
+        let p = &mut self.particles;
+        p.vert.x.clone_from(&s.vert_x);
+        p.vert.v.clone_from(&s.vert_v);
+        p.vert.c.clone_from(&s.vert_c);
+        p.quad.x.clone_from(&s.quad_x);
+        p.quad.v.clone_from(&s.quad_v);
+        p.quad.c.clone_from(&s.quad_c);
+        p.quad.d.clone_from(&s.quad_d);
+        self.failed = None;
+        self.frames_stale = true;
+        Ok(())
+    }
+
     /// The dynamic state as bytes.
     pub fn save_state(&self) -> Vec<u8> {
-        let p = self.particles();
-        let mut payload = Vec::with_capacity(self.state_size() - HEADER);
-        payload.extend_from_slice(&self.time.to_le_bytes());
-        payload.extend_from_slice(&self.steps.to_le_bytes());
-        put_vec(&mut payload, &self.gravity);
-        put_vec(&mut payload, &self.attractor.position);
-        payload.extend_from_slice(&self.attractor.strength.to_le_bytes());
-        payload.extend_from_slice(&(self.attractor.active as u64).to_le_bytes());
-        payload.extend_from_slice(&self.dt.to_le_bytes());
-        for k in self.input_pins() {
-            if let PinMotion::Input {
-                position,
-                velocity,
-                since,
-            } = self.pins()[k].motion
-            {
-                put_vec(&mut payload, &position);
-                put_vec(&mut payload, &velocity);
-                payload.extend_from_slice(&since.to_le_bytes());
-            }
-        }
-        for i in 0..p.vert.x.len() {
-            put_vec(&mut payload, &p.vert.x[i]);
-            put_vec(&mut payload, &p.vert.v[i]);
-            put_mat(&mut payload, &p.vert.c[i]);
-        }
-        for q in 0..p.quad.x.len() {
-            put_vec(&mut payload, &p.quad.x[q]);
-            put_vec(&mut payload, &p.quad.v[q]);
-            put_mat(&mut payload, &p.quad.c[q]);
-            put_mat(&mut payload, &p.quad.d[q]);
-            put_mat(&mut payload, &p.quad.deformation_gradient(q));
-        }
-        let mut out = Vec::with_capacity(HEADER + payload.len());
+        self.encode_state(&self.dynamic_state())
+            .expect("a simulation's own state fits it")
+    }
+
+    /// A dynamic state of a simulation of this scene as bytes (the format
+    /// of [`YarnSim::save_state`]; this simulation gives the scene
+    /// fingerprint and the rest frames for the stored `F`).
+    pub fn encode_state(&self, s: &DynamicState) -> Result<Vec<u8>, StateError> {
+        let mut out = Vec::with_capacity(self.state_size());
+        self.encode_state_into(s, &mut out)?;
+        Ok(out)
+    }
+
+    /// [`YarnSim::encode_state`], appended to `out` ([`YarnSim::state_size`]
+    /// bytes).
+    pub fn encode_state_into(&self, s: &DynamicState, out: &mut Vec<u8>) -> Result<(), StateError> {
+        self.check_fits(s)?;
+        let rest_inv = &self.particles().quad.d_rest_inv;
+        let (nv, nq) = (s.vert_x.len(), s.quad_x.len());
+        let start = out.len();
+        let len = self.state_size() - HEADER;
+        out.reserve(HEADER + len);
         out.extend_from_slice(MAGIC);
         out.extend_from_slice(&VERSION.to_le_bytes());
         out.extend_from_slice(&self.scene_fingerprint().to_le_bytes());
-        out.extend_from_slice(&(p.vert.x.len() as u64).to_le_bytes());
-        out.extend_from_slice(&(p.quad.x.len() as u64).to_le_bytes());
-        out.extend_from_slice(&(payload.len() as u64).to_le_bytes());
-        out.extend_from_slice(&fnv1a(&payload).to_le_bytes());
-        out.extend_from_slice(&payload);
-        out
+        out.extend_from_slice(&(nv as u64).to_le_bytes());
+        out.extend_from_slice(&(nq as u64).to_le_bytes());
+        out.extend_from_slice(&(len as u64).to_le_bytes());
+        out.extend_from_slice(&0u64.to_le_bytes()); // the checksum, below
+        out.extend_from_slice(&s.time.to_le_bytes());
+        out.extend_from_slice(&s.steps.to_le_bytes());
+        put_vec(out, &s.gravity);
+        put_vec(out, &s.attractor.position);
+        out.extend_from_slice(&s.attractor.strength.to_le_bytes());
+        out.extend_from_slice(&(s.attractor.active as u64).to_le_bytes());
+        out.extend_from_slice(&s.dt.to_le_bytes());
+        for (_, position, velocity, since) in &s.targets {
+            put_vec(out, position);
+            put_vec(out, velocity);
+            out.extend_from_slice(&since.to_le_bytes());
+        }
+        for ((x, v), c) in s.vert_x.iter().zip(&s.vert_v).zip(&s.vert_c) {
+            put_vec(out, x);
+            put_vec(out, v);
+            put_mat(out, c);
+        }
+        let quads = s.quad_x.iter().zip(&s.quad_v).zip(&s.quad_c).zip(&s.quad_d);
+        for ((((x, v), c), d), rest_inv) in quads.zip(rest_inv) {
+            put_vec(out, x);
+            put_vec(out, v);
+            put_mat(out, c);
+            put_mat(out, d);
+            // F = d D^-1 (Quads::deformation_gradient), for readers of the format.
+            put_mat(out, &(d * rest_inv));
+        }
+        debug_assert_eq!(out.len() - start, HEADER + len);
+        let sum = fnv1a(&out[start + HEADER..]);
+        out[start + HEADER - 8..start + HEADER].copy_from_slice(&sum.to_le_bytes());
+        Ok(())
     }
 
     /// Restores a state written by [`YarnSim::save_state`] for the same
     /// scene. Nothing changes when the bytes are rejected. Restoring clears a
     /// previous divergence.
     pub fn load_state(&mut self, bytes: &[u8]) -> Result<(), StateError> {
+        let s = self.decode_state(bytes)?;
+        self.set_dynamic_state(&s)
+    }
+
+    /// Reads and checks bytes written by [`YarnSim::save_state`] for this
+    /// scene, without changing the simulation.
+    pub fn decode_state(&self, bytes: &[u8]) -> Result<DynamicState, StateError> {
         if bytes.len() < HEADER {
             return Err(StateError::TooShort {
                 len: bytes.len(),
@@ -275,31 +426,25 @@ impl YarnSim {
         if !finite || dt <= 0.0 {
             return Err(StateError::NonFinite);
         }
-        for (k, position, velocity, since) in targets {
-            self.restore_pin_target(
-                k,
-                PinMotion::Input {
-                    position,
-                    velocity,
-                    since,
-                },
-            );
-        }
-        self.time = time;
-        self.steps = steps;
-        self.gravity = gravity;
-        self.attractor = Attractor {
-            position: apos,
-            strength: astr,
-            active: aact,
-        };
-        self.dt = dt;
-        let p = &mut self.particles;
-        (p.vert.x, p.vert.v, p.vert.c) = vert;
         // quad.4 (F) is determined by d; it is stored for readers of the format
-        (p.quad.x, p.quad.v, p.quad.c, p.quad.d) = (quad.0, quad.1, quad.2, quad.3);
-        self.failed = None;
-        self.frames_stale = true;
-        Ok(())
+        Ok(DynamicState {
+            time,
+            steps,
+            gravity,
+            attractor: Attractor {
+                position: apos,
+                strength: astr,
+                active: aact,
+            },
+            dt,
+            targets,
+            vert_x: vert.0,
+            vert_v: vert.1,
+            vert_c: vert.2,
+            quad_x: quad.0,
+            quad_v: quad.1,
+            quad_c: quad.2,
+            quad_d: quad.3,
+        })
     }
 }
