@@ -227,7 +227,9 @@ pub fn chain_scene(resolution: u32, dt: f64, transfer: TransferSpec) -> YarnScen
             size: 1.0,
         },
         time: TimeSpec {
-            dt,
+            dt: dt.into(),
+            safety: None,
+            dt_max: None,
             frame_dt: 1.0 / 60.0,
         },
         material: chain_material(),
@@ -303,7 +305,7 @@ fn swing(scene: &YarnScene, periods: f64) -> Result<(f64, f64, f64, u64), String
     let l: f64 = sim.particles().quad.l0.iter().sum();
     let w_oracle = oracle_omega(GRAVITY, l);
     let t_end = periods * 2.0 * std::f64::consts::PI / w_oracle;
-    let n = (t_end / scene.time.dt).ceil() as u64;
+    let n = (t_end / scene.time.dt.fixed().expect("a fixed dt")).ceil() as u64;
     let tip = sim.particles().vert.x.len() - 1;
     let x_pin = TOP[0];
     let mut samples = Vec::with_capacity(n as usize + 1);

@@ -325,7 +325,7 @@ fn input_pin_driven_on_a_circle_gives_the_library_bits() {
 #[test]
 fn input_pin_on_the_substep_grid_reproduces_line_and_circle_pins() {
     let input = pinned_scene("motion = \"input\"");
-    let dt = input.time.dt;
+    let dt = input.time.dt.fixed().unwrap();
     let steps = 250; // 0.05 s
     let run_fmu = |target: &dyn Fn(f64) -> (Vec2, Vec2)| {
         let f = Fmu::new(&input);
