@@ -270,7 +270,20 @@ impl YarnModel {
 
     pub fn substep(&mut self) -> Result<(), StepFailure> {
         self.diag = None;
-        self.sim.step().map_err(|e| StepFailure {
+        let step = self.sim.step();
+        self.after_substep(step)
+    }
+
+    /// One adaptive substep toward `until` on the simulation's clock
+    /// (`dt = "auto"`), the last one landing on it.
+    pub fn substep_toward(&mut self, until: f64) -> Result<(), StepFailure> {
+        self.diag = None;
+        let step = self.sim.step_toward(until).map(|_| ());
+        self.after_substep(step)
+    }
+
+    fn after_substep(&mut self, step: Result<(), SimError>) -> Result<(), StepFailure> {
+        step.map_err(|e| StepFailure {
             terminal: matches!(e, SimError::NonFinite { .. }),
             msg: e.to_string(),
         })?;
@@ -670,6 +683,15 @@ impl FmuModel for YarnModel {
     }
     fn begin_step(&mut self, since_start: f64) -> Result<(), StepFailure> {
         YarnModel::begin_step(self, since_start)
+    }
+    fn adaptive(&self) -> bool {
+        self.sim.is_auto()
+    }
+    fn substeps_to(&self, until: f64) -> u64 {
+        self.sim.substeps_to(until)
+    }
+    fn substep_toward(&mut self, until: f64) -> Result<(), StepFailure> {
+        YarnModel::substep_toward(self, until)
     }
     fn substep(&mut self, _k: u64) -> Result<(), StepFailure> {
         YarnModel::substep(self)
