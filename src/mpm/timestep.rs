@@ -35,6 +35,12 @@
 //! impacts) are not known in advance: [`YarnSim::stable_dt`] uses the
 //! current largest particle speed, so at initialization it is the elastic
 //! bound of a scene at rest, a necessary condition, not a guarantee.
+//!
+//! `[time] dt = "auto"` applies the bound in every substep instead:
+//! [`YarnSim::auto_dt`] is `min(safety * stable_dt, dt_max)` of the state
+//! the substep starts from (default safety
+//! [`crate::scene::DEFAULT_SAFETY`], measured on the reference scene), and
+//! [`YarnSim::advance_to`] lands on frame and communication times exactly.
 
 use super::constitutive::YarnEnergy;
 use super::YarnSim;
