@@ -119,3 +119,43 @@ fn a_step_that_outgrows_its_estimate_is_undone() {
         "{e}"
     );
 }
+
+/// Under `dt = "auto"` the pin force output is the time average over the
+/// communication step's substeps (weighted by their lengths), the same
+/// bits as the library's reactions averaged that way.
+#[test]
+fn pin_force_is_the_time_average_of_the_adaptive_substeps() {
+    let text = SMALL_SCENE
+        .replace(
+            "count = 3\nspacing = [0.0, 0.03]",
+            "count = 2\nspacing = [0.0, 0.1]\n\n[[pins]]\nyarn = 0\nend = \"start\"\n",
+        )
+        .replace("dt = 2e-4", "dt = \"auto\"");
+    let scene = YarnScene::from_toml_str(&text).unwrap();
+    assert!(scene.time.dt.is_auto() && scene.pins.len() == 1);
+    let f = Fmu::new(&scene);
+    f.init();
+    let mut sim = YarnSim::new(&scene).unwrap();
+    let force = [VR_PIN_BASE + PIN_FORCE, VR_PIN_BASE + PIN_FORCE + 1];
+    for k in 0..5 {
+        let t = k as f64 * H;
+        assert_eq!(f.do_step(t, H), fmi2OK, "{:?}", f.lines());
+        let (mut sum, mut span) = (yarnsim::math::Vec2::zeros(), 0.0);
+        loop {
+            let before = sim.time();
+            if !sim.step_toward(t + H).unwrap() {
+                break;
+            }
+            let w = sim.time() - before;
+            sum -= sim.pin_reactions()[0] * w;
+            span += w;
+        }
+        let mean = sum / span;
+        let fmu = f.get_real(&force).unwrap();
+        assert_eq!(
+            [fmu[0].to_bits(), fmu[1].to_bits()],
+            [mean.x.to_bits(), mean.y.to_bits()],
+            "step {k}"
+        );
+    }
+}

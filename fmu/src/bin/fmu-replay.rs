@@ -185,9 +185,11 @@ fn replay_yarn(scene: &YarnScene, rows: &[Vec<f64>], h: f64, stop: f64) -> Resul
                 sim.set_pin_target_at(pin, Vec2::new(c[0], c[1]), Vec2::new(c[2], c[3]), now)
                     .map_err(|e| e.to_string())?;
             }
-            let mut n = 0u64;
+            // The FMU's mean: per substep, or time-weighted under "auto".
+            let mut weight = 0.0;
             let mut sum = vec![Vec2::zeros(); pins];
             loop {
+                let before = sim.time();
                 let stepped = if auto {
                     sim.step_toward(next).map_err(|e| e.to_string())?
                 } else if sim.steps() < target {
@@ -199,13 +201,14 @@ fn replay_yarn(scene: &YarnScene, rows: &[Vec<f64>], h: f64, stop: f64) -> Resul
                 if !stepped {
                     break;
                 }
-                n += 1;
+                let w = if auto { sim.time() - before } else { 1.0 };
+                weight += w;
                 for (s, r) in sum.iter_mut().zip(sim.pin_reactions()) {
-                    *s -= *r;
+                    *s -= *r * w;
                 }
             }
             for (f, s) in force.iter_mut().zip(&sum) {
-                *f = *s / n as f64;
+                *f = *s / weight;
             }
         }
         record(&mut csv, next, &sim, &force);
