@@ -134,7 +134,7 @@ vertices = 30
 fn yarns_crushed_against_an_obstacle() {
     let mut sc = yarnsim::scene::builtin::small_yarn_scene(4, 40, 64);
     sc.gravity = [0.0, -200.0];
-    sc.time.dt = 5e-5;
+    sc.time.dt = 5e-5.into();
     sc.obstacles[0].center = [0.5, 0.4];
     sc.obstacles[0].radius = 0.12;
     sc.yarns[0].start = Some([0.25, 0.6]);

@@ -402,7 +402,7 @@ end = [0.7, 0.5]
 vertices = 60
 "#,
     );
-    scene.time.dt = 2e-3; // far above the stable step
+    scene.time.dt = 2e-3.into(); // far above the stable step
     let mut sim = YarnSim::new(&scene).unwrap();
     {
         let p = sim.particles_mut();
@@ -509,7 +509,7 @@ end = "start"
     scene.gravity = [0.0, -9.8];
     scene.material.bending = 0.0;
     scene.material.k = 4900.0;
-    scene.time.dt = 2e-4;
+    scene.time.dt = 2e-4.into();
     let mut sim = YarnSim::new(&scene).unwrap();
     sim.advance(0.1).unwrap();
     // the reaction averaged over 0.2 s (many periods of the yarn's

@@ -60,9 +60,9 @@ fn stable_dt_is_the_cfl_wave_bound() {
         if let Ok(yarnsim::Scene::Yarn(y)) = yarnsim::Scene::resolve(name) {
             let sim = YarnSim::new(&y).unwrap();
             assert!(
-                y.time.dt <= sim.stable_dt(),
+                sim.dt() <= sim.stable_dt(),
                 "{name}: {} > {}",
-                y.time.dt,
+                sim.dt(),
                 sim.stable_dt()
             );
         }
@@ -76,7 +76,7 @@ fn a_substep_beyond_the_bound_diverges() {
     let bound = YarnSim::new(&base).unwrap().stable_dt();
     let run = |dt: f64| {
         let mut s = base.clone();
-        s.time.dt = dt;
+        s.time.dt = dt.into();
         let mut sim = YarnSim::new(&s).unwrap();
         {
             let p = sim.particles_mut();
@@ -98,7 +98,7 @@ fn a_substep_beyond_the_bound_diverges() {
 fn divergence_message_reports_the_velocity_that_tripped_the_check() {
     let mut s = scene("", YARN);
     s.gravity = [0.0, -1.0e6];
-    s.time.dt = 2e-3;
+    s.time.dt = 2e-3.into();
     let mut sim = YarnSim::new(&s).unwrap();
     let e = sim.step().expect_err("1e6 m/s2 for 2 ms is 2000 m/s");
     let SimError::NonFinite { what, .. } = &e else {

@@ -61,7 +61,7 @@ fn random_scene(
     s.material.bending = bending;
     s.material.k *= stiffness;
     s.material.youngs_modulus *= stiffness;
-    s.time.dt = dt;
+    s.time.dt = dt.into();
     s
 }
 

@@ -329,6 +329,25 @@ fn cantilever_tip_deflection_matches_euler_bernoulli_at_every_resolution() {
 #[test]
 #[cfg_attr(debug_assertions, ignore = "release-mode test (cargo test --release)")]
 fn hanging_chain_swings_at_its_first_mode_and_its_pin_carries_its_weight() {
+    let substeps = hanging_chain("1e-4");
+    assert!(substeps > 0);
+}
+
+/// The hanging-chain oracle under `dt = "auto"` (default safety factor):
+/// the same tolerances as with the fixed 1e-4 s, in fewer substeps.
+#[test]
+#[cfg_attr(debug_assertions, ignore = "release-mode test (cargo test --release)")]
+fn hanging_chain_oracle_holds_under_adaptive_substeps() {
+    let fixed = hanging_chain("1e-4");
+    let auto = hanging_chain("\"auto\"");
+    eprintln!("hanging chain: {auto} adaptive substeps against {fixed} of 1e-4 s");
+    assert!(auto < fixed, "{auto} adaptive substeps, {fixed} fixed");
+}
+
+/// The hanging chain's first mode and pin force with the substep `dt` (a
+/// TOML value); returns the substeps run. The crossing times interpolate
+/// within the substep that crossed, the pin force is the time average.
+fn hanging_chain(dt: &str) -> u64 {
     // L = 0.8 m pinned at (0.5, 0.9), 100 vertices, 64^2 grid, dt 1e-4,
     // bending 0, k = 2000 (static strain at the top g L rho / k = 0.4 %),
     // no cross-section energy; default FLIP.
@@ -350,7 +369,7 @@ gravity = [0.0, -{g}]
 [grid]
 resolution = 64
 [time]
-dt = 1e-4
+dt = {dt}
 [material]
 k = 2000.0
 gamma = 0.0
@@ -376,11 +395,13 @@ end = "start"
     let mut prev = sim.yarn_endpoints(0).1.x - 0.5;
     let mut reaction = Vec::new();
     while crossings.len() < 5 {
+        let before = sim.time();
         sim.step().unwrap();
+        let h = sim.time() - before;
         let u = sim.yarn_endpoints(0).1.x - 0.5;
-        reaction.push(sim.pin_reactions()[0]);
+        reaction.push((sim.pin_reactions()[0], h));
         if prev * u < 0.0 {
-            let t = sim.time() - sim.dt() * u / (u - prev);
+            let t = sim.time() - h * u / (u - prev);
             crossings.push((t, reaction.len()));
         }
         prev = u;
@@ -391,15 +412,17 @@ end = "start"
     let measured = 2.0 * (t4 - t0) / 4.0;
     let err = (measured - period) / period;
     eprintln!(
-        "hanging chain (100 vertices, 64^2, dt 1e-4, FLIP): period {measured:.5} s, \
+        "hanging chain (100 vertices, 64^2, dt {dt}, FLIP, {} substeps): period {measured:.5} s, \
          oracle 2 pi / (1.2024 sqrt(g/L)) = {period:.5} s, error {:+.2} %",
+        sim.steps(),
         100.0 * err
     );
     // tolerance 3 % on omega_1
     assert!(err.abs() < 0.03, "period error {err:+.4}");
     // the pin's force on the yarn, averaged over the two periods between
     // the crossings, carries the yarn's weight
-    let mean: Vec2 = reaction[k0..k4].iter().sum::<Vec2>() / (k4 - k0) as f64;
+    let span: f64 = reaction[k0..k4].iter().map(|(_, h)| h).sum();
+    let mean: Vec2 = reaction[k0..k4].iter().map(|(r, h)| r * *h).sum::<Vec2>() / span;
     let werr = (mean.y - weight) / weight;
     eprintln!(
         "hanging chain pin reaction mean ({:.4e}, {:.4e}) N, weight {weight:.4e} N, error {:+.2} %",
@@ -410,6 +433,7 @@ end = "start"
     // tolerance 2 % on the vertical, 1 % of the weight sideways
     assert!(werr.abs() < 0.02, "weight error {werr:+.4}");
     assert!(mean.x.abs() < 0.01 * weight, "sideways {}", mean.x);
+    sim.steps()
 }
 
 // ---- conservation -----------------------------------------------------------
@@ -502,7 +526,7 @@ fn dt_ladder(scheme: TransferScheme) -> Vec<f64> {
     s.transfer.scheme = scheme;
     let mut ends: Vec<Vec<Vec2>> = Vec::new();
     for k in 0..6 {
-        s.time.dt = 2e-4 / (1u32 << k) as f64;
+        s.time.dt = (2e-4 / (1u32 << k) as f64).into();
         let mut sim = YarnSim::new(&s).unwrap();
         sim.advance(0.1).unwrap();
         assert!((sim.time() - 0.1).abs() < 1e-9);

@@ -19,6 +19,18 @@ pub trait Stepper {
     fn steps(&self) -> u64;
     /// Number of particles (the unit of the throughput figure).
     fn num_particles(&self) -> usize;
+    /// The simulation's clock, s (adaptive schedules).
+    fn time(&self) -> f64 {
+        0.0
+    }
+    /// One adaptive substep toward the time `until`, the last landing on
+    /// it; `Ok(false)` when already there (adaptive schedules only).
+    fn step_toward(&mut self, until: f64) -> Result<bool, CliError> {
+        let _ = until;
+        Err(CliError::Failed(
+            "this simulation has no adaptive substeps".into(),
+        ))
+    }
     /// Checked after every frame: an error when the state is no longer
     /// finite (for simulations whose `step` does not check it itself).
     fn check_finite(&self) -> Result<(), CliError> {
@@ -35,6 +47,12 @@ impl Stepper for YarnSim {
     }
     fn num_particles(&self) -> usize {
         self.particles().len()
+    }
+    fn time(&self) -> f64 {
+        YarnSim::time(self)
+    }
+    fn step_toward(&mut self, until: f64) -> Result<bool, CliError> {
+        YarnSim::step_toward(self, until).map_err(CliError::from)
     }
 }
 
@@ -133,6 +151,7 @@ pub fn run_frames<S: Stepper>(
     mut on_frame: impl FnMut(&S, FrameInfo) -> Result<(), CliError>,
 ) -> Result<FrameRun, CliError> {
     let start_steps = sim.steps();
+    let start_time = sim.time();
     let last_frame = schedule.last_frame();
     on_frame(
         sim,
@@ -154,12 +173,24 @@ pub fn run_frames<S: Stepper>(
         let target = start_steps + schedule.steps_at_frame(frame);
         let before = sim.steps();
         let t0 = Instant::now();
-        while sim.steps() < target {
+        let until = start_time + schedule.time_at_frame(frame);
+        loop {
+            let more = match schedule.adaptive {
+                Some(_) => sim.time() < until,
+                None => sim.steps() < target,
+            };
+            if !more {
+                break;
+            }
             if interrupt.load(Ordering::Relaxed) {
                 outcome.interrupted = true;
                 break;
             }
-            if let Err(e) = sim.step() {
+            let stepped = match schedule.adaptive {
+                Some(_) => sim.step_toward(until).map(|_| ()),
+                None => sim.step(),
+            };
+            if let Err(e) = stepped {
                 failure = Some(e);
                 break;
             }

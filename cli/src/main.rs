@@ -220,8 +220,12 @@ fn execute(command: Command) -> Result<u8, CliError> {
             } else {
                 String::new()
             };
+            let adaptive = match &r.adaptive_dt {
+                Some(range) => format!(" adaptive, dt min / mean / max = {range}"),
+                None => String::new(),
+            };
             let text = format!(
-                "recorded {} frames{every_note} ({} substeps, {} particles) to {} in {:.2} s of stepping",
+                "recorded {} frames{every_note} ({} substeps{adaptive}, {} particles) to {} in {:.2} s of stepping",
                 r.frames_logged,
                 o.substeps,
                 r.particles,

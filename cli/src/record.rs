@@ -296,6 +296,8 @@ pub struct RecordOutcome {
     pub outcome: Outcome,
     pub particles: usize,
     pub frames_logged: u64,
+    /// Adaptive substeps (`dt = "auto"`): their `min / mean / max`.
+    pub adaptive_dt: Option<String>,
     /// The simulation error that stopped the run early; the recording holds
     /// the frames before it and is complete.
     pub failure: Option<CliError>,
@@ -378,6 +380,7 @@ fn record_frames<S: Stepper>(
         outcome,
         particles: sim.num_particles(),
         frames_logged,
+        adaptive_dt: None,
         failure,
     })
 }
@@ -388,14 +391,18 @@ pub fn record_yarn(
     duration: f64,
     opts: &RecordOptions,
 ) -> Result<RecordOutcome, CliError> {
-    let schedule = Schedule::new(duration, sim.dt(), sim.scene().time.frame_dt)?;
+    let schedule = crate::run::yarn_schedule(sim, duration)?;
+    sim.reset_dt_stats();
     let name = sim.scene().name.clone();
     let rec = open(&name, yarn_blueprint(), &opts.sink)?;
     log_yarn_static(&rec, sim).map_err(|e| opts.sink.error(e))?;
     let t0 = sim.time();
-    record_frames(rec, sim, &schedule, &name, opts, |rec, sim, frame| {
+    let mut out = record_frames(rec, sim, &schedule, &name, opts, |rec, sim, frame| {
         log_yarn_frame(rec, sim, frame, sim.time() - t0)
-    })
+    })?;
+    let stats = sim.dt_stats();
+    out.adaptive_dt = (sim.is_auto() && stats.substeps > 0).then(|| crate::run::dt_range(&stats));
+    Ok(out)
 }
 
 /// Records a mass-spring simulation from its current state.

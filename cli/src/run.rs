@@ -73,6 +73,7 @@ pub fn run_massspring(
         particles,
         particles_detail: format!("{fixed} pinned or driven, {springs} springs, {spheres} spheres"),
         dt: run.h,
+        adaptive_dt: None,
         substeps: outcome.substeps,
         frames: outcome.last_frame,
         sim_time: last.time - initial.time,
@@ -125,10 +126,31 @@ pub fn no_integrator_for_yarn(args: &IntegratorArgs) -> Result<(), CliError> {
     }
 }
 
+/// The frame schedule of a yarn run: fixed substeps, or adaptive ones
+/// landing on every frame time under `dt = "auto"`.
+pub fn yarn_schedule(sim: &YarnSim, duration: f64) -> Result<Schedule, CliError> {
+    let frame_dt = sim.scene().time.frame_dt;
+    if sim.is_auto() {
+        Schedule::adaptive(duration, sim.dt(), frame_dt)
+    } else {
+        Schedule::new(duration, sim.dt(), frame_dt)
+    }
+}
+
+/// `"min / mean / max"` of the substeps a run took under `dt = "auto"`.
+pub fn dt_range(stats: &yarnsim::mpm::DtStats) -> String {
+    format!(
+        "{:.3e} / {:.3e} / {:.3e} s",
+        stats.min,
+        stats.mean(),
+        stats.max
+    )
+}
+
 /// Runs a yarn simulation from its current state for `duration` seconds.
 pub fn run_yarn(sim: &mut YarnSim, duration: f64, csv: Option<&Path>) -> Result<Summary, CliError> {
     let sc = sim.scene();
-    let schedule = Schedule::new(duration, sim.dt(), sc.time.frame_dt)?;
+    let schedule = yarn_schedule(sim, duration)?;
     let mut writer = match csv {
         Some(path) => Some(CsvWriter::create(path, sim.num_yarns())?),
         None => None,
@@ -137,6 +159,7 @@ pub fn run_yarn(sim: &mut YarnSim, duration: f64, csv: Option<&Path>) -> Result<
     let mut last = initial;
     let progress = progress_bar(schedule.total_steps, &sc.name);
     let dt = sim.dt();
+    sim.reset_dt_stats();
     let FrameRun { outcome, failure } = run_frames(
         sim,
         &schedule,
@@ -165,6 +188,11 @@ pub fn run_yarn(sim: &mut YarnSim, duration: f64, csv: Option<&Path>) -> Result<
             sim.num_yarns()
         ),
         dt: sim.dt(),
+        adaptive_dt: sim
+            .is_auto()
+            .then(|| sim.dt_stats())
+            .filter(|s| s.substeps > 0)
+            .map(|s| dt_range(&s)),
         substeps: outcome.substeps,
         frames: outcome.last_frame,
         sim_time: last.time - initial.time,
@@ -286,11 +314,14 @@ impl CsvWriter {
         d: &Diagnostics,
         dt: f64,
     ) -> Result<(), CliError> {
-        let mut cols: Vec<String> = vec![
-            frame.to_string(),
-            csv_time(d.steps as f64 * dt),
-            d.steps.to_string(),
-        ];
+        // Fixed substeps: steps * dt; adaptive ones land on the frame
+        // times, so the clock itself.
+        let time = if sim.is_auto() {
+            d.time
+        } else {
+            d.steps as f64 * dt
+        };
+        let mut cols: Vec<String> = vec![frame.to_string(), csv_time(time), d.steps.to_string()];
         cols.extend(
             [
                 d.kinetic_energy,

@@ -5,11 +5,17 @@ use crate::error::CliError;
 /// Frames of a run: frame `k` is the state after `round(k * frame_dt / dt)`
 /// substeps (frame 0 is the initial state), clamped to the run's total of
 /// `round(duration / dt)` substeps; the last frame is the end of the run.
+///
+/// An adaptive schedule ([`Schedule::adaptive`], the yarn's `dt = "auto"`)
+/// puts frame `k` at the time `k * frame_dt` exactly (the last at the end of
+/// the run); `dt` and `total_steps` are then the estimate at the start.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Schedule {
     pub dt: f64,
     pub frame_dt: f64,
     pub total_steps: u64,
+    /// Adaptive substeps: the run's duration in s.
+    pub adaptive: Option<f64>,
 }
 
 /// The most substeps one command will run (about 30 years of wall time at 1e3/s).
@@ -33,7 +39,36 @@ impl Schedule {
             dt,
             frame_dt,
             total_steps: steps as u64,
+            adaptive: None,
         })
+    }
+
+    /// The schedule of a run of `duration` seconds with adaptive substeps,
+    /// `dt_estimate` the first one (for the progress bar).
+    pub fn adaptive(duration: f64, dt_estimate: f64, frame_dt: f64) -> Result<Self, CliError> {
+        if !(duration > 0.0 && duration.is_finite()) {
+            return Err(CliError::Usage(format!(
+                "duration {duration} s must be finite and > 0"
+            )));
+        }
+        let steps = (duration / dt_estimate).ceil();
+        Ok(Schedule {
+            dt: dt_estimate,
+            frame_dt,
+            total_steps: if steps.is_finite() {
+                steps.clamp(1.0, MAX_STEPS as f64) as u64
+            } else {
+                MAX_STEPS
+            },
+            adaptive: Some(duration),
+        })
+    }
+
+    /// Adaptive schedules: the time of frame `frame` after the start,
+    /// `min(frame * frame_dt, duration)`.
+    pub fn time_at_frame(&self, frame: u64) -> f64 {
+        let t = frame as f64 * self.frame_dt;
+        self.adaptive.map_or(t, |d| t.min(d))
     }
 
     fn unclamped(&self, frame: u64) -> u64 {
@@ -47,6 +82,12 @@ impl Schedule {
 
     /// Index of the last frame (the number of frames after the initial one).
     pub fn last_frame(&self) -> u64 {
+        if let Some(d) = self.adaptive {
+            // The frames strictly before the end, then the end (a frame
+            // within 1e-9 of a frame time is that frame).
+            let k = (d / self.frame_dt * (1.0 - 1e-9)).ceil().max(1.0);
+            return k as u64;
+        }
         let mut k = (self.total_steps as f64 * self.dt / self.frame_dt).floor() as u64;
         while self.unclamped(k) < self.total_steps {
             k += 1;
@@ -59,7 +100,7 @@ impl Schedule {
 
     /// Simulated duration of the whole run.
     pub fn duration(&self) -> f64 {
-        self.total_steps as f64 * self.dt
+        self.adaptive.unwrap_or(self.total_steps as f64 * self.dt)
     }
 }
 
@@ -83,6 +124,19 @@ mod tests {
         for k in 1..=s.last_frame() {
             assert!(s.steps_at_frame(k) > s.steps_at_frame(k - 1));
         }
+    }
+
+    #[test]
+    fn adaptive_frames_fall_on_frame_times() {
+        let s = Schedule::adaptive(0.025, 1e-4, 0.01).unwrap();
+        assert_eq!(s.last_frame(), 3);
+        assert_eq!(s.time_at_frame(2), 0.02);
+        assert_eq!(s.time_at_frame(3), 0.025);
+        let s = Schedule::adaptive(1.0, 1e-4, 1.0 / 60.0).unwrap();
+        assert_eq!(s.last_frame(), 60);
+        assert_eq!(s.time_at_frame(60), 1.0);
+        assert_eq!(s.duration(), 1.0);
+        assert!(Schedule::adaptive(0.0, 1e-4, 0.01).is_err());
     }
 
     #[test]

@@ -18,6 +18,8 @@ pub struct Summary {
     /// What the particles are, e.g. `120 vertices + 108 quadrature, 12 yarns`.
     pub particles_detail: String,
     pub dt: f64,
+    /// Adaptive substeps (`dt = "auto"`): their `min / mean / max`.
+    pub adaptive_dt: Option<String>,
     pub substeps: u64,
     pub frames: u64,
     pub sim_time: f64,
@@ -107,7 +109,16 @@ pub fn format_summary(s: &Summary, timing: Timing) -> String {
             "particles",
             format!("{} ({})", s.particles, s.particles_detail),
         ),
-        ("substeps", format!("{} of dt = {} s", s.substeps, s.dt)),
+        (
+            "substeps",
+            match &s.adaptive_dt {
+                Some(range) => format!(
+                    "{} adaptive (dt = \"auto\"), dt min / mean / max = {range}",
+                    s.substeps
+                ),
+                None => format!("{} of dt = {} s", s.substeps, s.dt),
+            },
+        ),
         ("frames", format!("{}{status}", s.frames)),
         ("simulated time", format!("{:.6} s", s.sim_time)),
         ("wall time", wall),

@@ -357,3 +357,63 @@ fn bench_table_fits_100_columns() {
         assert!(line.chars().count() <= 100, "{line}");
     }
 }
+
+/// `dt = "auto"`: `run` reports the adaptive substeps and their min / mean
+/// / max, the CSV frames fall on the frame times exactly; `record` reports
+/// them too.
+#[test]
+fn adaptive_substeps_are_reported_and_hit_every_frame() {
+    let text = std::fs::read_to_string(small_scene())
+        .unwrap()
+        .replace("dt = 0.00004", "dt = \"auto\"");
+    let scene = tmp("small-auto.toml");
+    std::fs::write(&scene, text).unwrap();
+    let csv = tmp("run-auto.csv");
+    let out = yarnsim(&[
+        "run",
+        scene.to_str().unwrap(),
+        "--duration",
+        "2ms",
+        "--csv",
+        csv.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let s = stdout(&out);
+    let line = s.lines().find(|l| l.starts_with("substeps")).unwrap();
+    assert!(
+        line.contains("adaptive (dt = \"auto\"), dt min / mean / max = "),
+        "{line}"
+    );
+    let n: u64 = line.split_whitespace().nth(1).unwrap().parse().unwrap();
+    assert!((5..50).contains(&n), "{line}: fixed 4e-5 s takes 50");
+    let text = std::fs::read_to_string(&csv).unwrap();
+    let rows: Vec<Vec<&str>> = text
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').collect())
+        .collect();
+    let times: Vec<&str> = rows.iter().map(|r| r[1]).collect();
+    assert_eq!(
+        times,
+        ["0", "0.0004", "0.0008", "0.0012", "0.0016", "0.002"]
+    );
+    assert_eq!(rows.last().unwrap()[2], n.to_string());
+
+    let rrd = tmp("record-auto.rrd");
+    let out = yarnsim(&[
+        "record",
+        scene.to_str().unwrap(),
+        "--duration",
+        "2ms",
+        "-o",
+        rrd.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let s = stdout(&out);
+    assert!(
+        s.contains(&format!(
+            "recorded 6 frames ({n} substeps adaptive, dt min / mean / max = "
+        )),
+        "{s}"
+    );
+}

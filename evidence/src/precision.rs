@@ -117,7 +117,7 @@ pub fn run_massspring(
 pub fn run_yarn(scene: &YarnScene, dt: f64, t_end: f64) -> Result<(Vec<V3>, f64, u64), String> {
     let n = (t_end / dt).round().max(1.0) as u64;
     let mut s = scene.clone();
-    s.time.dt = t_end / n as f64;
+    s.time.dt = (t_end / n as f64).into();
     let mut sim = YarnSim::new(&s).map_err(|e| e.to_string())?;
     let t0 = Instant::now();
     sim.steps_n(n).map_err(|e| e.to_string())?;

@@ -209,7 +209,7 @@ fn massspring_limits(
 /// Whether a yarn scene survives a probe run at substep `dt`.
 pub fn yarn_stable(scene: &YarnScene, dt: f64) -> bool {
     let mut s = scene.clone();
-    s.time.dt = dt;
+    s.time.dt = dt.into();
     let Ok(mut sim) = YarnSim::new(&s) else {
         return false;
     };

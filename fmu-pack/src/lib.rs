@@ -150,7 +150,7 @@ pub fn documentation_html(scene: &FmuScene) -> Result<String, String> {
         FmuScene::Yarn(s) => (
             "an MPM yarn bundle",
             format!(
-                "{}, substep {} s, grid {}<sup>2</sup>",
+                "{}, substep {}, grid {}<sup>2</sup>",
                 scene.summary(),
                 s.time.dt,
                 s.grid.resolution

@@ -91,6 +91,27 @@ pub trait FmuModel: fmt::Debug + Send {
     }
     /// Substep number `k` (0-based since initialization).
     fn substep(&mut self, k: u64) -> Result<(), StepFailure>;
+    /// Whether the model picks its own substeps (the yarn's `dt = "auto"`):
+    /// then the front end runs [`Self::substep_toward`] instead of a fixed
+    /// grid of [`Self::substep`]s.
+    fn adaptive(&self) -> bool {
+        false
+    }
+    /// Adaptive models: the estimated substeps to reach `until` seconds
+    /// after the start time at the present bound (0: already there).
+    fn substeps_to(&self, until: f64) -> u64 {
+        let _ = until;
+        0
+    }
+    /// Adaptive models: one substep toward `until` seconds after the start
+    /// time; the last one lands on it exactly.
+    fn substep_toward(&mut self, until: f64) -> Result<(), StepFailure> {
+        let _ = until;
+        Err(StepFailure {
+            terminal: false,
+            msg: "this model has fixed substeps".into(),
+        })
+    }
     /// Every Real output is finite.
     fn outputs_finite(&mut self) -> bool;
     /// A copy of the simulated state to go back to.

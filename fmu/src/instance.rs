@@ -402,20 +402,32 @@ impl Instance {
                 ));
             }
         }
-        // The substep count is an integer grid from the start time: the
-        // substeps done by a given time do not depend on how the master
-        // partitions its interval.
-        let dt = m.physics.dt();
-        let target = ((end - m.start_time) / dt).round();
-        if !(0.0..9.0e15).contains(&target) {
-            return error(format!("step to {end} needs {target} substeps of {dt} s"));
-        }
-        let target = target as u64;
-        let needed = target.saturating_sub(m.substeps);
+        // Fixed substeps: the substep count is an integer grid from the
+        // start time, so the substeps done by a given time do not depend on
+        // how the master partitions its interval. Adaptive substeps
+        // (`dt = "auto"`): the model steps to the communication point on its
+        // own clock (seconds since the start time), landing on it exactly;
+        // `needed` is then the estimate at the present stability bound.
         let budget = self.execution.max_substeps;
+        let until = end - m.start_time;
+        let dt = m.physics.dt();
+        let (target, needed) = if m.physics.adaptive() {
+            (None, m.physics.substeps_to(until))
+        } else {
+            let target = ((end - m.start_time) / dt).round();
+            if !(0.0..9.0e15).contains(&target) {
+                return error(format!("step to {end} needs {target} substeps of {dt} s"));
+            }
+            let target = target as u64;
+            (Some(target), target.saturating_sub(m.substeps))
+        };
         if needed > budget as u64 {
+            let (about, of) = match target {
+                Some(_) => ("", format!("of {dt} s")),
+                None => ("about ", format!("(adaptive, now {dt:.3e} s each)")),
+            };
             return error(format!(
-                "step from t = {t} by {h} needs {needed} substeps of {dt} s, more than max_substeps_per_step = {budget}; no substep was run (take shorter communication steps or raise the parameter)"
+                "step from t = {t} by {h} needs {about}{needed} substeps {of}, more than max_substeps_per_step = {budget}; no substep was run (take shorter communication steps or raise the parameter)"
             ));
         }
         // The last good state: the one at the start of this communication
@@ -423,7 +435,7 @@ impl Instance {
         // the outputs stay readable after a Discard (one checkpoint per step
         // that runs substeps; measured in the README).
         let start_substeps = m.substeps;
-        let mut last_good = (m.substeps < target).then(|| m.physics.checkpoint());
+        let mut last_good = (needed > 0).then(|| m.physics.checkpoint());
         let mut restore = |m: &mut Model| {
             if let Some(c) = last_good.take() {
                 m.physics.restore(c);
@@ -431,20 +443,41 @@ impl Instance {
             }
         };
         let since_start = t - m.start_time;
-        let run = |m: &mut Model| -> Result<(), StepFailure> {
-            if m.substeps < target {
+        // Ok(false): an adaptive step ran out of its budget of substeps.
+        let run = |m: &mut Model| -> Result<bool, StepFailure> {
+            if needed > 0 {
                 m.physics.begin_step(since_start)?;
             }
-            while m.substeps < target {
-                m.physics.substep(m.substeps)?;
-                m.substeps += 1;
+            match target {
+                Some(target) => {
+                    while m.substeps < target {
+                        m.physics.substep(m.substeps)?;
+                        m.substeps += 1;
+                    }
+                }
+                None => {
+                    while m.physics.substeps_to(until) > 0 {
+                        if m.substeps - start_substeps >= budget as u64 {
+                            return Ok(false);
+                        }
+                        m.physics.substep_toward(until)?;
+                        m.substeps += 1;
+                    }
+                }
             }
-            Ok(())
+            Ok(true)
         };
         let ran = match &self.pool {
             Some((_, pool)) => pool.install(|| run(m)),
             None => run(m),
         };
+        if let Ok(false) = ran {
+            restore(m);
+            m.outputs_checked = false;
+            return error(format!(
+                "step from t = {t} by {h} needed more than max_substeps_per_step = {budget} adaptive substeps (the stability bound fell as the yarn sped up); the step was undone (take shorter communication steps or raise the parameter)"
+            ));
+        }
         if let Err(e) = ran {
             m.terminated = true;
             restore(m);

@@ -10,7 +10,7 @@
 use std::fmt::Write as _;
 
 use yarnsim::mpm::state::fnv1a;
-use yarnsim::scene::{PinMotionKind, Scene, TransferScheme, YarnScene};
+use yarnsim::scene::{PinMotionKind, Scene, StepSize, TransferScheme, YarnScene};
 
 /// The FMI model identifier: the shared library's and the C symbols' name.
 pub const MODEL_IDENTIFIER: &str = "YarnBundle";
@@ -399,6 +399,19 @@ pub fn parse_scheme(s: &str) -> Option<TransferScheme> {
 
 use VarType::{Boolean, Real};
 
+/// Sets the scene's `time.dt` from the `dt` parameter: 0 is `"auto"` (the
+/// scene's `safety` and `dt_max` kept), a positive value a fixed substep
+/// (`safety` and `dt_max`, which only `"auto"` takes, dropped).
+fn set_dt(s: &mut YarnScene, v: f64) {
+    if v == 0.0 {
+        s.time.dt = StepSize::Auto;
+    } else {
+        s.time.dt = StepSize::Fixed(v);
+        s.time.safety = None;
+        s.time.dt_max = None;
+    }
+}
+
 /// The YarnBundle's variables before the ones every model has
 /// ([`COMMON_VARIABLES`]) and the per-yarn outputs ([`yarn_outputs`]), in
 /// `ModelVariables` order. The Real parameters read and override the scene
@@ -416,7 +429,7 @@ pub static YARN_VARIABLES: [VarSpec; 20] = [
     parameter("material.friction", VR_FRICTION, Real, None, material(|s| s.material.friction, |s, v| s.material.friction = v, false), "Mohr-Coulomb friction coefficient"),
     parameter("material.bending", VR_BENDING, Real, Some("Pa"), material(|s| s.material.bending, |s, v| s.material.bending = v, false), "Bending modulus (0 disables bending)"),
     parameter("material.density", VR_DENSITY, Real, Some("kg/m"), material(|s| s.material.density, |s, v| s.material.density = v, true), "Line density"),
-    parameter("dt", VR_DT, Real, Some("s"), material(|s| s.time.dt, |s, v| s.time.dt = v, true), "Substep size; a communication step runs an integer number of substeps"),
+    parameter("dt", VR_DT, Real, Some("s"), Start::Scene(SceneField { get: |s| s.time.dt.fixed().unwrap_or(0.0), set: set_dt, positive: false, max: 1e12 }), "Substep size; 0: adaptive (the scene's dt = \"auto\": each substep is the safety factor times the stability bound of the current state, the last one before a communication point shortened to land on it). A fixed dt runs an integer number of substeps per communication step"),
     parameter("material.plasticity", VR_PLASTICITY, Boolean, None, Start::Bool(|s| s.material.plasticity), "Mohr-Coulomb return mapping on or off"),
     parameter("transfer.scheme", VR_TRANSFER_SCHEME, VarType::String, None, Start::Name(|s| scheme_name(s.transfer.scheme)), "Particle velocity update of grid-to-particle: flip (FLIP/APIC blend by transfer.flip_ratio) or apic"),
     parameter("transfer.flip_ratio", VR_FLIP_RATIO, Real, None, Start::Scene(SceneField { get: |s| s.transfer.flip_ratio, set: |s, v| s.transfer.flip_ratio = v, positive: false, max: 1.0 }), "FLIP ratio in [0, 1] of the flip scheme (1: pure FLIP; ignored by apic)"),

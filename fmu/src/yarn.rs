@@ -184,18 +184,23 @@ pub struct YarnModel {
     pub inputs: Inputs,
     /// Diagnostics of the current state, computed on first use.
     pub diag: Option<Diagnostics>,
-    /// Per pin: the force the yarn exerted on it, summed over the substeps
-    /// of the current (or last) communication step, and their number.
+    /// Per pin: the force the yarn exerted on it over the substeps of the
+    /// current (or last) communication step (time-weighted under
+    /// `dt = "auto"`), and their number.
     pub forces: PinForces,
 }
 
 /// The pins' forces on the yarn summed over the substeps of a
-/// communication step.
+/// communication step: with a fixed `dt` plainly (weight 1 per substep),
+/// under `dt = "auto"` weighted by each substep's length, so the mean is
+/// the time average over the step either way.
 #[derive(Clone, Debug, PartialEq)]
 pub struct PinForces {
-    /// Per pin, the sum of the yarn's force on it, N/m.
+    /// Per pin, the weighted sum of the yarn's force on it.
     pub sum: Vec<Vec2>,
     pub substeps: u64,
+    /// Sum of the weights (the substep count, or the time under "auto").
+    pub weight: f64,
 }
 
 impl PinForces {
@@ -203,6 +208,7 @@ impl PinForces {
         PinForces {
             sum: vec![Vec2::zeros(); pins],
             substeps: 0,
+            weight: 0.0,
         }
     }
 
@@ -211,7 +217,7 @@ impl PinForces {
         if self.substeps == 0 {
             Vec2::zeros()
         } else {
-            self.sum[i] / self.substeps as f64
+            self.sum[i] / self.weight
         }
     }
 }
@@ -291,15 +297,37 @@ impl YarnModel {
 
     pub fn substep(&mut self) -> Result<(), StepFailure> {
         self.diag = None;
-        self.sim.step().map_err(|e| StepFailure {
+        let step = self.sim.step();
+        self.after_substep(step, 1.0)
+    }
+
+    /// One adaptive substep toward `until` on the simulation's clock
+    /// (`dt = "auto"`), the last one landing on it.
+    pub fn substep_toward(&mut self, until: f64) -> Result<(), StepFailure> {
+        self.diag = None;
+        let before = self.sim.time();
+        let step = self.sim.step_toward(until).map(|_| ());
+        let dt = self.sim.time() - before;
+        self.after_substep(step, dt)
+    }
+
+    /// Adds the substep's pin forces with `weight` (1, or the substep's
+    /// length under `dt = "auto"`).
+    fn after_substep(
+        &mut self,
+        step: Result<(), SimError>,
+        weight: f64,
+    ) -> Result<(), StepFailure> {
+        step.map_err(|e| StepFailure {
             terminal: matches!(e, SimError::NonFinite { .. }),
             msg: e.to_string(),
         })?;
         // The yarn pulls on each pin with the opposite of the pin's force.
         for (s, r) in self.forces.sum.iter_mut().zip(self.sim.pin_reactions()) {
-            *s -= *r;
+            *s -= *r * weight;
         }
         self.forces.substeps += 1;
+        self.forces.weight += weight;
         Ok(())
     }
 
@@ -620,6 +648,7 @@ impl YarnModel {
             Some(TransferScheme::Apic) => 2,
         });
         w.u64(s.forces.substeps);
+        w.f64(s.forces.weight);
         for f in &s.forces.sum {
             w.f64(f.x);
             w.f64(f.y);
@@ -680,11 +709,19 @@ impl YarnModel {
             scheme,
         };
         let substeps = r.u64()?;
+        let weight = r.f64()?;
+        if !(weight.is_finite() && weight >= 0.0) {
+            return Err(format!("bad pin force weight {weight}"));
+        }
         let mut sum = Vec::with_capacity(current.forces.sum.len());
         for _ in 0..current.forces.sum.len() {
             sum.push(Vec2::new(r.f64()?, r.f64()?));
         }
-        let forces = PinForces { sum, substeps };
+        let forces = PinForces {
+            sum,
+            substeps,
+            weight,
+        };
         let scene_text = r.string()?;
         let sim_bytes = r.bytes()?;
         r.finish()?;
@@ -735,6 +772,15 @@ impl FmuModel for YarnModel {
     }
     fn begin_step(&mut self, since_start: f64) -> Result<(), StepFailure> {
         YarnModel::begin_step(self, since_start)
+    }
+    fn adaptive(&self) -> bool {
+        self.sim.is_auto()
+    }
+    fn substeps_to(&self, until: f64) -> u64 {
+        self.sim.substeps_to(until)
+    }
+    fn substep_toward(&mut self, until: f64) -> Result<(), StepFailure> {
+        YarnModel::substep_toward(self, until)
     }
     fn substep(&mut self, _k: u64) -> Result<(), StepFailure> {
         YarnModel::substep(self)

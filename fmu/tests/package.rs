@@ -86,7 +86,7 @@ fn guid_follows_the_scene_and_survives_the_scene_file() {
     let back = YarnScene::from_toml_str(&text).unwrap();
     assert_eq!(guid(&back), guid(&scene));
     let mut other = scene.clone();
-    other.time.dt *= 0.5;
+    other.time.dt = (other.time.dt.fixed().unwrap() * 0.5).into();
     assert_ne!(guid(&other), guid(&scene));
     assert_ne!(guid(&yarn_reference()), guid(&scene));
 }

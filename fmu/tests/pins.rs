@@ -366,7 +366,7 @@ fn driven_pin_state_round_trip_gives_identical_bits() {
 #[test]
 fn input_pin_on_the_substep_grid_reproduces_line_and_circle_pins() {
     let input = pinned_scene("motion = \"input\"");
-    let dt = input.time.dt;
+    let dt = input.time.dt.fixed().unwrap();
     let steps = 250; // 0.05 s
     let run_fmu = |target: &dyn Fn(f64) -> (Vec2, Vec2)| {
         let f = Fmu::new(&input);

@@ -35,5 +35,5 @@ pub mod transfer;
 pub mod vertex_forces;
 
 pub use pins::{Pin, PinMotion};
-pub use sim::{Attractor, Diagnostics, PassTimes, Passes, SimError, YarnSim};
+pub use sim::{Attractor, Diagnostics, DtStats, PassTimes, Passes, SimError, Stepping, YarnSim};
 pub use transfer::Transfer;

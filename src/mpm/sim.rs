@@ -13,7 +13,10 @@ use super::spin;
 use super::transfer::Transfer;
 use super::vertex_forces;
 use crate::math::Vec2;
-use crate::scene::{Obstacle, SceneError, TransferScheme, TransferSpec, WallMode, YarnScene};
+use crate::scene::{
+    Obstacle, SceneError, StepSize, TransferScheme, TransferSpec, WallMode, YarnScene,
+    DEFAULT_SAFETY,
+};
 
 /// Why a step failed.
 #[derive(Clone, Debug, PartialEq)]
@@ -107,6 +110,55 @@ impl PassTimes {
     }
 }
 
+/// How the substep is chosen (`[time] dt`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Stepping {
+    /// Every substep has the same size.
+    Fixed(f64),
+    /// `dt = "auto"`: each substep is `min(safety * stable_dt, dt_max)` of
+    /// the state it starts from ([`super::timestep::stable_dt`]).
+    Auto { safety: f64, dt_max: f64 },
+}
+
+/// The substeps taken since the last reset: count and sizes.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DtStats {
+    pub substeps: u64,
+    pub min: f64,
+    pub max: f64,
+    /// Sum of the substeps (simulated time), s.
+    pub sum: f64,
+}
+
+impl Default for DtStats {
+    fn default() -> Self {
+        DtStats {
+            substeps: 0,
+            min: f64::INFINITY,
+            max: 0.0,
+            sum: 0.0,
+        }
+    }
+}
+
+impl DtStats {
+    fn record(&mut self, dt: f64) {
+        self.substeps += 1;
+        self.min = self.min.min(dt);
+        self.max = self.max.max(dt);
+        self.sum += dt;
+    }
+
+    /// Mean substep, s (0 before any).
+    pub fn mean(&self) -> f64 {
+        if self.substeps == 0 {
+            0.0
+        } else {
+            self.sum / self.substeps as f64
+        }
+    }
+}
+
 /// Summary quantities of the current state.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Diagnostics {
@@ -134,6 +186,8 @@ pub struct YarnSim {
     grid: Grid,
     energy: YarnEnergy,
     pub(crate) dt: f64,
+    stepping: Stepping,
+    dt_stats: DtStats,
     pub(crate) gravity: Vec2,
     pub(crate) attractor: Attractor,
     pub(crate) time: f64,
@@ -160,6 +214,17 @@ pub fn transfer_of(spec: &TransferSpec) -> Transfer {
     }
 }
 
+/// How a scene's substeps are chosen.
+pub fn stepping_of(scene: &YarnScene) -> Stepping {
+    match scene.time.dt {
+        StepSize::Fixed(dt) => Stepping::Fixed(dt),
+        StepSize::Auto => Stepping::Auto {
+            safety: scene.time.safety.unwrap_or(DEFAULT_SAFETY),
+            dt_max: scene.time.dt_max.unwrap_or(f64::INFINITY),
+        },
+    }
+}
+
 impl YarnSim {
     /// Builds the simulation of a scene, at rest at t = 0.
     pub fn new(scene: &YarnScene) -> Result<Self, SceneError> {
@@ -174,7 +239,7 @@ impl YarnSim {
                 pinned[i] = true;
             }
         }
-        Ok(YarnSim {
+        let mut sim = YarnSim {
             pinned,
             transfer: transfer_of(&scene.transfer),
             pin_reactions: vec![Vec2::zeros(); pins.len()],
@@ -182,7 +247,9 @@ impl YarnSim {
             particles,
             grid: Grid::new(geom),
             energy: YarnEnergy::from_material(&scene.material),
-            dt: scene.time.dt,
+            dt: scene.time.dt.fixed().unwrap_or(0.0),
+            stepping: stepping_of(scene),
+            dt_stats: DtStats::default(),
             gravity: Vec2::from(scene.gravity),
             attractor: Attractor {
                 position: Vec2::from(scene.attractor.position),
@@ -195,7 +262,12 @@ impl YarnSim {
             frames_stale: true,
             timings: PassTimes::default(),
             scene: scene.clone(),
-        })
+        };
+        if sim.is_auto() {
+            // Not used under "auto"; kept positive for the saved state.
+            sim.dt = sim.auto_dt();
+        }
+        Ok(sim)
     }
 
     pub fn scene(&self) -> &YarnScene {
@@ -216,9 +288,40 @@ impl YarnSim {
     pub fn steps(&self) -> u64 {
         self.steps
     }
-    /// Substep size.
+    /// Substep size: the fixed one, or under `dt = "auto"` the one the
+    /// current state allows ([`YarnSim::auto_dt`]).
     pub fn dt(&self) -> f64 {
-        self.dt
+        match self.stepping {
+            Stepping::Fixed(_) => self.dt,
+            Stepping::Auto { .. } => self.auto_dt(),
+        }
+    }
+    /// How the substeps are chosen.
+    pub fn stepping(&self) -> Stepping {
+        self.stepping
+    }
+    /// Whether the substeps are chosen adaptively (`dt = "auto"`).
+    pub fn is_auto(&self) -> bool {
+        matches!(self.stepping, Stepping::Auto { .. })
+    }
+    /// The adaptive substep of the current state:
+    /// `min(safety * stable_dt, dt_max)` ([`YarnSim::stable_dt`]: the
+    /// elastic-wave plus particle-speed CFL bound and the bending bound);
+    /// with a fixed `dt`, safety [`DEFAULT_SAFETY`] and no cap.
+    pub fn auto_dt(&self) -> f64 {
+        let (safety, dt_max) = match self.stepping {
+            Stepping::Auto { safety, dt_max } => (safety, dt_max),
+            Stepping::Fixed(_) => (DEFAULT_SAFETY, f64::INFINITY),
+        };
+        (safety * self.stable_dt()).min(dt_max)
+    }
+    /// Count and sizes of the substeps since the last
+    /// [`YarnSim::reset_dt_stats`] (or since the start).
+    pub fn dt_stats(&self) -> DtStats {
+        self.dt_stats
+    }
+    pub fn reset_dt_stats(&mut self) {
+        self.dt_stats = DtStats::default();
     }
     pub fn grid_geom(&self) -> GridGeom {
         self.grid.geom
@@ -376,9 +479,10 @@ impl YarnSim {
         self.timings = PassTimes::default();
     }
 
-    /// One substep of the scene's `dt`.
+    /// One substep of the scene's `dt` (under `dt = "auto"`: of
+    /// [`YarnSim::auto_dt`]).
     pub fn step(&mut self) -> Result<(), SimError> {
-        self.step_dt(self.dt)
+        self.step_dt(self.dt())
     }
 
     /// `n` substeps.
@@ -389,10 +493,77 @@ impl YarnSim {
         Ok(())
     }
 
-    /// Advances by `duration` seconds in `round(duration / dt)` substeps.
+    /// Advances by `duration` seconds: in `round(duration / dt)` substeps
+    /// with a fixed `dt`, under `dt = "auto"` to the time `now + duration`
+    /// exactly ([`YarnSim::advance_to`]).
     pub fn advance(&mut self, duration: f64) -> Result<(), SimError> {
-        let n = (duration / self.dt).round().max(0.0) as u64;
-        self.steps_n(n)
+        match self.stepping {
+            Stepping::Fixed(_) => {
+                let n = (duration / self.dt).round().max(0.0) as u64;
+                self.steps_n(n)
+            }
+            Stepping::Auto { .. } => self.advance_to(self.time + duration),
+        }
+    }
+
+    /// The next substep toward the time `until` under `dt = "auto"`, or
+    /// `None` when the simulation is there: the bound `b`
+    /// ([`YarnSim::auto_dt`]) when more than `2 b` remain, half the rest
+    /// when between `b` and `2 b` remain (no sliver step before the end),
+    /// else the rest. Every substep is at most the bound of the state it
+    /// starts from.
+    pub fn substep_toward(&self, until: f64) -> Option<f64> {
+        let rest = until - self.time;
+        if rest <= 0.0 || !rest.is_finite() {
+            return None;
+        }
+        let b = self.auto_dt();
+        Some(if rest <= b {
+            rest
+        } else if rest <= 2.0 * b {
+            0.5 * rest
+        } else {
+            b
+        })
+    }
+
+    /// Runs adaptive substeps ([`YarnSim::substep_toward`]) until the time
+    /// is `until` exactly (the last substep lands on it; its clock is set
+    /// to `until`, not to the rounded sum). With a fixed `dt`, runs
+    /// `round((until - now) / dt)` substeps of it.
+    pub fn advance_to(&mut self, until: f64) -> Result<(), SimError> {
+        if let Stepping::Fixed(_) = self.stepping {
+            let n = ((until - self.time) / self.dt).round().max(0.0) as u64;
+            return self.steps_n(n);
+        }
+        while self.step_toward(until)? {}
+        Ok(())
+    }
+
+    /// One adaptive substep toward `until` ([`YarnSim::substep_toward`]);
+    /// `Ok(false)` when already there (no substep run). After the last
+    /// substep the clock reads `until` exactly.
+    pub fn step_toward(&mut self, until: f64) -> Result<bool, SimError> {
+        let Some(dt) = self.substep_toward(until) else {
+            return Ok(false);
+        };
+        let last = dt == until - self.time;
+        self.step_dt(dt)?;
+        if last {
+            self.time = until;
+        }
+        Ok(true)
+    }
+
+    /// Estimated substeps to reach `until` at the current bound (adaptive)
+    /// or the fixed `dt`: `ceil(rest / dt)`, at least 1 when any time
+    /// remains (the adaptive count can grow when the particles speed up).
+    pub fn substeps_to(&self, until: f64) -> u64 {
+        let rest = until - self.time;
+        if rest <= 0.0 || rest.is_nan() {
+            return 0;
+        }
+        (rest / self.dt()).ceil().clamp(1.0, u64::MAX as f64) as u64
     }
 
     /// One substep of size `dt`.
@@ -492,6 +663,7 @@ impl YarnSim {
         tm.gather_vertices += (t4 - t3).as_secs_f64();
         tm.gather_quads += (t5 - t4).as_secs_f64();
         tm.substeps += 1;
+        self.dt_stats.record(dt);
 
         self.steps += 1;
         self.time += dt;

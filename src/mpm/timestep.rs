@@ -35,6 +35,12 @@
 //! impacts) are not known in advance: [`YarnSim::stable_dt`] uses the
 //! current largest particle speed, so at initialization it is the elastic
 //! bound of a scene at rest, a necessary condition, not a guarantee.
+//!
+//! `[time] dt = "auto"` applies the bound in every substep instead:
+//! [`YarnSim::auto_dt`] is `min(safety * stable_dt, dt_max)` of the state
+//! the substep starts from (default safety
+//! [`crate::scene::DEFAULT_SAFETY`], measured on the reference scene), and
+//! [`YarnSim::advance_to`] lands on frame and communication times exactly.
 
 use super::constitutive::YarnEnergy;
 use super::YarnSim;
@@ -65,15 +71,18 @@ pub fn stable_dt(m: &Material, dx: f64, v_max: f64) -> f64 {
 
 impl YarnSim {
     /// The largest particle speed now, in m/s (vertices and quadrature
-    /// particles).
+    /// particles). A parallel maximum: the same value for any thread count
+    /// (the maximum does not depend on the order of the reduction).
     pub fn max_speed(&self) -> f64 {
+        use rayon::prelude::*;
         let p = self.particles();
-        p.vert
-            .v
-            .iter()
-            .chain(&p.quad.v)
-            .map(|v| v.norm())
-            .fold(0.0, f64::max)
+        let max = |v: &[crate::math::Vec2]| {
+            v.par_iter()
+                .with_min_len(4096)
+                .map(|v| v.norm_squared())
+                .reduce(|| 0.0, f64::max)
+        };
+        max(&p.vert.v).max(max(&p.quad.v)).sqrt()
     }
 
     /// The stable substep bound of the current state

@@ -1,7 +1,7 @@
 //! The built-in scenes.
 
 use super::yarn::{
-    AttractorSpec, GridSpec, Material, Obstacle, TimeSpec, Walls, YarnScene, YarnSpec,
+    AttractorSpec, GridSpec, Material, Obstacle, StepSize, TimeSpec, Walls, YarnScene, YarnSpec,
 };
 use super::Scene;
 
@@ -78,7 +78,9 @@ pub fn yarn_reference() -> YarnScene {
             size: 1.0,
         },
         time: TimeSpec {
-            dt: 4e-5,
+            dt: StepSize::Fixed(4e-5),
+            safety: None,
+            dt_max: None,
             frame_dt: 1.0 / 60.0,
         },
         material: reference_material(),
@@ -148,7 +150,9 @@ pub fn small_yarn_scene(yarns: u32, vertices: u32, resolution: u32) -> YarnScene
             size: 1.0,
         },
         time: TimeSpec {
-            dt: 1e-4,
+            dt: StepSize::Fixed(1e-4),
+            safety: None,
+            dt_max: None,
             frame_dt: 1.0 / 60.0,
         },
         material: reference_material(),

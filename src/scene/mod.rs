@@ -12,8 +12,8 @@ pub mod yarn;
 pub use builtin::{builtin, builtin_names, DEFAULT_SCENE};
 pub use error::SceneError;
 pub use yarn::{
-    AttractorSpec, GridSpec, Material, Obstacle, PinMotionKind, PinSpec, TimeSpec, TransferScheme,
-    TransferSpec, WallMode, Walls, YarnEnd, YarnScene, YarnSpec,
+    AttractorSpec, GridSpec, Material, Obstacle, PinMotionKind, PinSpec, StepSize, TimeSpec,
+    TransferScheme, TransferSpec, WallMode, Walls, YarnEnd, YarnScene, YarnSpec, DEFAULT_SAFETY,
 };
 
 /// Any scene this crate can simulate.

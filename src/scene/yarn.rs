@@ -4,7 +4,7 @@
 
 use serde::{Deserialize, Deserializer, Serialize};
 
-use super::error::{from_toml_error, table_line, SceneError};
+use super::error::{from_toml_error, line_of, table_line, SceneError};
 use crate::math::Vec2;
 
 /// A complete yarn-bundle scene. See the README section "Scene files" for
@@ -161,12 +161,107 @@ pub struct GridSpec {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct TimeSpec {
-    /// Substep size in s.
-    #[serde(deserialize_with = "positive")]
-    pub dt: f64,
+    /// Substep size: a number in s, or `"auto"` (each substep from the
+    /// stability bound of the current state, see [`crate::mpm::timestep`]).
+    pub dt: StepSize,
+    /// Safety factor of `dt = "auto"`: the substep is `safety` times the
+    /// stability bound (default [`DEFAULT_SAFETY`]; 0 < safety <= 2). Only
+    /// with `dt = "auto"`.
+    #[serde(
+        default,
+        skip_serializing_if = "Option::is_none",
+        deserialize_with = "opt_safety"
+    )]
+    pub safety: Option<f64>,
+    /// Largest substep of `dt = "auto"` in s (default: no cap). Only with
+    /// `dt = "auto"`.
+    #[serde(
+        default,
+        skip_serializing_if = "Option::is_none",
+        deserialize_with = "opt_positive"
+    )]
+    pub dt_max: Option<f64>,
     /// Output frame interval in s (CLI frames and recordings; default 1/60).
     #[serde(default = "default_frame_dt", deserialize_with = "positive")]
     pub frame_dt: f64,
+}
+
+/// Default safety factor of `dt = "auto"`: the substep is this fraction of
+/// the stability bound `dx / (c + |v|max)` (and of the bending bound).
+/// Measured on the reference scene (README "Adaptive substeps"): it runs
+/// to 0.5 s at a factor of 1.1 and diverges at 1.2 (t = 0.13 s), so 0.8
+/// leaves a margin of about 1.4x below the largest stable factor.
+pub const DEFAULT_SAFETY: f64 = 0.8;
+
+/// The substep setting `[time] dt`: a fixed size or `"auto"`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum StepSize {
+    /// Every substep is this long (s, finite, > 0).
+    Fixed(f64),
+    /// Each substep is chosen from the stability bound of the current state.
+    Auto,
+}
+
+impl StepSize {
+    /// The fixed substep, `None` for `"auto"`.
+    pub fn fixed(self) -> Option<f64> {
+        match self {
+            StepSize::Fixed(dt) => Some(dt),
+            StepSize::Auto => None,
+        }
+    }
+
+    /// Whether the substep is `"auto"`.
+    pub fn is_auto(self) -> bool {
+        self == StepSize::Auto
+    }
+}
+
+impl std::fmt::Display for StepSize {
+    /// `4e-5 s` or `auto`.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            StepSize::Fixed(dt) => write!(f, "{dt} s"),
+            StepSize::Auto => f.write_str("auto"),
+        }
+    }
+}
+
+impl From<f64> for StepSize {
+    fn from(dt: f64) -> Self {
+        StepSize::Fixed(dt)
+    }
+}
+
+impl Serialize for StepSize {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        match self {
+            StepSize::Fixed(dt) => s.serialize_f64(*dt),
+            StepSize::Auto => s.serialize_str("auto"),
+        }
+    }
+}
+
+impl<'de> Deserialize<'de> for StepSize {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        #[derive(Deserialize)]
+        #[serde(untagged)]
+        enum Raw {
+            Number(f64),
+            Text(String),
+        }
+        let bad = |what: String| {
+            D::Error::custom(format!(
+                "must be a substep in s (a finite number > 0) or \"auto\", got {what}"
+            ))
+        };
+        match Raw::deserialize(d).map_err(|_| bad("another type".into()))? {
+            Raw::Number(v) if v.is_finite() && v > 0.0 => Ok(StepSize::Fixed(v)),
+            Raw::Number(v) => Err(bad(v.to_string())),
+            Raw::Text(t) if t == "auto" => Ok(StepSize::Auto),
+            Raw::Text(t) => Err(bad(format!("{t:?}"))),
+        }
+    }
 }
 
 /// Material of the yarns (per unit thickness: the 2D model has unit depth).
@@ -417,17 +512,53 @@ impl YarnScene {
             });
         }
         self.validate_pins(text)?;
-        if self.time.frame_dt < self.time.dt {
-            return Err(SceneError::Invalid {
-                field: "time.frame_dt".into(),
-                line: None,
-                message: format!(
-                    "frame_dt {} is shorter than the substep dt {}",
-                    self.time.frame_dt, self.time.dt
-                ),
-            });
-        }
+        self.validate_time(text)?;
         super::overlap::check_yarns_clear_of_obstacles(self, text)?;
+        Ok(())
+    }
+
+    fn validate_time(&self, text: Option<&str>) -> Result<(), SceneError> {
+        let t = &self.time;
+        let invalid = |field: &str, message: String| SceneError::Invalid {
+            field: format!("time.{field}"),
+            line: text.and_then(|text| key_line(text, "[time]", field)),
+            message,
+        };
+        match t.dt {
+            StepSize::Fixed(dt) => {
+                if !(dt.is_finite() && dt > 0.0) {
+                    return Err(invalid("dt", format!("must be > 0, got {dt}")));
+                }
+                if t.frame_dt < dt {
+                    return Err(invalid(
+                        "frame_dt",
+                        format!(
+                            "frame_dt {} is shorter than the substep dt {dt}",
+                            t.frame_dt
+                        ),
+                    ));
+                }
+                for (field, set) in [
+                    ("safety", t.safety.is_some()),
+                    ("dt_max", t.dt_max.is_some()),
+                ] {
+                    if set {
+                        return Err(invalid(
+                            field,
+                            format!("applies only to dt = \"auto\", but dt is {dt}"),
+                        ));
+                    }
+                }
+            }
+            StepSize::Auto => {
+                if let Some(s) = t.safety.filter(|s| !(*s > 0.0 && *s <= 2.0)) {
+                    return Err(invalid("safety", format!("must be in (0, 2], got {s}")));
+                }
+                if let Some(m) = t.dt_max.filter(|m| !(m.is_finite() && *m > 0.0)) {
+                    return Err(invalid("dt_max", format!("must be > 0, got {m}")));
+                }
+            }
+        }
         Ok(())
     }
 
@@ -584,6 +715,26 @@ impl YarnSpec {
     }
 }
 
+/// Line of `key = ...` inside the table `header` (e.g. `[time]`), else of
+/// the header, when the text has it.
+fn key_line(text: &str, header: &str, key: &str) -> Option<usize> {
+    let start = text.find(header)?;
+    let body = &text[start + header.len()..];
+    let end = body.find("\n[").map_or(body.len(), |i| i + 1);
+    let mut pos = start + header.len();
+    for line in body[..end].split_inclusive('\n') {
+        if line
+            .trim_start()
+            .strip_prefix(key)
+            .is_some_and(|r| r.trim_start().starts_with('='))
+        {
+            return Some(line_of(text, pos));
+        }
+        pos += line.len();
+    }
+    Some(line_of(text, start))
+}
+
 /// `n` points equally spaced by arc length along the polyline `poly`.
 fn resample(poly: &[Vec2], n: usize) -> Result<Vec<Vec2>, String> {
     let seg: Vec<f64> = poly.windows(2).map(|w| (w[1] - w[0]).norm()).collect();
@@ -675,6 +826,15 @@ fn unit_interval<'de, D: Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
         Err(D::Error::custom(format!(
             "must be between 0 and 1, got {v}"
         )))
+    }
+}
+
+fn opt_safety<'de, D: Deserializer<'de>>(d: D) -> Result<Option<f64>, D::Error> {
+    let v = super::readers::finite(d)?;
+    if v > 0.0 && v <= 2.0 {
+        Ok(Some(v))
+    } else {
+        Err(D::Error::custom(format!("must be in (0, 2], got {v}")))
     }
 }
 

@@ -170,25 +170,45 @@ fn replay_yarn(scene: &YarnScene, rows: &[Vec<f64>], h: f64, stop: f64) -> Resul
             active: row[4] != 0.0,
         })
         .map_err(|e| e.to_string())?;
-        // The FMU's rule: substeps done by time t are round((t - t0) / dt).
-        let target = (next / sim.dt()).round() as u64;
-        if target > sim.steps() {
+        // The FMU's rule: substeps done by time t are round((t - t0) / dt);
+        // under dt = "auto" adaptive substeps land on every point.
+        let auto = sim.is_auto();
+        let target = if auto {
+            0
+        } else {
+            (next / sim.dt()).round() as u64
+        };
+        if (auto && sim.time() < next) || (!auto && target > sim.steps()) {
             // The FMU latches the pin inputs when a step that runs substeps begins.
             for (j, &pin) in inputs.iter().enumerate() {
                 let c = &row[7 + 4 * j..11 + 4 * j];
                 sim.set_pin_target_at(pin, Vec2::new(c[0], c[1]), Vec2::new(c[2], c[3]), now)
                     .map_err(|e| e.to_string())?;
             }
-            let n = target - sim.steps();
+            // The FMU's mean: per substep, or time-weighted under "auto".
+            let mut weight = 0.0;
             let mut sum = vec![Vec2::zeros(); pins];
-            for _ in 0..n {
-                sim.step().map_err(|e| e.to_string())?;
+            loop {
+                let before = sim.time();
+                let stepped = if auto {
+                    sim.step_toward(next).map_err(|e| e.to_string())?
+                } else if sim.steps() < target {
+                    sim.step().map_err(|e| e.to_string())?;
+                    true
+                } else {
+                    false
+                };
+                if !stepped {
+                    break;
+                }
+                let w = if auto { sim.time() - before } else { 1.0 };
+                weight += w;
                 for (s, r) in sum.iter_mut().zip(sim.pin_reactions()) {
-                    *s -= *r;
+                    *s -= *r * w;
                 }
             }
             for (f, s) in force.iter_mut().zip(&sum) {
-                *f = *s / n as f64;
+                *f = *s / weight;
             }
         }
         record(&mut csv, next, &sim, &force);
