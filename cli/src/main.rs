@@ -10,7 +10,10 @@ use yarnsim_cli::duration::parse_duration;
 use yarnsim_cli::error::{CliError, EXIT_INTERRUPTED};
 use yarnsim_cli::estimate::{announce, Estimate};
 use yarnsim_cli::massspring::IntegratorArgs;
-use yarnsim_cli::record::{record, RecordOptions, Sink, DEFAULT_CONNECT_URL};
+use yarnsim_cli::record::{
+    parse_memory_limit, record, MemoryLimit, RecordOptions, Sink, DEFAULT_CONNECT_URL,
+    DEFAULT_SERVER_MEMORY_LIMIT, DEFAULT_SERVE_PORT,
+};
 use yarnsim_cli::run::run;
 use yarnsim_cli::scenes::{list_scenes, load_scene, show_scene};
 use yarnsim_cli::table::{format_summary, Timing};
@@ -23,8 +26,10 @@ use yarnsim_cli::table::{format_summary, Timing};
 ///
 /// Exit codes: 0 success, 1 simulation failure, 2 bad arguments (e.g. an
 /// invalid duration), 3 unknown scene or unreadable/invalid scene file,
-/// 4 output file cannot be written or viewer unreachable, 130 interrupted by
-/// Ctrl-C or SIGTERM (output so far is complete and valid).
+/// 4 output file cannot be written, viewer unreachable or port in use,
+/// 130 interrupted by Ctrl-C or SIGTERM (output so far is complete and
+/// valid). `record --serve` serves on after the run until Ctrl-C or SIGTERM,
+/// and then exits 0.
 #[derive(Parser, Debug)]
 #[command(name = "yarnsim", version, max_term_width = 100)]
 struct Cli {
@@ -56,9 +61,9 @@ enum Command {
     /// Record a scene for the Rerun viewer: particles, yarns or springs, obstacles, plots.
     ///
     /// Into a file (default run.rrd; open it with `rerun run.rrd`), to
-    /// standard output (`-o - | rerun -`), or live into a viewer (`--spawn`,
-    /// `--connect`). Timelines are `frame` and `sim_time`; there is no
-    /// wall-clock timeline.
+    /// standard output (`-o - | rerun -`), live into a viewer (`--spawn`,
+    /// `--connect`), or served to viewers that connect (`--serve`).
+    /// Timelines are `frame` and `sim_time`; there is no wall-clock timeline.
     Record {
         /// Built-in scene name or scene file.
         #[arg(default_value = DEFAULT_SCENE)]
@@ -83,10 +88,25 @@ enum Command {
         /// a rerun+http://HOST:PORT/proxy URL or HOST:PORT.
         #[arg(long, value_name = "ADDR", num_args = 0..=1, default_missing_value = DEFAULT_CONNECT_URL, group = "sink")]
         connect: Option<String>,
-        /// Not built in (it needs Rerun's server feature): start `rerun
-        /// --serve-web` and record with `--connect` instead.
-        #[arg(long, group = "sink")]
+        /// Host a gRPC server and stream to it live; view with `rerun
+        /// --connect URL` (the URL is printed). After the run it serves on
+        /// until Ctrl-C or SIGTERM (exit code 0). With --save FILE, also
+        /// writes the file.
+        #[arg(long, conflicts_with_all = ["spawn", "connect"])]
         serve: bool,
+        /// Port of the --serve server.
+        #[arg(long, value_name = "PORT", default_value_t = DEFAULT_SERVE_PORT, requires = "serve",
+              value_parser = clap::value_parser!(u16).range(1..))]
+        port: u16,
+        /// Address the --serve server listens on (0.0.0.0: every interface).
+        #[arg(long, value_name = "IP", default_value = "0.0.0.0", requires = "serve")]
+        bind: std::net::IpAddr,
+        /// Memory the --serve server keeps the recording in, for viewers
+        /// that connect late: 16GB, 500MiB or 50% (of RAM); beyond it the
+        /// oldest frames are dropped.
+        #[arg(long, value_name = "X", default_value = DEFAULT_SERVER_MEMORY_LIMIT,
+              value_parser = parse_memory_limit, requires = "serve")]
+        server_memory_limit: MemoryLimit,
         /// Log every Nth frame only (frame 0 and the last frame always).
         #[arg(long, value_name = "N", default_value_t = 1, value_parser = clap::value_parser!(u64).range(1..))]
         every: u64,
@@ -193,16 +213,14 @@ fn execute(command: Command) -> Result<u8, CliError> {
             spawn,
             connect,
             serve,
+            port,
+            bind,
+            server_memory_limit,
             every,
             integrator,
         } => {
             let sink = if serve {
-                return Err(CliError::Usage(
-                    "--serve is not built into yarnsim (it needs Rerun's server feature); start \
-                     a server with a web viewer with `rerun --serve-web`, then record into it with \
-                     `yarnsim record --connect`"
-                        .into(),
-                ));
+                Sink::serve(bind, port, server_memory_limit, output.as_deref())?
             } else if spawn {
                 Sink::Spawn
             } else if let Some(addr) = &connect {
@@ -238,12 +256,29 @@ fn execute(command: Command) -> Result<u8, CliError> {
                 _ => println!("{line}"),
             };
             say(&text);
-            if let Sink::File(path) = &opts.sink {
-                say(&format!("open it with: rerun {}", path.display()));
+            match &opts.sink {
+                Sink::File(path) => say(&format!("open it with: rerun {}", path.display())),
+                Sink::Serve(s) => {
+                    if let Some(path) = &s.save {
+                        say(&format!("open the file with: rerun {}", path.display()));
+                    }
+                }
+                _ => {}
             }
-            if let Some(failure) = r.failure {
+            if let Some(failure) = &r.failure {
                 eprintln!("error: {failure}");
                 eprintln!("the recording holds the frames before the failure");
+            }
+            // A failed run is served too: its last frames show what went wrong.
+            if let Some(server) = r.server {
+                say(&format!(
+                    "still serving at {url} until Ctrl-C or SIGTERM; view it with: rerun --connect {url}",
+                    url = server.url()
+                ));
+                server.serve_until_interrupted();
+                say("stopped serving");
+            }
+            if let Some(failure) = r.failure {
                 return Ok(failure.exit_code());
             }
             if o.interrupted {

@@ -24,7 +24,10 @@
 //! same scene hold the same data everywhere except under `timing/`.
 
 use std::io::IsTerminal;
+use std::net::{IpAddr, Ipv4Addr, Ipv6Addr, SocketAddr};
 use std::path::{Path, PathBuf};
+use std::sync::atomic::Ordering;
+use std::time::Duration;
 
 use rerun::blueprint::components::PanelState;
 use rerun::blueprint::{
@@ -193,6 +196,65 @@ impl PlasticState {
 /// Address `--connect` uses without a value: a viewer started with plain `rerun`.
 pub const DEFAULT_CONNECT_URL: &str = "rerun+http://127.0.0.1:9876/proxy";
 
+pub use rerun::MemoryLimit;
+
+/// Port `--serve` listens on without `--port`: Rerun's own default.
+pub const DEFAULT_SERVE_PORT: u16 = rerun::DEFAULT_SERVER_PORT;
+
+/// Memory limit of the `--serve` server without `--server-memory-limit`:
+/// the default of Rerun's own `--serve` flag.
+pub const DEFAULT_SERVER_MEMORY_LIMIT: &str = "25%";
+
+/// Parses a `--server-memory-limit` the way Rerun does: `16GB`, `500MiB`,
+/// `50%` (of the machine's memory), `0` or `unlimited`.
+pub fn parse_memory_limit(text: &str) -> Result<MemoryLimit, String> {
+    MemoryLimit::parse(text)
+}
+
+/// A gRPC server that the recording hosts (`--serve`): viewers connect to
+/// it, during the run or after it, and get everything logged so far.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Serve {
+    /// Address to listen on (`--bind`, default `0.0.0.0`: every interface).
+    pub bind: IpAddr,
+    /// Port to listen on (`--port`, default 9876).
+    pub port: u16,
+    /// How much of the recording the server keeps for viewers that connect
+    /// late (`--server-memory-limit`); beyond it the oldest frames go first,
+    /// static data (geometry, legend, blueprint) is always kept.
+    pub memory_limit: MemoryLimit,
+    /// Also save the recording to this `.rrd` file (`--save FILE`).
+    pub save: Option<PathBuf>,
+}
+
+impl Serve {
+    /// The URL a viewer connects to: `rerun --connect URL`. A server on
+    /// every interface is reached at `127.0.0.1` on this machine.
+    pub fn url(&self) -> String {
+        let host = match self.bind {
+            IpAddr::V4(ip) if ip.is_unspecified() => IpAddr::V4(Ipv4Addr::LOCALHOST),
+            IpAddr::V6(ip) if ip.is_unspecified() => IpAddr::V6(Ipv6Addr::LOCALHOST),
+            ip => ip,
+        };
+        format!("rerun+http://{}/proxy", SocketAddr::new(host, self.port))
+    }
+
+    /// Rerun's server starts on a thread of its own and only logs a failed
+    /// start; binding the address here first turns a port in use (e.g. by a
+    /// viewer started with plain `rerun`, which listens on 9876) into an error.
+    fn check_address(&self) -> Result<(), CliError> {
+        let addr = SocketAddr::new(self.bind, self.port);
+        std::net::TcpListener::bind(addr).map(drop).map_err(|e| {
+            CliError::Viewer(format!(
+                "cannot serve on {addr}: {e}; is a Rerun viewer or server already listening \
+                 there? Pick another port with --port, or stream into that viewer with \
+                 --connect {}",
+                self.url()
+            ))
+        })
+    }
+}
+
 /// Where a recording goes: Rerun's usual sinks.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub enum Sink {
@@ -204,6 +266,9 @@ pub enum Sink {
     Spawn,
     /// A running viewer or server at this gRPC URL (`--connect [ADDR]`).
     Connect(String),
+    /// A gRPC server of its own, for viewers to connect to (`--serve`),
+    /// optionally with a copy in a file (`--serve --save FILE`).
+    Serve(Serve),
 }
 
 impl Sink {
@@ -234,6 +299,33 @@ impl Sink {
         }
     }
 
+    /// The sink of `--serve`, saving to `output` too when given (`--save
+    /// FILE`; standard output is refused: the server is the live stream).
+    pub fn serve(
+        bind: IpAddr,
+        port: u16,
+        memory_limit: MemoryLimit,
+        output: Option<&Path>,
+    ) -> Result<Sink, CliError> {
+        let save = match output.map(Sink::output).transpose()? {
+            None => None,
+            Some(Sink::File(path)) => Some(path),
+            Some(_) => {
+                return Err(CliError::Usage(
+                    "--serve does not write to standard output (`-o -`): connect a viewer to \
+                     the server instead, or save a copy with --save FILE"
+                        .into(),
+                ))
+            }
+        };
+        Ok(Sink::Serve(Serve {
+            bind,
+            port,
+            memory_limit,
+            save,
+        }))
+    }
+
     /// Where the data went, for the closing message.
     pub fn describe(&self) -> String {
         match self {
@@ -241,6 +333,10 @@ impl Sink {
             Sink::Stdout => "standard output".into(),
             Sink::Spawn => "a new Rerun viewer".into(),
             Sink::Connect(url) => format!("the viewer at {url}"),
+            Sink::Serve(s) => match &s.save {
+                None => format!("the server at {}", s.url()),
+                Some(p) => format!("the server at {} and {}", s.url(), p.display()),
+            },
         }
     }
 
@@ -255,6 +351,7 @@ impl Sink {
             Sink::Connect(url) => {
                 CliError::Viewer(format!("cannot stream to the viewer at {url}: {cause}"))
             }
+            Sink::Serve(s) => CliError::Viewer(format!("cannot serve at {}: {cause}", s.url())),
         }
     }
 }
@@ -301,6 +398,39 @@ pub struct RecordOutcome {
     /// The simulation error that stopped the run early; the recording holds
     /// the frames before it and is complete.
     pub failure: Option<CliError>,
+    /// The `--serve` server, still serving the recording after the run (not
+    /// after an interruption: Ctrl-C during the run stops both).
+    pub server: Option<Server>,
+}
+
+/// The gRPC server of a `--serve` recording, serving everything logged to
+/// viewers that connect; it stops when this is dropped.
+pub struct Server {
+    rec: RecordingStream,
+    url: String,
+}
+
+impl std::fmt::Debug for Server {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Server").field("url", &self.url).finish()
+    }
+}
+
+impl Server {
+    /// The URL viewers connect to (`rerun --connect URL`).
+    pub fn url(&self) -> &str {
+        &self.url
+    }
+
+    /// Keeps serving until Ctrl-C, SIGTERM or SIGHUP, then shuts the server
+    /// down (viewers keep what they received).
+    pub fn serve_until_interrupted(self) {
+        let interrupt = interrupt_flag();
+        while !interrupt.load(Ordering::SeqCst) {
+            std::thread::sleep(Duration::from_millis(100));
+        }
+        drop(self.rec);
+    }
 }
 
 /// Records `scene` for `duration` seconds; `integrator` applies to
@@ -346,9 +476,38 @@ fn open(name: &str, blueprint: Blueprint, sink: &Sink) -> Result<RecordingStream
         }
         Sink::Spawn => builder.spawn(),
         Sink::Connect(url) => builder.connect_grpc_opts(url.clone()),
+        Sink::Serve(s) => {
+            s.check_address()?;
+            let options = rerun::ServerOptions {
+                memory_limit: s.memory_limit,
+                ..Default::default()
+            };
+            match &s.save {
+                None => builder.serve_grpc_opts(s.bind.to_string(), s.port, options),
+                Some(path) => {
+                    std::fs::File::create(path).map_err(|e| CliError::output(path, e))?;
+                    let file = rerun::sink::FileSink::new(path)
+                        .map_err(|e| CliError::output(path, root_cause(&e)))?;
+                    let server = rerun::grpc_server::GrpcServerSink::new(
+                        &s.bind.to_string(),
+                        s.port,
+                        options,
+                    )
+                    .map_err(|e| sink.error(e))?;
+                    builder.set_sinks((server, file))
+                }
+            }
+        }
     }
     .map_err(|e| sink.error(e))?;
     rec.set_log_time_enabled(false);
+    if let Sink::Serve(s) = sink {
+        // Before the first frame, so a viewer can follow the run live.
+        println!(
+            "serving at {url}; view it live with: rerun --connect {url}",
+            url = s.url()
+        );
+    }
     Ok(rec)
 }
 
@@ -373,7 +532,18 @@ fn record_frames<S: Stepper>(
         Ok(())
     });
     let flushed = rec.flush_blocking();
-    drop(rec);
+    let keep_serving = matches!(&result, Ok(run) if !run.outcome.interrupted);
+    let server = match &opts.sink {
+        Sink::Serve(s) if keep_serving => {
+            // Completes the file of `--save` (its footer); the server stays.
+            rec.finalize_deferred_sinks();
+            Some(Server { rec, url: s.url() })
+        }
+        _ => {
+            drop(rec);
+            None
+        }
+    };
     let FrameRun { outcome, failure } = result?;
     flushed.map_err(|e| opts.sink.error(e))?;
     Ok(RecordOutcome {
@@ -382,6 +552,7 @@ fn record_frames<S: Stepper>(
         frames_logged,
         adaptive_dt: None,
         failure,
+        server,
     })
 }
 

@@ -404,10 +404,45 @@ fn sinks_refuse_clearly() {
     // One sink at a time.
     let (code, err) = fails(&["record", &small, "--spawn", "-o", "a.rrd"], &[]);
     assert_eq!(code, 2, "{err}");
-    // --serve is not built in, and says what to do instead.
-    let (code, err) = fails(&["record", &small, "--serve"], &[]);
+    // --serve goes with --save FILE, not with another live sink or stdout.
+    let (code, err) = fails(&["record", &small, "--serve", "--spawn"], &[]);
     assert_eq!(code, 2, "{err}");
-    assert!(err.contains("rerun --serve-web"), "{err}");
+    let (code, err) = fails(&["record", &small, "--serve", "-o", "-"], &[]);
+    assert_eq!(code, 2, "{err}");
+    assert!(
+        err.contains("--serve does not write to standard output"),
+        "{err}"
+    );
+    // The server options need --serve, and a limit Rerun understands.
+    let (code, err) = fails(&["record", &small, "--port", "9000"], &[]);
+    assert_eq!(code, 2, "{err}");
+    let (code, err) = fails(
+        &["record", &small, "--serve", "--server-memory-limit", "lots"],
+        &[],
+    );
+    assert_eq!(code, 2, "{err}");
+    // A port in use (e.g. by a viewer): refused before anything runs.
+    let taken = std::net::TcpListener::bind("127.0.0.1:0").unwrap();
+    let port = taken.local_addr().unwrap().port().to_string();
+    let (code, err) = fails(
+        &[
+            "record",
+            &small,
+            "-d",
+            "1ms",
+            "--serve",
+            "--bind",
+            "127.0.0.1",
+            "--port",
+            &port,
+        ],
+        &[],
+    );
+    assert_eq!(code, 4, "{err}");
+    assert!(
+        err.contains(&format!("cannot serve on 127.0.0.1:{port}")),
+        "{err}"
+    );
     // --spawn without a viewer on PATH.
     let (code, err) = fails(
         &["record", &small, "-d", "1ms", "--spawn"],
@@ -555,4 +590,134 @@ fn recordings_read_at_a_glance() {
     let chunks = decode(&rrd);
     let vc = all_values::<ViewCoordinates>(&chunks["world"]);
     assert_eq!(vc, vec![rerun::components::ViewCoordinates::RUB]);
+}
+
+/// Reads the data chunks a `--serve` server sends, the way a viewer started
+/// with `rerun --connect URL` does (Rerun's gRPC client), until `done`
+/// holds for them; fails after 60 s or when the connection fails.
+#[cfg(unix)]
+fn read_server(
+    url: &str,
+    done: impl Fn(&BTreeMap<String, Vec<Chunk>>) -> bool,
+) -> BTreeMap<String, Vec<Chunk>> {
+    use re_log_channel::{DataSourceMessage, SmartMessagePayload};
+    let runtime = tokio::runtime::Builder::new_multi_thread()
+        .worker_threads(1)
+        .enable_all()
+        .build()
+        .unwrap();
+    let handle = re_async::AsyncRuntimeHandle::new_native(runtime.handle().clone());
+    let rx = rerun::external::re_grpc_client::stream(&handle, url.parse().expect("proxy URL"));
+    let deadline = std::time::Instant::now() + std::time::Duration::from_secs(60);
+    let mut chunks: BTreeMap<String, Vec<Chunk>> = BTreeMap::new();
+    while !done(&chunks) {
+        let left = deadline.saturating_duration_since(std::time::Instant::now());
+        let msg = rx
+            .recv_timeout(left)
+            .unwrap_or_else(|e| panic!("no more data from {url} ({e}); got {:?}", chunks.keys()));
+        match msg.payload {
+            SmartMessagePayload::Msg(DataSourceMessage::LogMsg(LogMsg::ArrowMsg(store, arrow)))
+                if store.kind() == StoreKind::Recording =>
+            {
+                let chunk = Chunk::from_arrow_msg(&arrow).expect("chunk");
+                let path = chunk.entity_path().to_string();
+                chunks
+                    .entry(path.trim_start_matches('/').to_string())
+                    .or_default()
+                    .push(chunk);
+            }
+            SmartMessagePayload::Quit(err) => panic!("connection to {url} ended: {err:?}"),
+            _ => {}
+        }
+    }
+    chunks
+}
+
+/// `record --serve --save FILE`: the server serves the whole recording to a
+/// viewer that connects after the run, the file is complete while it still
+/// serves, and SIGTERM ends the serving with exit code 0.
+#[cfg(unix)]
+#[test]
+fn serve_serves_the_recording_until_sigterm() {
+    use std::io::BufRead;
+    let rrd = tmp("record-serve.rrd");
+    let _ = std::fs::remove_file(&rrd);
+    let port = {
+        let free = std::net::TcpListener::bind("127.0.0.1:0").unwrap();
+        free.local_addr().unwrap().port().to_string()
+    };
+    let mut child = Command::new(env!("CARGO_BIN_EXE_yarnsim"))
+        .args(["record", &small_scene(), "-d", "2ms", "--serve"])
+        .args(["--bind", "127.0.0.1", "--port", &port, "--save"])
+        .arg(&rrd)
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .expect("start yarnsim");
+    let url = format!("rerun+http://127.0.0.1:{port}/proxy");
+    // Kill the child whatever happens below, so a failure leaves no server.
+    struct Reap(std::process::Child);
+    impl Drop for Reap {
+        fn drop(&mut self) {
+            let _ = self.0.kill();
+            let _ = self.0.wait();
+        }
+    }
+    let mut lines = std::io::BufReader::new(child.stdout.take().unwrap()).lines();
+    let mut child = Reap(child);
+    let mut stdout = String::new();
+    // The URL comes first, before the run; "still serving" once it is done.
+    while !stdout.contains("still serving") {
+        let Some(Ok(line)) = lines.next() else {
+            let mut err = String::new();
+            std::io::Read::read_to_string(child.0.stderr.as_mut().unwrap(), &mut err).unwrap();
+            panic!("yarnsim stopped before serving:\n{stdout}{err}");
+        };
+        stdout += &line;
+        stdout += "\n";
+    }
+    assert!(
+        stdout.starts_with(&format!(
+            "serving at {url}; view it live with: rerun --connect {url}\n"
+        )),
+        "{stdout}"
+    );
+    assert!(
+        stdout.contains(&format!(
+            "recorded 6 frames (50 substeps, 118 particles) to the server at {url} and {}",
+            rrd.display()
+        )),
+        "{stdout}"
+    );
+    // The saved copy is complete while the server still runs.
+    let saved = decode(&rrd);
+    assert_eq!(vertex_frames(&saved), (0..=5).collect::<Vec<_>>());
+    // A viewer connecting now gets all of it: every entity, every frame.
+    let served = read_server(&url, |c| {
+        c.get("world/vertices").is_some_and(|v| {
+            by_frame::<Position2D>(v, Points2D::descriptor_positions().component).len() == 6
+        }) && saved.keys().all(|k| c.contains_key(k))
+    });
+    assert_eq!(
+        served.keys().collect::<Vec<_>>(),
+        saved.keys().collect::<Vec<_>>()
+    );
+    assert_eq!(vertex_frames(&served), (0..=5).collect::<Vec<_>>());
+    let positions = |c: &BTreeMap<String, Vec<Chunk>>| {
+        by_frame::<Position2D>(
+            &c["world/vertices"],
+            Points2D::descriptor_positions().component,
+        )
+    };
+    assert_eq!(positions(&served), positions(&saved));
+    // SIGTERM (like Ctrl-C) ends the serving: exit code 0, the run was complete.
+    let kill = Command::new("kill")
+        .args(["-TERM", &child.0.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(kill.success());
+    let status = child.0.wait().unwrap();
+    let rest: Vec<String> = lines.map(Result::unwrap).collect();
+    assert_eq!(status.code(), Some(0), "{rest:?}");
+    assert_eq!(rest, ["stopped serving"]);
 }
