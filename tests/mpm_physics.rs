@@ -86,8 +86,9 @@ vertices = 40
     let mut checked = 0;
     let mut worst: f64 = 0.0;
     let mut forces = Vec::new();
+    let win = grid.geom;
     for &b in &grid.active {
-        for idx in geom.block_nodes(b as usize) {
+        for idx in win.block_nodes(b as usize) {
             let f: Vec2 = grid
                 .buffers
                 .iter()
@@ -95,7 +96,7 @@ vertices = 40
                 .sum();
             let m: f64 = grid.buffers.iter().map(|buf| buf.node[idx][grid::M]).sum();
             if m > 0.0 {
-                forces.push((geom.node(idx), f));
+                forces.push((win.node(idx), f));
                 max_f = max_f.max(f.norm());
             }
         }

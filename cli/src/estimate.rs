@@ -11,9 +11,10 @@ use yarnsim::scene::Scene;
 /// Bytes of memory per MPM particle (vertex or quadrature particle: state,
 /// APIC matrices, stencils, frames): 272 measured (`run`, 2.4e6 particles).
 pub const YARN_BYTES_PER_PARTICLE: f64 = 280.0;
-/// Bytes of memory per grid node: 10.5 measured (2048^2 grid; storage
-/// follows the active blocks, so this is an upper bound).
-pub const YARN_BYTES_PER_NODE: f64 = 12.0;
+/// Bytes of memory per node of the grid's window (the grid node, 32, and
+/// four scatter nodes of 64; the window is the yarns' bounding box with a
+/// margin of two 8-node blocks, not the domain): 288.
+pub const YARN_BYTES_PER_NODE: f64 = 288.0;
 /// Extra memory of `record` per yarn vertex (Rerun's buffers of a frame): 237 measured.
 pub const YARN_RECORDING_MEMORY_PER_VERTEX: f64 = 240.0;
 /// Bytes of a recording per yarn vertex and frame (a vertex and a quadrature
@@ -65,7 +66,7 @@ impl Estimate {
                     .iter()
                     .map(|s| (s.vertices.saturating_sub(1)) as f64 * s.count as f64)
                     .sum();
-                let nodes = (y.grid.resolution as f64 + 1.0).powi(2);
+                let nodes = window_nodes(y);
                 let mut memory =
                     YARN_BYTES_PER_PARTICLE * (vertices + quads) + YARN_BYTES_PER_NODE * nodes;
                 if recording {
@@ -130,6 +131,25 @@ impl Estimate {
         }
         Some(text)
     }
+}
+
+/// Nodes of the grid window at the start: the yarns' bounding box in
+/// cells, plus the stencil and a margin of two blocks per side, at most
+/// the whole grid. (The window follows the yarns; if they spread, it grows.)
+fn window_nodes(y: &yarnsim::scene::YarnScene) -> f64 {
+    let n = y.grid.resolution as f64;
+    let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+    for p in y.curves().iter().flatten() {
+        for a in 0..2 {
+            lo[a] = lo[a].min(p[a]);
+            hi[a] = hi[a].max(p[a]);
+        }
+    }
+    if lo[0] > hi[0] {
+        return 0.0;
+    }
+    let side = |a: usize| ((hi[a] - lo[a]) / y.dx() + 3.0 + 2.0 * 2.0 * 8.0 + 8.0).min(n + 8.0);
+    side(0) * side(1)
 }
 
 /// Prints the note of a large run on stderr.

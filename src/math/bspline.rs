@@ -25,6 +25,16 @@ pub fn weights_1d(fx: f64) -> [f64; 3] {
     [0.5 * a * a, 0.75 - b * b, 0.5 * c * c]
 }
 
+/// Lower-left node of the stencil of a particle at `x` (what
+/// [`Stencil::new`] puts in `base`).
+#[inline(always)]
+pub fn base_of(x: Vec2, inv_dx: f64) -> [i32; 2] {
+    [
+        ((x.x * inv_dx - 0.5) as i64) as i32,
+        ((x.y * inv_dx - 0.5) as i64) as i32,
+    ]
+}
+
 impl Stencil {
     /// Stencil of a particle at `x >= 0.5 dx` (per axis) on a grid of spacing `1 / inv_dx`.
     #[inline(always)]

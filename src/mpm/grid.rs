@@ -1,6 +1,11 @@
-//! The background grid: dense row-major storage, worked on block by block
-//! (8 x 8 nodes) so that clearing, summing and the grid update touch only the
-//! blocks that particles reach.
+//! The background grid: dense row-major storage of a *window* of whole
+//! blocks (8 x 8 nodes) around the particles, worked on block by block so
+//! that summing and the grid update touch only the blocks that particles
+//! reach. The window follows the particles' bounding box (with a margin of
+//! two blocks, refitted when a particle leaves it or it is four times larger
+//! than needed), so memory follows the yarns, not the domain: a bundle on
+//! an 8192^2 grid stores what it stores on 256^2. Where the window sits
+//! changes no result (only where nodes are kept, not how they are summed).
 //!
 //! Scattering runs over a fixed number of particle chunks, each into its own
 //! buffer; the buffers are summed in chunk order, so results do not depend on
@@ -49,20 +54,29 @@ pub const DVX: usize = 2;
 /// Lane of the y velocity change.
 pub const DVY: usize = 3;
 
-/// Grid geometry: `n x n` nodes at `(i dx, j dx)`, stored with row stride
-/// `stride` (`n` rounded up to whole blocks): node `(i, j)` is at `i * stride + j`.
+/// Grid geometry, `n x n` nodes at `(i dx, j dx)`, and the stored window:
+/// blocks `nbi x nbj` from node `(i0, j0)`, row-major with row stride
+/// `stride = nbj * BLOCK`: node `(i, j)` is at `(i - i0) * stride + j - j0`.
+/// Blocks are numbered inside the window.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct GridGeom {
     pub n: usize,
     pub dx: f64,
     pub inv_dx: f64,
-    /// Blocks per side.
+    /// Blocks per side of the whole grid.
     pub nb: usize,
-    /// Row stride, `nb * BLOCK`.
+    /// First node of the window (multiples of [`BLOCK`]).
+    pub i0: usize,
+    pub j0: usize,
+    /// Window size in blocks.
+    pub nbi: usize,
+    pub nbj: usize,
+    /// Row stride of the window, `nbj * BLOCK`.
     pub stride: usize,
 }
 
 impl GridGeom {
+    /// The geometry with a window over the whole grid.
     pub fn new(n: usize, size: f64) -> Self {
         let dx = size / n as f64;
         let nb = n.div_ceil(BLOCK);
@@ -71,44 +85,89 @@ impl GridGeom {
             dx,
             inv_dx: 1.0 / dx,
             nb,
+            i0: 0,
+            j0: 0,
+            nbi: nb,
+            nbj: nb,
             stride: nb * BLOCK,
         }
     }
 
-    /// Storage index of node `(i, j)`.
+    /// The same grid with the window of blocks `bi0..bi0 + nbi`,
+    /// `bj0..bj0 + nbj`.
+    pub fn with_window(&self, bi0: usize, bj0: usize, nbi: usize, nbj: usize) -> Self {
+        GridGeom {
+            i0: bi0 * BLOCK,
+            j0: bj0 * BLOCK,
+            nbi,
+            nbj,
+            stride: nbj * BLOCK,
+            ..*self
+        }
+    }
+
+    /// Storage index of node `(i, j)` (inside the window).
     #[inline(always)]
     pub fn index(&self, i: usize, j: usize) -> usize {
-        i * self.stride + j
+        (i - self.i0) * self.stride + (j - self.j0)
     }
 
     /// Node `(i, j)` of storage index `idx`.
     #[inline(always)]
     pub fn node(&self, idx: usize) -> (usize, usize) {
-        (idx / self.stride, idx % self.stride)
+        (idx / self.stride + self.i0, idx % self.stride + self.j0)
     }
 
-    /// Total stored nodes.
+    /// Stored nodes (the window's).
     pub fn storage(&self) -> usize {
-        self.stride * self.stride
+        self.nbi * BLOCK * self.stride
     }
 
+    /// Blocks of the window.
     pub fn blocks(&self) -> usize {
-        self.nb * self.nb
+        self.nbi * self.nbj
     }
 
-    /// Block of node `(i, j)`.
+    /// Window block of node `(i, j)`.
     #[inline(always)]
     pub fn block_of(&self, i: usize, j: usize) -> usize {
-        (i >> BLOCK_SHIFT) * self.nb + (j >> BLOCK_SHIFT)
+        ((i - self.i0) >> BLOCK_SHIFT) * self.nbj + ((j - self.j0) >> BLOCK_SHIFT)
     }
 
-    /// Storage indices of block `b`, row by row (eight runs of eight).
+    /// First node `(i, j)` of window block `b`.
+    #[inline(always)]
+    pub fn block_origin(&self, b: usize) -> (usize, usize) {
+        (
+            self.i0 + ((b / self.nbj) << BLOCK_SHIFT),
+            self.j0 + ((b % self.nbj) << BLOCK_SHIFT),
+        )
+    }
+
+    /// Storage indices of window block `b`, row by row (eight runs of eight).
     pub fn block_nodes(&self, b: usize) -> impl Iterator<Item = usize> + '_ {
-        let (bi, bj) = (b / self.nb, b % self.nb);
+        let (bi, bj) = (b / self.nbj, b % self.nbj);
         (0..BLOCK).flat_map(move |r| {
             let start = ((bi << BLOCK_SHIFT) + r) * self.stride + (bj << BLOCK_SHIFT);
             start..start + BLOCK
         })
+    }
+
+    /// Whether the 3x3 stencils with lower-left nodes in `lo..=hi` (per
+    /// axis) lie inside the window.
+    fn window_holds(&self, lo: [usize; 2], hi: [usize; 2]) -> bool {
+        lo[0] >= self.i0
+            && lo[1] >= self.j0
+            && hi[0] + 2 < self.i0 + self.nbi * BLOCK
+            && hi[1] + 2 < self.j0 + self.nbj * BLOCK
+    }
+}
+
+/// Resizes a pool to `len` entries (new ones `zero`), giving memory back
+/// when the window has shrunk to under a quarter of the capacity.
+fn fit<T: Clone>(pool: &mut Vec<T>, len: usize, zero: T) {
+    pool.resize(len, zero);
+    if pool.capacity() > 4 * len {
+        pool.shrink_to(2 * len);
     }
 }
 
@@ -142,22 +201,17 @@ impl ScatterBuffer {
     /// Marks the blocks covered by the 3x3 stencil at `base`.
     #[inline(always)]
     pub fn touch_stencil(&mut self, geom: &GridGeom, base: [i32; 2]) {
-        let (i0, j0) = (
-            base[0] as usize >> BLOCK_SHIFT,
-            base[1] as usize >> BLOCK_SHIFT,
-        );
-        let (i1, j1) = (
-            (base[0] as usize + 2) >> BLOCK_SHIFT,
-            (base[1] as usize + 2) >> BLOCK_SHIFT,
-        );
-        self.touch(i0 * geom.nb + j0);
+        let (ri, rj) = (base[0] as usize - geom.i0, base[1] as usize - geom.j0);
+        let (i0, j0) = (ri >> BLOCK_SHIFT, rj >> BLOCK_SHIFT);
+        let (i1, j1) = ((ri + 2) >> BLOCK_SHIFT, (rj + 2) >> BLOCK_SHIFT);
+        self.touch(i0 * geom.nbj + j0);
         if j1 != j0 {
-            self.touch(i0 * geom.nb + j1);
+            self.touch(i0 * geom.nbj + j1);
         }
         if i1 != i0 {
-            self.touch(i1 * geom.nb + j0);
+            self.touch(i1 * geom.nbj + j0);
             if j1 != j0 {
-                self.touch(i1 * geom.nb + j1);
+                self.touch(i1 * geom.nbj + j1);
             }
         }
     }
@@ -171,7 +225,8 @@ impl ScatterBuffer {
     }
 }
 
-/// The summed grid: a [`Node`] per node on the active blocks.
+/// The summed grid: a [`Node`] per node of the window (meaningful on the
+/// active blocks), and the chunks' scatter buffers.
 #[derive(Clone, Debug)]
 pub struct Grid {
     pub geom: GridGeom,
@@ -184,14 +239,84 @@ pub struct Grid {
 }
 
 impl Grid {
+    /// A grid of geometry `geom` with an empty window (nothing stored until
+    /// the first [`Grid::fit_window`]).
     pub fn new(geom: GridGeom) -> Self {
+        let geom = geom.with_window(0, 0, 0, 0);
         Grid {
             geom,
-            node: vec![[0.0; 4]; geom.storage()],
+            node: Vec::new(),
             active: Vec::new(),
-            is_active: vec![false; geom.blocks()],
+            is_active: Vec::new(),
             buffers: (0..CHUNKS).map(|_| ScatterBuffer::new(&geom)).collect(),
         }
+    }
+
+    /// Moves the window so that it holds the 3x3 stencils at `bases`: kept
+    /// while it holds them and is at most four times the blocks they need
+    /// (and 16), otherwise refitted with a margin of two blocks per side.
+    /// Call before a scatter (it forgets the last scatter's touched blocks).
+    pub fn fit_window(&mut self, bases: impl Iterator<Item = [i32; 2]>) {
+        let (mut lo, mut hi) = ([usize::MAX; 2], [0usize; 2]);
+        for b in bases {
+            let b = [b[0].max(0) as usize, b[1].max(0) as usize];
+            for a in 0..2 {
+                lo[a] = lo[a].min(b[a]);
+                hi[a] = hi[a].max(b[a]);
+            }
+        }
+        if lo[0] > hi[0] {
+            return; // no particles
+        }
+        let g = self.geom;
+        let (k_lo, k_hi) = (
+            [lo[0] >> BLOCK_SHIFT, lo[1] >> BLOCK_SHIFT],
+            [(hi[0] + 2) >> BLOCK_SHIFT, (hi[1] + 2) >> BLOCK_SHIFT],
+        );
+        let need = (k_hi[0] - k_lo[0] + 1) * (k_hi[1] - k_lo[1] + 1);
+        if g.window_holds(lo, hi) && g.blocks() <= 4 * need.max(16) {
+            return;
+        }
+        const MARGIN: usize = 2;
+        let last = g.nb - 1;
+        let (bi0, bj0) = (
+            k_lo[0].saturating_sub(MARGIN),
+            k_lo[1].saturating_sub(MARGIN),
+        );
+        let (bi1, bj1) = ((k_hi[0] + MARGIN).min(last), (k_hi[1] + MARGIN).min(last));
+        // forget the touched and active blocks while their numbers still
+        // mean the old window
+        for buf in &mut self.buffers {
+            buf.clear();
+        }
+        for &b in &self.active {
+            self.is_active[b as usize] = false;
+        }
+        self.active.clear();
+        let geom = g.with_window(bi0, bj0, bi1 - bi0 + 1, bj1 - bj0 + 1);
+        self.geom = geom;
+        // every scatter node is zero here (the grid update zeroed what it
+        // summed), so the pools need no clearing wherever the window moved
+        fit(&mut self.node, geom.storage(), [0.0; 4]);
+        fit(&mut self.is_active, geom.blocks(), false);
+        for buf in &mut self.buffers {
+            fit(&mut buf.node, geom.storage(), [0.0; P2G_LANES]);
+            fit(&mut buf.touched, geom.blocks(), false);
+        }
+    }
+
+    /// Bytes the grid holds now (its pools by capacity).
+    pub fn memory_bytes(&self) -> usize {
+        use std::mem::size_of;
+        let mut b = self.node.capacity() * size_of::<Node>()
+            + self.active.capacity() * size_of::<u32>()
+            + self.is_active.capacity();
+        for buf in &self.buffers {
+            b += buf.node.capacity() * size_of::<P2gNode>()
+                + buf.touched.capacity()
+                + buf.touched_list.capacity() * size_of::<u32>();
+        }
+        b
     }
 
     /// Collects the union of the chunks' touched blocks into `active`, sorted.
@@ -218,9 +343,10 @@ mod tests {
 
     #[test]
     fn index_roundtrip_and_blocks_partition_the_nodes() {
-        let g = GridGeom::new(37, 1.0);
-        for i in 0..37 {
-            for j in 0..37 {
+        let full = GridGeom::new(37, 1.0);
+        let g = full.with_window(1, 2, 3, 2);
+        for i in 8..32 {
+            for j in 16..32 {
                 assert_eq!(g.node(g.index(i, j)), (i, j));
             }
         }
@@ -230,6 +356,8 @@ mod tests {
                 seen[k] += 1;
                 let (i, j) = g.node(k);
                 assert_eq!(g.block_of(i, j), b);
+                let (i0, j0) = g.block_origin(b);
+                assert!((i0..i0 + BLOCK).contains(&i) && (j0..j0 + BLOCK).contains(&j));
             }
         }
         assert!(seen.iter().all(|&c| c == 1));

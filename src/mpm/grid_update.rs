@@ -41,7 +41,7 @@ struct BandSrc<'a> {
 pub fn grid_update(grid: &mut Grid, dt: f64, ext: &GridForces, flip: bool) {
     let geom = grid.geom;
     let band_len = geom.stride * BLOCK;
-    let mut bands: Vec<Vec<BandSrc>> = (0..geom.nb).map(|_| Vec::with_capacity(CHUNKS)).collect();
+    let mut bands: Vec<Vec<BandSrc>> = (0..geom.nbi).map(|_| Vec::with_capacity(CHUNKS)).collect();
     for buf in grid.buffers.iter_mut() {
         let ScatterBuffer { node, touched, .. } = buf;
         for (band, node) in bands.iter_mut().zip(node.chunks_mut(band_len)) {
@@ -63,7 +63,7 @@ pub fn grid_update(grid: &mut Grid, dt: f64, ext: &GridForces, flip: bool) {
 }
 
 multiversion! {
-    /// [`grid_update`] on the active blocks of block row `bi`.
+    /// [`grid_update`] on the active blocks of block row `bi` of the window.
     fn grid_band<const FLIP: bool>(
         bi: usize,
         band: &mut [Node],
@@ -78,12 +78,12 @@ multiversion! {
         // contact reaches nodes up to the particles' stencil (1.5 cells) plus
         // the contact margin outside an obstacle
         let reach = 2.0 * dx;
-        for bj in 0..geom.nb {
-            let b = bi * geom.nb + bj;
+        for bj in 0..geom.nbj {
+            let b = bi * geom.nbj + bj;
             if !is_active[b] {
                 continue;
             }
-            let (i0, j0) = (bi * BLOCK, bj * BLOCK);
+            let (i0, j0) = geom.block_origin(b);
             let mut srcs: [usize; CHUNKS] = [0; CHUNKS];
             let mut nsrc = 0;
             for (k, s) in buffers.iter().enumerate() {
@@ -107,7 +107,7 @@ multiversion! {
                     || j0 + BLOCK + cells > geom.n);
             for r in 0..BLOCK {
                 let i = i0 + r;
-                let row = r * geom.stride + j0;
+                let row = r * geom.stride + bj * BLOCK;
                 for c in 0..BLOCK {
                     let j = j0 + c;
                     let mut acc = [0.0; P2G_LANES];

@@ -14,7 +14,7 @@ use super::grid::{
 use super::particles::{Particles, Quads, Vertices};
 use super::simd::{chunk_range, multiversion};
 use super::vertex_forces::vertex_forces;
-use crate::math::bspline::Stencil;
+use crate::math::bspline::{base_of, Stencil};
 use crate::math::{Mat2, Vec2};
 use crate::scene::Obstacle;
 
@@ -123,6 +123,15 @@ fn split_chunks<T>(v: &mut [T], n: usize) -> Vec<&mut [T]> {
 /// alone too (in lanes that only FLIP reads); `obstacles` are the ones
 /// whose contact mass is marked.
 pub fn scatter(p: &mut Particles, grid: &mut Grid, dt: f64, bending: f64, obstacles: &[Obstacle]) {
+    // a window that holds every stencil
+    let inv_dx = grid.geom.inv_dx;
+    grid.fit_window(
+        p.vert
+            .x
+            .iter()
+            .map(|&x| base_of(x, inv_dx))
+            .chain(p.quad.stencil.iter().map(|st| st.base)),
+    );
     let geom = grid.geom;
     let (nv, nq) = (p.vert.x.len(), p.quad.x.len());
     // Each chunk writes the stencils and forces of its own vertex range

@@ -335,6 +335,11 @@ impl YarnSim {
     pub fn attractor(&self) -> Attractor {
         self.attractor
     }
+    /// Bytes the grid holds now: its window of nodes and the scatter
+    /// buffers (they follow the particles' bounding box, not the domain).
+    pub fn grid_memory_bytes(&self) -> usize {
+        self.grid.memory_bytes()
+    }
     /// Number of blocks (8x8 nodes) the last substep touched.
     pub fn active_blocks(&self) -> usize {
         self.grid.active.len()
