@@ -1,4 +1,5 @@
-//! `yarnsim bench precision`, `yarnsim stress` and `yarnsim bench skip`: the
+//! `yarnsim bench precision`, `yarnsim stress`, `yarnsim bench skip` and
+//! `yarnsim bench roofline`: the
 //! evidence studies of [`yarnsim_evidence`], writing CSV, SVG and a text
 //! report into a directory and printing the report.
 //!
@@ -10,7 +11,7 @@ use std::ffi::OsString;
 use std::path::{Path, PathBuf};
 
 use clap::Subcommand;
-use yarnsim_evidence::{precision, skip, stress, write_report};
+use yarnsim_evidence::{precision, roofline, skip, stress, write_report};
 
 use crate::error::CliError;
 
@@ -66,14 +67,34 @@ pub enum EvidenceCommand {
         #[arg(long, default_value_t = 12)]
         repeats: usize,
     },
+    /// The limit (`yarnsim bench roofline`): this core's peak flop/s and
+    /// memory bandwidth (multiply-add and triad kernels), the flops and
+    /// bytes per particle of each pass counted from the kernels, and where
+    /// each pass of the reference scene (1 thread) sits on the roofline.
+    #[command(name = "bench-roofline")]
+    BenchRoofline {
+        /// Output directory for roofline*.csv, roofline.txt.
+        #[arg(long, value_name = "DIR", default_value = "evidence")]
+        out: PathBuf,
+        /// Timed substeps per repeat.
+        #[arg(long, default_value_t = 200)]
+        steps: u64,
+        /// Repeats (substeps: the fastest is kept; peak kernels: the median).
+        #[arg(long, default_value_t = 7)]
+        repeats: usize,
+    },
 }
 
 /// Maps `yarnsim bench precision ...` to `yarnsim bench-precision ...` and
-/// `yarnsim bench skip ...` to `yarnsim bench-skip ...`; other arguments
+/// `yarnsim bench skip ...` to `yarnsim bench-skip ...` (and `roofline`
+/// likewise); other arguments
 /// pass unchanged.
 pub fn rewrite_args(args: impl IntoIterator<Item = OsString>) -> Vec<OsString> {
     let mut v: Vec<OsString> = args.into_iter().collect();
-    if v.len() >= 3 && v[1] == "bench" && (v[2] == "precision" || v[2] == "skip") {
+    if v.len() >= 3
+        && v[1] == "bench"
+        && (v[2] == "precision" || v[2] == "skip" || v[2] == "roofline")
+    {
         let joined = format!("bench-{}", v[2].to_string_lossy());
         v.splice(1..3, [OsString::from(joined)]);
     }
@@ -123,6 +144,24 @@ pub fn execute(cmd: &EvidenceCommand) -> Result<(String, Vec<String>), CliError>
             .map_err(CliError::Failed)?;
             Ok((r.to_text(), write(out, &r.files())?))
         }
+        EvidenceCommand::BenchRoofline {
+            out,
+            steps,
+            repeats,
+        } => {
+            if *steps == 0 || *repeats == 0 {
+                return Err(CliError::Usage(
+                    "--steps and --repeats must be at least 1".into(),
+                ));
+            }
+            let r = roofline::run(&roofline::RooflineOptions {
+                steps: *steps,
+                repeats: *repeats,
+                ..Default::default()
+            })
+            .map_err(CliError::Failed)?;
+            Ok((r.to_text(), write(out, &r.files())?))
+        }
     }
 }
 
@@ -143,6 +182,10 @@ mod tests {
         assert_eq!(
             rewrite_args(os(&["yarnsim", "bench", "skip"])),
             os(&["yarnsim", "bench-skip"])
+        );
+        assert_eq!(
+            rewrite_args(os(&["yarnsim", "bench", "roofline", "--steps", "5"])),
+            os(&["yarnsim", "bench-roofline", "--steps", "5"])
         );
         assert_eq!(
             rewrite_args(os(&["yarnsim", "bench", "yarn-reference"])),

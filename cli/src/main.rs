@@ -315,6 +315,7 @@ fn execute(command: Command) -> Result<u8, CliError> {
                 E::Stress { quick: false, .. } => ("stress", "about 50 s"),
                 E::Stress { quick: true, .. } => ("stress --quick", "about 25 s"),
                 E::BenchSkip { .. } => ("bench skip", "grows with --steps x --repeats"),
+                E::BenchRoofline { .. } => ("bench roofline", "about 10 s"),
             };
             let spinner = yarnsim_cli::driver::spinner(label);
             spinner.set_message(note);

@@ -1,10 +1,10 @@
 //! Runs the evidence studies without the CLI:
-//! `cargo run --release -p yarnsim-evidence --example evidence -- precision|stress|skip [--quick] [--out DIR]`
+//! `cargo run --release -p yarnsim-evidence --example evidence -- precision|stress|skip|roofline [--quick] [--out DIR]`
 //! (precision also takes `--yarn-reference` and `--no-chain`).
 
 use std::path::PathBuf;
 
-use yarnsim_evidence::{precision, skip, stress, write_report};
+use yarnsim_evidence::{precision, roofline, skip, stress, write_report};
 
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
@@ -34,7 +34,12 @@ fn main() {
             let r = skip::run(&skip::SkipOptions::default()).unwrap_or_else(|e| panic!("{e}"));
             (r.to_text(), r.files())
         }
-        other => panic!("unknown study {other:?}: precision, stress or skip"),
+        "roofline" => {
+            let r = roofline::run(&roofline::RooflineOptions::default())
+                .unwrap_or_else(|e| panic!("{e}"));
+            (r.to_text(), r.files())
+        }
+        other => panic!("unknown study {other:?}: precision, stress, skip or roofline"),
     };
     println!("{text}");
     for f in write_report(&out, &files).expect("output directory writable") {

@@ -12,6 +12,9 @@
 //!   parameter), found by bisection, next to the theoretical bound.
 //! * [`skip`]: the cost of obstacles, attractor, plasticity and bending, grid
 //!   work against grid size, and the per-pass breakdown of the reference scene.
+//! * [`roofline`]: this core's peak flop/s and bandwidth (simple kernels),
+//!   flops and bytes per particle of each pass (counted from the kernels)
+//!   and where each pass of the reference scene sits against that limit.
 //! * [`plot`]: hand-written SVG plots.
 //!
 //! Every report renders as CSV ([`Table::to_csv`]), a text table
@@ -22,6 +25,7 @@
 pub mod chain;
 pub mod plot;
 pub mod precision;
+pub mod roofline;
 pub mod skip;
 pub mod stress;
 
