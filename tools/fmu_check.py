@@ -5,7 +5,9 @@ usage: fmu_check.py SMALL.fmu REFERENCE_SCENE.fmu WORKDIR REPLAY_EXE SMALL_SCENE
 1. fmpy's validation of both FMUs (schema, structure, start values, units).
 2. fmpy.simulate_fmu of SMALL.fmu with an input signal (attractor on a
    circle, switched on at 0.1 s; gravity turning), compared bit for bit
-   with the Rust library run of the same inputs (fmu-replay).
+   with the Rust library run of the same inputs (fmu-replay); again with
+   the parameter dt = 0 (adaptive substeps) against the scene with
+   dt = "auto", in fewer substeps.
 3. FMU state through fmpy: get + serialize at t1, run on, deserialize +
    set, run on again: identical outputs.
 4. A short simulate_fmu of the default (reference) scene FMU.
@@ -22,6 +24,7 @@ Exits non-zero on any problem.
 """
 import csv
 import math
+import re
 import subprocess
 import sys
 
@@ -145,6 +148,36 @@ compare("YarnBundle (small)", result, out_csv, outputs)
 moved = max(abs(result[-1][n] - result[0][n]) for n in outputs if n.startswith("yarn"))
 if not moved > 0.05:
     failures.append(f"the yarn ends moved only {moved} m: the inputs had no effect")
+
+# 2b. the same under adaptive substeps: the FMU's dt = 0 against the Rust
+# run of the scene with dt = "auto"; fewer substeps than the fixed 2e-4
+result_auto = simulate_fmu(
+    small_fmu,
+    start_time=0.0,
+    stop_time=STOP,
+    output_interval=H,
+    input=signals,
+    output=outputs,
+    start_values={"dt": 0.0},
+    validate=True,
+)
+with open(small_scene) as fh:
+    scene_text = fh.read()
+auto_text = re.sub(r"(?m)^dt\s*=.*$", 'dt = "auto"', scene_text, count=1)
+if auto_text == scene_text:
+    failures.append("could not set dt = \"auto\" in the small scene")
+auto_scene = f"{work}/small_auto.toml"
+with open(auto_scene, "w") as fh:
+    fh.write(auto_text)
+subprocess.run(
+    [replay, "--scene", auto_scene, "--inputs", in_csv, "--step", repr(H), "--stop", repr(STOP), "-o", f"{work}/rust_auto.csv"],
+    check=True,
+)
+compare("YarnBundle (small, dt = 0: auto)", result_auto, f"{work}/rust_auto.csv", outputs)
+fixed_n, auto_n = result[-1]["substeps"], result_auto[-1]["substeps"]
+print(f"substeps to {STOP} s: fixed dt {fixed_n:.0f}, auto {auto_n:.0f}")
+if not auto_n < fixed_n:
+    failures.append(f"auto took {auto_n} substeps, the fixed dt {fixed_n}")
 
 # 3. FMU state through fmpy's C calls
 vrs = [v.valueReference for v in md.modelVariables if v.causality == "output" and v.type == "Real"]
