@@ -29,6 +29,16 @@ use crate::model::{
 #[derive(Clone, Debug)]
 pub struct Model {
     pub physics: Box<dyn FmuModel>,
+    /// Time keeping and flags (what an FMU state holds besides the model).
+    pub clock: Clock,
+    /// The outputs were found finite and nothing changed since (no
+    /// substep, no value set); not part of the serialized state.
+    pub outputs_checked: bool,
+}
+
+/// The wrapper's time keeping and flags, as an FMU state holds them.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Clock {
     /// The simulation must be rebuilt from the scene and the parameters
     /// before use (a parameter changed).
     pub dirty: bool,
@@ -41,67 +51,45 @@ pub struct Model {
     pub substeps: u64,
     /// Set when a step diverged (`fmi2Terminated` status).
     pub terminated: bool,
-    /// The outputs were found finite and nothing changed since (no
-    /// substep, no value set); not part of the serialized state.
-    pub outputs_checked: bool,
 }
 
-/// The wrapper's time keeping and flags, as an FMU state holds them.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Clock {
-    pub dirty: bool,
-    pub start_time: f64,
-    pub stop_time: Option<f64>,
-    pub time: f64,
-    pub last_successful_time: f64,
-    pub substeps: u64,
-    pub terminated: bool,
+impl Clock {
+    /// At time 0, nothing run.
+    const START: Clock = Clock {
+        dirty: false,
+        start_time: 0.0,
+        stop_time: None,
+        time: 0.0,
+        last_successful_time: 0.0,
+        substeps: 0,
+        terminated: false,
+    };
 }
 
 impl Model {
     /// The time keeping and flags of an FMU state.
     pub fn clock(&self) -> Clock {
-        Clock {
-            dirty: self.dirty,
-            start_time: self.start_time,
-            stop_time: self.stop_time,
-            time: self.time,
-            last_successful_time: self.last_successful_time,
-            substeps: self.substeps,
-            terminated: self.terminated,
-        }
+        self.clock
     }
 
     fn set_clock(&mut self, c: &Clock) {
-        self.dirty = c.dirty;
-        self.start_time = c.start_time;
-        self.stop_time = c.stop_time;
-        self.time = c.time;
-        self.last_successful_time = c.last_successful_time;
-        self.substeps = c.substeps;
-        self.terminated = c.terminated;
+        self.clock = *c;
         self.outputs_checked = false;
     }
 
     fn new(scene: &FmuScene) -> Res<Self> {
         Ok(Model {
             physics: new_model(scene)?,
-            dirty: false,
-            start_time: 0.0,
-            stop_time: None,
-            time: 0.0,
-            last_successful_time: 0.0,
-            substeps: 0,
-            terminated: false,
+            clock: Clock::START,
             outputs_checked: false,
         })
     }
 
     /// Rebuilds the simulation after parameter changes.
     fn ensure_built(&mut self, count: usize) -> Res {
-        if self.dirty {
+        if self.clock.dirty {
             self.physics.rebuild(count)?;
-            self.dirty = false;
+            self.clock.dirty = false;
         }
         Ok(())
     }
@@ -295,10 +283,10 @@ impl Instance {
             }
         }
         let m = &mut self.model;
-        m.start_time = start;
-        m.stop_time = stop;
-        m.time = start;
-        m.last_successful_time = start;
+        m.clock.start_time = start;
+        m.clock.stop_time = stop;
+        m.clock.time = start;
+        m.clock.last_successful_time = start;
         Ok(())
     }
 
@@ -328,17 +316,17 @@ impl Instance {
             None => m.ensure_built(self.count)?,
         }
         let m = &mut self.model;
-        m.time = m.start_time;
-        m.last_successful_time = m.start_time;
-        m.substeps = 0;
-        m.terminated = false;
+        m.clock.time = m.clock.start_time;
+        m.clock.last_successful_time = m.clock.start_time;
+        m.clock.substeps = 0;
+        m.clock.terminated = false;
         self.phase = Phase::StepComplete;
         self.log(
             Status::Ok,
             LOG_EVENTS,
             &format!(
                 "initialized at t = {}: {} {}, substep {} s",
-                self.model.time,
+                self.model.clock.time,
                 self.count,
                 self.bundled.objects(),
                 self.model.physics.dt()
@@ -387,15 +375,15 @@ impl Instance {
         if h <= 0.0 {
             return error(format!("communication step size h = {h} must be > 0"));
         }
-        let tol = 1e-9 * m.time.abs().max(t.abs()).max(h);
-        if (t - m.time).abs() > tol {
+        let tol = 1e-9 * m.clock.time.abs().max(t.abs()).max(h);
+        if (t - m.clock.time).abs() > tol {
             return error(format!(
                 "communication point {t} does not match the FMU's time {} (tolerance {tol:e})",
-                m.time
+                m.clock.time
             ));
         }
         let end = t + h;
-        if let Some(stop) = m.stop_time {
+        if let Some(stop) = m.clock.stop_time {
             if end > stop + 1e-9 * stop.abs().max(h) {
                 return error(format!(
                     "step from {t} by {h} ends past the stop time {stop}"
@@ -409,17 +397,17 @@ impl Instance {
         // own clock (seconds since the start time), landing on it exactly;
         // `needed` is then the estimate at the present stability bound.
         let budget = self.execution.max_substeps;
-        let until = end - m.start_time;
+        let until = end - m.clock.start_time;
         let dt = m.physics.dt();
         let (target, needed) = if m.physics.adaptive() {
             (None, m.physics.substeps_to(until))
         } else {
-            let target = ((end - m.start_time) / dt).round();
+            let target = ((end - m.clock.start_time) / dt).round();
             if !(0.0..9.0e15).contains(&target) {
                 return error(format!("step to {end} needs {target} substeps of {dt} s"));
             }
             let target = target as u64;
-            (Some(target), target.saturating_sub(m.substeps))
+            (Some(target), target.saturating_sub(m.clock.substeps))
         };
         if needed > budget as u64 {
             let (about, of) = match target {
@@ -434,15 +422,15 @@ impl Instance {
         // step (time t = lastSuccessfulTime). A failed step puts it back, so
         // the outputs stay readable after a Discard (one checkpoint per step
         // that runs substeps; measured in the README).
-        let start_substeps = m.substeps;
+        let start_substeps = m.clock.substeps;
         let mut last_good = (needed > 0).then(|| m.physics.checkpoint());
         let mut restore = |m: &mut Model| {
             if let Some(c) = last_good.take() {
                 m.physics.restore(c);
-                m.substeps = start_substeps;
+                m.clock.substeps = start_substeps;
             }
         };
-        let since_start = t - m.start_time;
+        let since_start = t - m.clock.start_time;
         // Ok(false): an adaptive step ran out of its budget of substeps.
         let run = |m: &mut Model| -> Result<bool, StepFailure> {
             if needed > 0 {
@@ -450,18 +438,18 @@ impl Instance {
             }
             match target {
                 Some(target) => {
-                    while m.substeps < target {
-                        m.physics.substep(m.substeps)?;
-                        m.substeps += 1;
+                    while m.clock.substeps < target {
+                        m.physics.substep(m.clock.substeps)?;
+                        m.clock.substeps += 1;
                     }
                 }
                 None => {
                     while m.physics.substeps_to(until) > 0 {
-                        if m.substeps - start_substeps >= budget as u64 {
+                        if m.clock.substeps - start_substeps >= budget as u64 {
                             return Ok(false);
                         }
                         m.physics.substep_toward(until)?;
-                        m.substeps += 1;
+                        m.clock.substeps += 1;
                     }
                 }
             }
@@ -479,7 +467,7 @@ impl Instance {
             ));
         }
         if let Err(e) = ran {
-            m.terminated = true;
+            m.clock.terminated = true;
             restore(m);
             self.phase = Phase::StepFailed;
             let msg = if e.terminal {
@@ -499,11 +487,11 @@ impl Instance {
         // checked too, so a step never ends OK with a non-finite output.
         // Unchanged since the last check (no substep ran, no value was set):
         // nothing to check again.
-        if m.substeps > start_substeps {
+        if m.clock.substeps > start_substeps {
             m.outputs_checked = false;
         }
         if !m.outputs_checked && !m.physics.outputs_finite() {
-            m.terminated = true;
+            m.clock.terminated = true;
             restore(m);
             self.phase = Phase::StepFailed;
             return Err(Fail {
@@ -514,8 +502,8 @@ impl Instance {
             });
         }
         m.outputs_checked = true;
-        m.time = end;
-        m.last_successful_time = end;
+        m.clock.time = end;
+        m.clock.last_successful_time = end;
         Ok(Status::Ok)
     }
 
@@ -540,7 +528,7 @@ impl Instance {
             if !v.is_finite() {
                 return error(format!(
                     "fmi2GetReal: value reference {vr} is not finite ({v}) at t = {}",
-                    self.model.time
+                    self.model.clock.time
                 ));
             }
             out[k] = v;
@@ -553,7 +541,7 @@ impl Instance {
         for (k, &vr) in vrs.iter().enumerate() {
             out[k] = match vr {
                 // Saturates instead of wrapping past 2^31 - 1 substeps.
-                VR_SUBSTEPS => self.model.substeps.min(c_int::MAX as u64) as c_int,
+                VR_SUBSTEPS => self.model.clock.substeps.min(c_int::MAX as u64) as c_int,
                 VR_MAX_SUBSTEPS => self.execution.max_substeps as c_int,
                 VR_THREADS => self.execution.threads as c_int,
                 _ => {
@@ -610,7 +598,7 @@ impl Instance {
             bundled: &self.bundled,
         };
         let changed = set(self.model.physics.as_mut(), &check, &ctx)?;
-        self.model.dirty |= changed;
+        self.model.clock.dirty |= changed;
         self.model.outputs_checked = false;
         Ok(())
     }
@@ -725,7 +713,7 @@ impl Instance {
         self.log(
             Status::Ok,
             LOG_EVENTS,
-            &format!("state restored: t = {}", self.model.time),
+            &format!("state restored: t = {}", self.model.clock.time),
         );
         Ok(())
     }
@@ -749,8 +737,9 @@ impl Instance {
     pub fn deserialize(&mut self, bytes: &[u8]) -> Res<Box<Snapshot>> {
         self.require("fmi2DeSerializeFMUstate")?;
         let m = &self.model;
-        let (phase, clock, physics) = deserialize(bytes, m.physics.as_ref(), !m.dirty, self.count)
-            .or_else(|e| error(format!("fmi2DeSerializeFMUstate: {e}")))?;
+        let (phase, clock, physics) =
+            deserialize(bytes, m.physics.as_ref(), !m.clock.dirty, self.count)
+                .or_else(|e| error(format!("fmi2DeSerializeFMUstate: {e}")))?;
         Ok(Box::new(Snapshot {
             magic: SNAPSHOT_MAGIC,
             phase,
@@ -763,10 +752,10 @@ impl Instance {
     }
 
     pub fn last_successful_time(&self) -> f64 {
-        self.model.last_successful_time
+        self.model.clock.last_successful_time
     }
 
     pub fn terminated(&self) -> bool {
-        self.model.terminated
+        self.model.clock.terminated
     }
 }
