@@ -67,6 +67,28 @@ def compare(label, result, rust_csv, outputs):
     print(f"{label}: simulate_fmu vs Rust: {len(result)} rows x {len(outputs)} outputs, {compared} values, max |diff| = {max_diff}")
 
 
+def against_replay(label, fmu, scene, in_csv, signals, outputs, h, stop, out_csv, start_values=None, replay_args=()):
+    """simulate_fmu of `fmu` with the input `signals` (also in `in_csv`),
+    fmu-replay of `scene` with the same inputs into `out_csv`, and every
+    output compared bit for bit; returns the fmpy result."""
+    result = simulate_fmu(
+        fmu,
+        start_time=0.0,
+        stop_time=stop,
+        output_interval=h,
+        input=signals,
+        output=outputs,
+        start_values=start_values or {},
+        validate=True,
+    )
+    subprocess.run(
+        [replay, "--scene", scene, *replay_args, "--inputs", in_csv, "--step", repr(h), "--stop", repr(stop), "-o", out_csv],
+        check=True,
+    )
+    compare(label, result, out_csv, outputs)
+    return result
+
+
 def state_round_trip(label, path, h, vrs):
     """get + serialize at t1, run on, deserialize + set, run on again."""
     md = read_model_description(path)
@@ -130,37 +152,13 @@ write_inputs(in_csv, cols)
 
 md = read_model_description(small_fmu)
 outputs = [v.name for v in md.modelVariables if v.causality == "output"]
-result = simulate_fmu(
-    small_fmu,
-    start_time=0.0,
-    stop_time=STOP,
-    output_interval=H,
-    input=signals,
-    output=outputs,
-    validate=True,
-)
-out_csv = f"{work}/rust.csv"
-subprocess.run(
-    [replay, "--scene", small_scene, "--inputs", in_csv, "--step", repr(H), "--stop", repr(STOP), "-o", out_csv],
-    check=True,
-)
-compare("YarnBundle (small)", result, out_csv, outputs)
+result = against_replay("YarnBundle (small)", small_fmu, small_scene, in_csv, signals, outputs, H, STOP, f"{work}/rust.csv")
 moved = max(abs(result[-1][n] - result[0][n]) for n in outputs if n.startswith("yarn"))
 if not moved > 0.05:
     failures.append(f"the yarn ends moved only {moved} m: the inputs had no effect")
 
 # 2b. the same under adaptive substeps: the FMU's dt = 0 against the Rust
 # run of the scene with dt = "auto"; fewer substeps than the fixed 2e-4
-result_auto = simulate_fmu(
-    small_fmu,
-    start_time=0.0,
-    stop_time=STOP,
-    output_interval=H,
-    input=signals,
-    output=outputs,
-    start_values={"dt": 0.0},
-    validate=True,
-)
 with open(small_scene) as fh:
     scene_text = fh.read()
 auto_text = re.sub(r"(?m)^dt\s*=.*$", 'dt = "auto"', scene_text, count=1)
@@ -169,11 +167,10 @@ if auto_text == scene_text:
 auto_scene = f"{work}/small_auto.toml"
 with open(auto_scene, "w") as fh:
     fh.write(auto_text)
-subprocess.run(
-    [replay, "--scene", auto_scene, "--inputs", in_csv, "--step", repr(H), "--stop", repr(STOP), "-o", f"{work}/rust_auto.csv"],
-    check=True,
+result_auto = against_replay(
+    "YarnBundle (small, dt = 0: auto)", small_fmu, auto_scene, in_csv, signals, outputs, H, STOP,
+    f"{work}/rust_auto.csv", start_values={"dt": 0.0},
 )
-compare("YarnBundle (small, dt = 0: auto)", result_auto, f"{work}/rust_auto.csv", outputs)
 fixed_n, auto_n = result[-1]["substeps"], result_auto[-1]["substeps"]
 print(f"substeps to {STOP} s: fixed dt {fixed_n:.0f}, auto {auto_n:.0f}")
 if not auto_n < fixed_n:
@@ -206,22 +203,11 @@ write_inputs(in_csv, cols)
 md = read_model_description(wire_fmu)
 outputs = [v.name for v in md.modelVariables if v.causality == "output"]
 for integrator in ("backward-euler", "symplectic-euler"):
-    result = simulate_fmu(
-        wire_fmu,
-        start_time=0.0,
-        stop_time=STOPW,
-        output_interval=HW,
-        input=signals,
-        output=outputs,
-        start_values={"integrator": integrator},
-        validate=True,
+    against_replay(
+        f"MassSpring (wire, {integrator})", wire_fmu, "wire", in_csv, signals, outputs, HW, STOPW,
+        f"{work}/wire_{integrator}.csv", start_values={"integrator": integrator},
+        replay_args=("--integrator", integrator),
     )
-    out_csv = f"{work}/wire_{integrator}.csv"
-    subprocess.run(
-        [replay, "--scene", "wire", "--integrator", integrator, "--inputs", in_csv, "--step", repr(HW), "--stop", repr(STOPW), "-o", out_csv],
-        check=True,
-    )
-    compare(f"MassSpring (wire, {integrator})", result, out_csv, outputs)
 vrs = [v.valueReference for v in md.modelVariables if v.causality == "output" and v.type == "Real"]
 state_round_trip("MassSpring (wire)", wire_fmu, HW, vrs)
 
@@ -256,21 +242,9 @@ outputs = [v.name for v in md.modelVariables if v.causality == "output"]
 for name in ("pin[0].force.x", "pin[0].force.y", "pin[1].force.x", "pin[1].force.y"):
     if name not in outputs:
         failures.append(f"driven FMU: no output {name}")
-result = simulate_fmu(
-    driven_fmu,
-    start_time=0.0,
-    stop_time=STOPD,
-    output_interval=HD,
-    input=signals,
-    output=outputs,
-    validate=True,
+result = against_replay(
+    "YarnBundle (driven)", driven_fmu, driven_scene, in_csv, signals, outputs, HD, STOPD, f"{work}/driven_rust.csv"
 )
-out_csv = f"{work}/driven_rust.csv"
-subprocess.run(
-    [replay, "--scene", driven_scene, "--inputs", in_csv, "--step", repr(HD), "--stop", repr(STOPD), "-o", out_csv],
-    check=True,
-)
-compare("YarnBundle (driven)", result, out_csv, outputs)
 follow = 0.0
 for k in range(1, len(result)):
     tc, te = result[k - 1]["time"], result[k]["time"]
