@@ -29,6 +29,8 @@ pub fn weights_1d(fx: f64) -> [f64; 3] {
 /// [`Stencil::new`] puts in `base`).
 #[inline(always)]
 pub fn base_of(x: Vec2, inv_dx: f64) -> [i32; 2] {
+    // Truncation is floor here: particles are kept at x >= dx, so
+    // x / dx - 0.5 > 0 (and it avoids a libm call on baseline x86-64).
     [
         ((x.x * inv_dx - 0.5) as i64) as i32,
         ((x.y * inv_dx - 0.5) as i64) as i32,
@@ -39,16 +41,11 @@ impl Stencil {
     /// Stencil of a particle at `x >= 0.5 dx` (per axis) on a grid of spacing `1 / inv_dx`.
     #[inline(always)]
     pub fn new(x: Vec2, inv_dx: f64) -> Self {
-        let gx = x.x * inv_dx;
-        let gy = x.y * inv_dx;
-        // Truncation is floor here: particles are kept at x >= dx, so
-        // x / dx - 0.5 > 0 (and it avoids a libm call on baseline x86-64).
-        let bx = ((gx - 0.5) as i64) as f64;
-        let by = ((gy - 0.5) as i64) as f64;
-        let fx = gx - bx;
-        let fy = gy - by;
+        let base = base_of(x, inv_dx);
+        let fx = x.x * inv_dx - base[0] as f64;
+        let fy = x.y * inv_dx - base[1] as f64;
         Stencil {
-            base: [bx as i32, by as i32],
+            base,
             w: [weights_1d(fx), weights_1d(fy)],
             fx: [fx, fy],
         }

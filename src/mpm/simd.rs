@@ -44,15 +44,6 @@ pub fn set_widest_kernels(k: Kernels) {
     WIDEST.store(k as u8, Ordering::Relaxed);
 }
 
-/// Same as `set_widest_kernels(Portable)` (`true`) or the default (`false`).
-pub fn set_portable_kernels(portable: bool) {
-    set_widest_kernels(if portable {
-        Kernels::Portable
-    } else {
-        Kernels::Avx512
-    });
-}
-
 /// The kernels this CPU runs, within the limit of [`set_widest_kernels`]
 /// (features detected once by std, cached).
 #[inline(always)]
