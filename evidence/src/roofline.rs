@@ -68,10 +68,9 @@ const fn per_obstacle(what: &'static str, source: &'static str, flops: u64) -> T
     }
 }
 
-/// Lanes of a scatter node `[px, py, m, mc, fx, fy, -, -]` (all 8 are
-/// computed; 6 carry data).
-pub const P2G_LANES: u64 = 8;
-/// Bytes of a scatter node (one cache line).
+/// Lanes of a scatter node `[px, py, m, mc, fx, fy]`.
+pub const P2G_LANES: u64 = yarnsim::mpm::grid::P2G_LANES as u64;
+/// Bytes of a scatter node.
 pub const P2G_NODE_BYTES: u64 = 8 * P2G_LANES;
 /// Bytes of a grid node `[vx, vy, dvx, dvy]`.
 pub const GRID_NODE_BYTES: u64 = 32;
@@ -93,7 +92,7 @@ pub const INTERPOLATE_FLIP_FLOPS: u64 = 3 + 3 * (3 * 4 * 4 + 1 + 7 * 4) + 1 + 8;
 /// 2 x `weights_1d` (3 differences, 6 products and sums).
 pub const STENCIL_FLOPS: u64 = 2 + 2 + 2 + 2 * 9;
 
-/// Pass "P2G scatter + vertex forces", per vertex: 478 flops, 1480 bytes.
+/// Pass "P2G scatter + vertex forces", per vertex: 394 flops, 1192 bytes.
 pub const P2G_VERTEX: &[Term] = &[
     t("window fit: base_of(x)", "particle_to_grid.rs scatter, bspline.rs base_of", 4, 16),
     t("fiber force f = t1[q_right] - t1[q_left] (q_left, q_right, 2 t1 read, f written)", "vertex_forces.rs vertex_forces", 4, 8 + 32 + 16),
@@ -103,10 +102,10 @@ pub const P2G_VERTEX: &[Term] = &[
     t("impulse f0 = dt f (f read)", "particle_to_grid.rs scatter_chunk", 2, 16),
     per_obstacle("contact mass: |x - centre|^2 <= (r + margin)^2, per obstacle (none touched)", "particle_to_grid.rs contact_mass", 7),
     t("affine A = C (m dx), momentum v m + f0 (m, v, C read)", "particle_to_grid.rs scatter_chunk", 9, 8 + 16 + 32),
-    t("splat into 9 scatter nodes of 8 lanes (each node read and written)", "particle_to_grid.rs splat", SPLAT_FLOPS, STENCIL_NODES * 2 * P2G_NODE_BYTES),
+    t("splat into 9 scatter nodes of 6 lanes (each node read and written)", "particle_to_grid.rs splat", SPLAT_FLOPS, STENCIL_NODES * 2 * P2G_NODE_BYTES),
 ];
 
-/// Pass "P2G scatter + vertex forces", per quadrature particle: 389 flops, 1336 bytes.
+/// Pass "P2G scatter + vertex forces", per quadrature particle: 305 flops, 1048 bytes.
 pub const P2G_QUAD: &[Term] = &[
     t(
         "window fit: stencil base read",
@@ -144,7 +143,7 @@ pub const P2G_QUAD: &[Term] = &[
         STENCIL_BYTES,
     ),
     t(
-        "splat into 9 scatter nodes of 8 lanes (each node read and written)",
+        "splat into 9 scatter nodes of 6 lanes (each node read and written)",
         "particle_to_grid.rs splat",
         SPLAT_FLOPS,
         STENCIL_NODES * 2 * P2G_NODE_BYTES,
@@ -152,9 +151,9 @@ pub const P2G_QUAD: &[Term] = &[
 ];
 
 /// Pass "grid update", per scatter buffer that touched the node's block
-/// (of the 4 chunk buffers): 8 flops, 128 bytes.
+/// (of the 4 chunk buffers): 6 flops, 96 bytes.
 pub const GRID_PER_SOURCE: &[Term] = &[t(
-    "sum one buffer's node (8 lanes) and zero it (node read and written)",
+    "sum one buffer's node (6 lanes) and zero it (node read and written)",
     "grid_update.rs grid_band",
     P2G_LANES,
     2 * P2G_NODE_BYTES,
@@ -1053,12 +1052,12 @@ mod tests {
     #[test]
     fn term_totals() {
         // the totals quoted in the tables' documentation (3 obstacles)
-        assert_eq!(SPLAT_FLOPS, 351);
+        assert_eq!(SPLAT_FLOPS, 267);
         assert_eq!(INTERPOLATE_FLIP_FLOPS, 243);
         assert_eq!(STENCIL_FLOPS, 24);
-        assert_eq!(totals(P2G_VERTEX, 3), (478, 1480));
-        assert_eq!(totals(P2G_QUAD, 3), (389, 1336));
-        assert_eq!(totals(GRID_PER_SOURCE, 3), (8, 128));
+        assert_eq!(totals(P2G_VERTEX, 3), (394, 1192));
+        assert_eq!(totals(P2G_QUAD, 3), (305, 1048));
+        assert_eq!(totals(GRID_PER_SOURCE, 3), (6, 96));
         assert_eq!(totals(GRID_MASS_NODE, 3), (13, 0));
         assert_eq!(totals(GRID_NEAR_OBSTACLE, 3), (21, 0));
         assert_eq!(totals(G2P_VERTEX, 3), (281, 496));
@@ -1066,7 +1065,7 @@ mod tests {
         assert_eq!(totals(SPIN_BALANCE, 3), (20, 104));
         // per-obstacle terms scale, the others do not
         let (f0, _) = totals(P2G_VERTEX, 0);
-        assert_eq!(f0, 478 - 21);
+        assert_eq!(f0, 394 - 21);
     }
 
     #[test]
@@ -1078,10 +1077,10 @@ mod tests {
             mass_nodes_near_obstacle: 10,
         };
         let w = pass_work(10, 9, 3, &g);
-        assert_eq!(w[0].flops, 10 * 478 + 9 * 389);
-        assert_eq!(w[0].bytes, 10 * 1480 + 9 * 1336);
-        assert_eq!(w[1].flops, 3 * 64 * 8 + 50 * 13 + 10 * 21);
-        assert_eq!(w[1].bytes, 3 * 64 * 128 + 2 * 64 * 32);
+        assert_eq!(w[0].flops, 10 * 394 + 9 * 305);
+        assert_eq!(w[0].bytes, 10 * 1192 + 9 * 1048);
+        assert_eq!(w[1].flops, 3 * 64 * 6 + 50 * 13 + 10 * 21);
+        assert_eq!(w[1].bytes, 3 * 64 * 96 + 2 * 64 * 32);
         assert_eq!(w[2].flops, 10 * 281);
         assert_eq!(w[3].flops, 9 * 355 + 19 * 20);
         assert_eq!(w[3].bytes, 9 * 740 + 19 * 104);

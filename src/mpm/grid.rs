@@ -18,15 +18,16 @@ const BLOCK_SHIFT: usize = 3;
 /// Number of scatter chunks (fixed for determinism).
 pub const CHUNKS: usize = 4;
 
-/// One node of a scatter buffer, one cache line (one AVX-512 register, two
-/// AVX2 ones): momentum including the impulse of the internal forces
-/// `[PX, PY]`, mass `M`, the mass of particles touching an obstacle `MC`,
-/// and the impulse `dt f` alone `[FX, FY]` (read only by the FLIP transfer,
-/// for the grid velocity before the forces; APIC leaves it zero). Two lanes
-/// pad the node to 64 bytes.
+/// One node of a scatter buffer, 48 bytes: momentum including the impulse
+/// of the internal forces `[PX, PY]`, mass `M`, the mass of particles
+/// touching an obstacle `MC`, and the impulse `dt f` alone `[FX, FY]` (read
+/// only by the FLIP transfer, for the grid velocity before the forces; APIC
+/// leaves it zero). No padding: the scatter and the grid update are bound
+/// by the bytes they stream, and six lanes ran 1.2x faster in the scatter
+/// than eight padded to a 64-byte line (same bits).
 pub type P2gNode = [f64; P2G_LANES];
 /// Lanes of a [`P2gNode`].
-pub const P2G_LANES: usize = 8;
+pub const P2G_LANES: usize = 6;
 /// Lane of the x momentum in a [`P2gNode`].
 pub const PX: usize = 0;
 /// Lane of the y momentum.
