@@ -11,6 +11,9 @@
 //! buffer; the buffers are summed in chunk order, so results do not depend on
 //! the number of threads.
 
+use crate::math::bspline::base_of;
+use crate::math::Vec2;
+
 /// Side of a block in nodes.
 pub const BLOCK: usize = 8;
 const BLOCK_SHIFT: usize = 3;
@@ -239,6 +242,65 @@ pub struct Grid {
     pub buffers: Vec<ScatterBuffer>,
 }
 
+/// The bounding box of stencil bases (lower-left nodes, clamped at 0) that
+/// a window must hold; empty (`lo > hi`) until a base is added.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct StencilBounds {
+    pub lo: [usize; 2],
+    pub hi: [usize; 2],
+}
+
+impl Default for StencilBounds {
+    fn default() -> Self {
+        StencilBounds {
+            lo: [usize::MAX; 2],
+            hi: [0; 2],
+        }
+    }
+}
+
+impl StencilBounds {
+    /// Adds the stencil with lower-left node `b`.
+    #[inline(always)]
+    pub fn add(&mut self, b: [i32; 2]) {
+        let b = [b[0].max(0) as usize, b[1].max(0) as usize];
+        for a in 0..2 {
+            self.lo[a] = self.lo[a].min(b[a]);
+            self.hi[a] = self.hi[a].max(b[a]);
+        }
+    }
+
+    /// Adds the stencils of particles at `xs` ([`base_of`] each): from the
+    /// coordinates' extremes, since `base_of` does not decrease with `x`
+    /// while `x / dx` is finite and well inside `i32`; one particle at a time
+    /// otherwise (a NaN or runaway position), to the same result.
+    pub fn add_positions(&mut self, xs: &[Vec2], inv_dx: f64) {
+        let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+        let mut nan = false;
+        for x in xs {
+            for a in 0..2 {
+                lo[a] = if x[a] < lo[a] { x[a] } else { lo[a] };
+                hi[a] = if x[a] > hi[a] { x[a] } else { hi[a] };
+            }
+            nan |= x.x.is_nan() | x.y.is_nan();
+        }
+        if xs.is_empty() {
+            return;
+        }
+        const SAFE: f64 = 1e9;
+        let tame = (0..2).all(|a| lo[a] * inv_dx > -SAFE && hi[a] * inv_dx < SAFE);
+        if nan || !tame {
+            for &x in xs {
+                self.add(base_of(x, inv_dx));
+            }
+            return;
+        }
+        let (l, h) = (Vec2::new(lo[0], lo[1]), Vec2::new(hi[0], hi[1]));
+        self.add(base_of(l, inv_dx));
+        self.add(base_of(h, inv_dx));
+    }
+}
+
 impl Grid {
     /// A grid of geometry `geom` with an empty window (nothing stored until
     /// the first [`Grid::fit_window`]).
@@ -253,19 +315,14 @@ impl Grid {
         }
     }
 
-    /// Moves the window so that it holds the 3x3 stencils at `bases`: kept
-    /// while it holds them and is at most four times the blocks they need
-    /// (and 16), otherwise refitted with a margin of two blocks per side.
-    /// Call before a scatter (it forgets the last scatter's touched blocks).
-    pub fn fit_window(&mut self, bases: impl Iterator<Item = [i32; 2]>) {
-        let (mut lo, mut hi) = ([usize::MAX; 2], [0usize; 2]);
-        for b in bases {
-            let b = [b[0].max(0) as usize, b[1].max(0) as usize];
-            for a in 0..2 {
-                lo[a] = lo[a].min(b[a]);
-                hi[a] = hi[a].max(b[a]);
-            }
-        }
+    /// Moves the window so that it holds the 3x3 stencils with lower-left
+    /// nodes from `lo` to `hi` (per axis, as [`StencilBounds`] collects
+    /// them): kept while it holds them and is at most four times the blocks
+    /// they need (and 16), otherwise refitted with a margin of two blocks per
+    /// side. Call before a scatter (it forgets the last scatter's touched
+    /// blocks).
+    pub fn fit_window(&mut self, bounds: &StencilBounds) {
+        let (lo, hi) = (bounds.lo, bounds.hi);
         if lo[0] > hi[0] {
             return; // no particles
         }
@@ -341,6 +398,43 @@ impl Grid {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn position_bounds_match_the_bases_one_by_one() {
+        let inv_dx = 256.0;
+        let one_by_one = |xs: &[Vec2]| {
+            let mut b = StencilBounds::default();
+            for &x in xs {
+                b.add(base_of(x, inv_dx));
+            }
+            b
+        };
+        let mut xs: Vec<Vec2> = (0..97)
+            .map(|k| {
+                let t = k as f64 * 0.731;
+                Vec2::new(0.5 + 0.4 * t.sin(), 0.5 + 0.3 * (1.3 * t).cos())
+            })
+            .collect();
+        let mut cases = vec![xs.clone(), Vec::new(), xs[..1].to_vec()];
+        // cell edges exactly, a NaN, a runaway and a negative coordinate
+        xs.push(Vec2::new(10.5 / inv_dx, 3.5 / inv_dx));
+        cases.push(xs.clone());
+        for bad in [
+            Vec2::new(f64::NAN, 0.3),
+            Vec2::new(0.4, f64::INFINITY),
+            Vec2::new(1e12, 0.2),
+            Vec2::new(-0.7, 0.2),
+        ] {
+            let mut c = xs.clone();
+            c.insert(40, bad);
+            cases.push(c);
+        }
+        for c in &cases {
+            let mut fast = StencilBounds::default();
+            fast.add_positions(c, inv_dx);
+            assert_eq!(fast, one_by_one(c), "{} positions", c.len());
+        }
+    }
 
     #[test]
     fn index_roundtrip_and_blocks_partition_the_nodes() {

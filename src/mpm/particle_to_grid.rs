@@ -9,12 +9,12 @@
 use rayon::prelude::*;
 
 use super::grid::{
-    Grid, GridGeom, P2gNode, ScatterBuffer, CHUNKS, FX, FY, M, MC, P2G_LANES, PX, PY,
+    Grid, GridGeom, P2gNode, ScatterBuffer, StencilBounds, CHUNKS, FX, FY, M, MC, P2G_LANES, PX, PY,
 };
 use super::particles::{Particles, Quads, Vertices};
 use super::simd::{chunk_range, multiversion};
 use super::vertex_forces::vertex_forces;
-use crate::math::bspline::{base_of, Stencil};
+use crate::math::bspline::Stencil;
 use crate::math::{Mat2, Vec2};
 use crate::scene::Obstacle;
 
@@ -125,13 +125,12 @@ fn split_chunks<T>(v: &mut [T], n: usize) -> Vec<&mut [T]> {
 pub fn scatter(p: &mut Particles, grid: &mut Grid, dt: f64, bending: f64, obstacles: &[Obstacle]) {
     // a window that holds every stencil
     let inv_dx = grid.geom.inv_dx;
-    grid.fit_window(
-        p.vert
-            .x
-            .iter()
-            .map(|&x| base_of(x, inv_dx))
-            .chain(p.quad.stencil.iter().map(|st| st.base)),
-    );
+    let mut bounds = StencilBounds::default();
+    bounds.add_positions(&p.vert.x, inv_dx);
+    for st in &p.quad.stencil {
+        bounds.add(st.base);
+    }
+    grid.fit_window(&bounds);
     let geom = grid.geom;
     let (nv, nq) = (p.vert.x.len(), p.quad.x.len());
     // Each chunk writes the stencils and forces of its own vertex range
