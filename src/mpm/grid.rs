@@ -263,11 +263,9 @@ impl StencilBounds {
     /// Adds the stencil with lower-left node `b`.
     #[inline(always)]
     pub fn add(&mut self, b: [i32; 2]) {
-        let b = [b[0].max(0) as usize, b[1].max(0) as usize];
-        for a in 0..2 {
-            self.lo[a] = self.lo[a].min(b[a]);
-            self.hi[a] = self.hi[a].max(b[a]);
-        }
+        let (i, j) = (b[0].max(0) as usize, b[1].max(0) as usize);
+        self.lo = [self.lo[0].min(i), self.lo[1].min(j)];
+        self.hi = [self.hi[0].max(i), self.hi[1].max(j)];
     }
 
     /// Adds the stencils of particles at `xs` ([`base_of`] each): from the
