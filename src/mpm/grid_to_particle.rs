@@ -9,7 +9,7 @@ use rayon::prelude::*;
 
 use super::constitutive::{frame_gradient_qr, YarnEnergy};
 use super::contact::{clamp_to_grid, project_out};
-use super::grid::{Grid, DVX, DVY, VX, VY};
+use super::grid::{Grid, Node, DVX, DVY, VX, VY};
 use super::particles::Quads;
 use super::simd::{multiversion, PAR_MIN};
 use super::transfer::{blend, Transfer};
@@ -47,45 +47,56 @@ pub fn quad_stress(q: &mut Quads, geom: &GridGeom, energy: &YarnEnergy) {
 /// grid's velocity change (zero otherwise).
 #[inline(always)]
 fn interpolate<const DELTA: bool>(grid: &Grid, st: &Stencil) -> (Vec2, Mat2, Vec2, Mat2) {
-    let geom = &grid.geom;
-    let (bi, bj) = (st.base[0] as usize, st.base[1] as usize);
-    let oy = [-st.fx[1], 1.0 - st.fx[1], 2.0 - st.fx[1]];
-    // lanes: v.x, v.y, dv.x, dv.y; sums of w and of w * offset
-    let lanes = if DELTA { 4 } else { 2 };
-    let mut s0 = [0.0; 4];
-    let mut sx = [0.0; 4];
-    let mut sy = [0.0; 4];
-    for i in 0..3 {
-        let start = geom.index(bi + i, bj);
-        let row = &grid.node[start..start + 3];
-        let mut r0 = [0.0; 4];
-        let mut ry = [0.0; 4];
-        for j in 0..3 {
-            let w = st.w[1][j];
-            for l in 0..lanes {
-                let wl = w * row[j][l];
-                r0[l] += wl;
-                ry[l] += wl * oy[j];
-            }
-        }
-        let wi = st.w[0][i];
-        let ox = i as f64 - st.fx[0];
-        for l in 0..lanes {
-            s0[l] += wi * r0[l];
-            sx[l] += wi * r0[l] * ox;
-            sy[l] += wi * ry[l];
-        }
-    }
-    let s = 4.0 * geom.inv_dx;
-    let v = Vec2::new(s0[VX], s0[VY]);
-    let c = Mat2::new(sx[VX] * s, sy[VX] * s, sx[VY] * s, sy[VY] * s);
+    let s = 4.0 * grid.geom.inv_dx;
     if DELTA {
+        // lanes: v.x, v.y, dv.x, dv.y
+        let [s0, sx, sy] = weighted_sums::<4>(grid, st);
+        let v = Vec2::new(s0[VX], s0[VY]);
+        let c = Mat2::new(sx[VX] * s, sy[VX] * s, sx[VY] * s, sy[VY] * s);
         let dv = Vec2::new(s0[DVX], s0[DVY]);
         let dc = Mat2::new(sx[DVX] * s, sy[DVX] * s, sx[DVY] * s, sy[DVY] * s);
         (v, c, dv, dc)
     } else {
+        let [s0, sx, sy] = weighted_sums::<2>(grid, st);
+        let v = Vec2::new(s0[VX], s0[VY]);
+        let c = Mat2::new(sx[VX] * s, sy[VX] * s, sx[VY] * s, sy[VY] * s);
         (v, c, Vec2::zeros(), Mat2::zeros())
     }
+}
+
+/// The first `N` lanes of the grid nodes at a stencil, summed with the
+/// weights `w` (`s0`), with `w` times the x offset (`sx`) and with `w`
+/// times the y offset (`sy`), in node units. Written lane-wise over whole
+/// `[f64; N]` rows so that each node is one vector load and a few vector
+/// operations; the per-lane arithmetic (and so every bit) is that of one
+/// lane at a time.
+#[inline(always)]
+fn weighted_sums<const N: usize>(grid: &Grid, st: &Stencil) -> [[f64; N]; 3] {
+    let geom = &grid.geom;
+    let (bi, bj) = (st.base[0] as usize, st.base[1] as usize);
+    let oy = [-st.fx[1], 1.0 - st.fx[1], 2.0 - st.fx[1]];
+    let mut s0 = [0.0; N];
+    let mut sx = [0.0; N];
+    let mut sy = [0.0; N];
+    for i in 0..3 {
+        let start = geom.index(bi + i, bj);
+        let row: &[Node; 3] = (&grid.node[start..start + 3]).try_into().unwrap();
+        let mut r0 = [0.0; N];
+        let mut ry = [0.0; N];
+        for j in 0..3 {
+            let w = st.w[1][j];
+            let n: [f64; N] = std::array::from_fn(|l| row[j][l]);
+            let wl: [f64; N] = std::array::from_fn(|l| w * n[l]);
+            r0 = std::array::from_fn(|l| r0[l] + wl[l]);
+            ry = std::array::from_fn(|l| ry[l] + wl[l] * oy[j]);
+        }
+        let wi = st.w[0][i];
+        let ox = i as f64 - st.fx[0];
+        s0 = std::array::from_fn(|l| s0[l] + wi * r0[l]);
+        sx = std::array::from_fn(|l| sx[l] + wi * r0[l] * ox);
+        sy = std::array::from_fn(|l| sy[l] + wi * ry[l]);
+    }
+    [s0, sx, sy]
 }
 
 /// New `(v, C)` of a particle by the transfer scheme, and the grid velocity
