@@ -9,12 +9,13 @@ use rayon::prelude::*;
 
 use super::constitutive::{frame_gradient_qr, YarnEnergy};
 use super::contact::{clamp_to_grid, project_out};
+use super::frames::update_frames;
 use super::grid::{Grid, Node, DVX, DVY, VX, VY};
 use super::particles::Quads;
 use super::simd::{multiversion, PAR_MIN};
 use super::transfer::{blend, Transfer};
 use crate::math::bspline::Stencil;
-use crate::math::qr::{qr, Qr2};
+use crate::math::qr::Qr2;
 use crate::math::{cross, Mat2, Vec2};
 use crate::mpm::grid::GridGeom;
 use crate::scene::Obstacle;
@@ -309,10 +310,11 @@ multiversion! {
     ) -> Option<usize> {
         let (dt, energy) = (rest.dt, rest.energy);
         let inv_dx = grid.geom.inv_dx;
-        let mut bad = None;
-        for k in 0..q.x.len() {
+        let n = q.x.len();
+        // the grid's part, one particle at a time: velocity and C by the
+        // transfer, position and d1 from the vertices, d2 advected
+        for k in 0..n {
             let g = base + k;
-            let l0 = rest.l0[g];
             let (_, nc) = transfer::<FLIP>(grid, &q.stencil[k], rest.ratio, &mut q.v[k], &mut q.c[k]);
             let left = rest.left[g] as usize;
             let (xl, xr) = (rest.vx[left], rest.vx[left + 1]);
@@ -321,26 +323,25 @@ multiversion! {
                 q.spin[k] = cross(x - q.x[k], q.v[k]);
             }
             q.x[k] = x;
-            let d1 = xr - xl;
             let d2o = q.d[k].column(1).into_owned();
-            let mut d2 = d2o + nc * d2o * dt;
-            let inv_l0 = 1.0 / l0;
-            let mut r = qr(&(Mat2::from_columns(&[d1, d2]) * inv_l0));
-            if rest.plastic {
-                let (r12, r22) = energy.return_map(r.r12, r.r22);
-                if r12 != r.r12 || r22 != r.r22 {
-                    d2 = r.rotate(Vec2::new(r12, r22)) * l0;
-                    // refactor (rather than patch r12, r22) so that `frame` is
-                    // always bitwise qr(d / l0), as after a state restore
-                    r = qr(&(Mat2::from_columns(&[d1, d2]) * inv_l0));
-                }
-            }
-            let d = Mat2::from_columns(&[d1, d2]);
-            q.frame[k] = r;
-            q.d[k] = d;
-            q.stencil[k] = Stencil::new(x, inv_dx);
-            (q.t1[k], q.t2[k]) = frame_gradient_qr(energy, &r, l0, rest.vol[g]);
-            let v = q.v[k];
+            q.d[k] = Mat2::from_columns(&[xr - xl, d2o + nc * d2o * dt]);
+        }
+        // the particle's own part over the chunk: QR, return mapping and
+        // stress (`frame` stays bitwise qr(d / l0), as after a state restore)
+        update_frames(
+            energy,
+            rest.plastic,
+            &rest.l0[base..base + n],
+            &rest.vol[base..base + n],
+            q.d,
+            q.frame,
+            q.t1,
+            q.t2,
+        );
+        let mut bad = None;
+        for k in 0..n {
+            q.stencil[k] = Stencil::new(q.x[k], inv_dx);
+            let (d, v) = (q.d[k], q.v[k]);
             let ok = d.iter().all(|e| e.is_finite()) && v.x.is_finite() && v.y.is_finite();
             if !ok && bad.is_none() {
                 bad = Some(k);

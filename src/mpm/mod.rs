@@ -10,6 +10,8 @@
 //! * [`grid_update`]: pass 2, velocities, gravity, attractor, contact, walls.
 //! * [`contact`]: the obstacle (Coulomb), wall and grid-edge laws.
 //! * [`grid_to_particle`]: passes 3 and 4, G2P of vertices and quadrature particles.
+//! * [`frames`]: the quadrature particles' QR, return mapping and stress,
+//!   over a batch (vectorized across particles).
 //! * [`transfer`]: the G2P velocity update (APIC or FLIP blend).
 //! * [`pins`]: pinned and driven vertices and their reaction forces.
 //! * [`spin`]: the per-yarn angular momentum balance of the FLIP transfer.
@@ -20,6 +22,7 @@
 
 pub mod constitutive;
 pub mod contact;
+pub mod frames;
 pub mod grid;
 pub mod grid_to_particle;
 pub mod grid_update;
