@@ -7,10 +7,12 @@
 //! * [`scene`]: scene descriptions ("layouts") and their TOML files.
 //! * [`mpm`]: the yarn-bundle MPM solver.
 //! * [`massspring`]: mass-spring wires and cloth (seeds 002, 004, 001).
+//! * [`pool`]: running a call's parallel passes on a rayon worker.
 
 pub mod massspring;
 pub mod math;
 pub mod mpm;
+pub mod pool;
 pub mod scene;
 
 pub use mpm::{SimError, YarnSim};

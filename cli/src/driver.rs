@@ -143,7 +143,7 @@ pub fn spinner(label: &str) -> ProgressBar {
 /// substep stops the run: the frames before it have been handed over, and
 /// the error comes back in [`FrameRun::failure`]. Errors of `on_frame`
 /// (output) end the run with `Err`.
-pub fn run_frames<S: Stepper>(
+pub fn run_frames<S: Stepper + Send>(
     sim: &mut S,
     schedule: &Schedule,
     interrupt: &AtomicBool,
@@ -174,26 +174,30 @@ pub fn run_frames<S: Stepper>(
         let before = sim.steps();
         let t0 = Instant::now();
         let until = start_time + schedule.time_at_frame(frame);
-        loop {
+        // the frame's substeps in one go on a rayon worker (see
+        // yarnsim::pool), not one hand-over to the pool per substep
+        let (interrupted, stepped) = yarnsim::pool::on_pool(|| loop {
             let more = match schedule.adaptive {
                 Some(_) => sim.time() < until,
                 None => sim.steps() < target,
             };
             if !more {
-                break;
+                return (false, Ok(()));
             }
             if interrupt.load(Ordering::Relaxed) {
-                outcome.interrupted = true;
-                break;
+                return (true, Ok(()));
             }
             let stepped = match schedule.adaptive {
                 Some(_) => sim.step_toward(until).map(|_| ()),
                 None => sim.step(),
             };
-            if let Err(e) = stepped {
-                failure = Some(e);
-                break;
+            if stepped.is_err() {
+                return (false, stepped);
             }
+        });
+        outcome.interrupted |= interrupted;
+        if let Err(e) = stepped {
+            failure = Some(e);
         }
         if failure.is_none() {
             failure = sim.check_finite().err();

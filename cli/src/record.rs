@@ -514,7 +514,7 @@ fn open(name: &str, blueprint: Blueprint, sink: &Sink) -> Result<RecordingStream
 /// Runs `schedule` on `sim`, logging the frames `opts` selects with `log`,
 /// then flushes and closes the stream whatever happened (divergence,
 /// Ctrl-C, SIGTERM), so a file ends readable.
-fn record_frames<S: Stepper>(
+fn record_frames<S: Stepper + Send>(
     rec: RecordingStream,
     sim: &mut S,
     schedule: &Schedule,

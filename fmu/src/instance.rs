@@ -457,7 +457,9 @@ impl Instance {
         };
         let ran = match &self.pool {
             Some((_, pool)) => pool.install(|| run(m)),
-            None => run(m),
+            // the global pool: the whole step on one of its workers, not
+            // one hand-over per substep (see yarnsim::pool)
+            None => yarnsim::pool::on_pool(|| run(m)),
         };
         if let Ok(false) = ran {
             restore(m);

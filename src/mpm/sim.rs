@@ -490,12 +490,14 @@ impl YarnSim {
         self.step_dt(self.dt())
     }
 
-    /// `n` substeps.
+    /// `n` substeps (on a rayon worker, see [`crate::pool`]).
     pub fn steps_n(&mut self, n: u64) -> Result<(), SimError> {
-        for _ in 0..n {
-            self.step()?;
-        }
-        Ok(())
+        crate::pool::on_pool(|| {
+            for _ in 0..n {
+                self.step()?;
+            }
+            Ok(())
+        })
     }
 
     /// Advances by `duration` seconds: in `round(duration / dt)` substeps
@@ -541,8 +543,10 @@ impl YarnSim {
             let n = ((until - self.time) / self.dt).round().max(0.0) as u64;
             return self.steps_n(n);
         }
-        while self.step_toward(until)? {}
-        Ok(())
+        crate::pool::on_pool(|| {
+            while self.step_toward(until)? {}
+            Ok(())
+        })
     }
 
     /// One adaptive substep toward `until` ([`YarnSim::substep_toward`]);
@@ -571,8 +575,13 @@ impl YarnSim {
         (rest / self.dt()).ceil().clamp(1.0, u64::MAX as f64) as u64
     }
 
-    /// One substep of size `dt`.
+    /// One substep of size `dt` (on a rayon worker, see [`crate::pool`]).
     pub fn step_dt(&mut self, dt: f64) -> Result<(), SimError> {
+        crate::pool::on_pool(|| self.substep(dt))
+    }
+
+    /// [`YarnSim::step_dt`] on this thread.
+    fn substep(&mut self, dt: f64) -> Result<(), SimError> {
         if let Some(e) = &self.failed {
             return Err(e.clone());
         }
