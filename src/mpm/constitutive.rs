@@ -72,16 +72,21 @@ impl YarnEnergy {
     #[inline]
     pub fn stress_qr(&self, d: &Qr2) -> Mat2 {
         let r11 = d.r11.max(R11_MIN);
-        let r12 = d.r12;
         let r22 = d.r22.max(R22_MIN);
+        let ln22 = if r22 < 1.0 { r22.ln() } else { 0.0 };
+        self.stress_clamped(d.c, d.s, r11, d.r12, r22, ln22)
+    }
+
+    /// [`YarnEnergy::stress_qr`] from the rotation `(c, s)`, the clamped
+    /// `r11 >= R11_MIN`, `r22 >= R22_MIN`, `r12`, and `ln22 = ln r22` (read
+    /// only where `r22 < 1`): the arithmetic after the `ln`, shared with the
+    /// batched frame update ([`super::frames`]).
+    #[inline(always)]
+    pub fn stress_clamped(&self, c: f64, s: f64, r11: f64, r12: f64, r22: f64, ln22: f64) -> Mat2 {
         let fp = self.k * (r11 - 1.0);
         let gp = self.gamma * r12;
         // h'(r22) r22 = normal * log r22 for r22 < 1, else 0.
-        let hr = if r22 < 1.0 {
-            self.normal * r22.ln()
-        } else {
-            0.0
-        };
+        let hr = if r22 < 1.0 { self.normal * ln22 } else { 0.0 };
         let a00 = fp * r11 + gp * r12;
         let a01 = gp * r22;
         let a11 = hr;
@@ -94,7 +99,6 @@ impl YarnEnergy {
         let b10 = a01 * i11 + a11 * i21;
         let b11 = a11 * i22;
         // Q B
-        let (c, s) = (d.c, d.s);
         Mat2::new(
             c * b00 - s * b10,
             c * b01 - s * b11,

@@ -23,41 +23,42 @@ use crate::math::{Mat2, Vec2};
 /// Particles per batch (the scratch lives on the stack).
 const BATCH: usize = 64;
 
+/// The per-particle arrays of a frame update (all of one length): rest
+/// length and volume (read), `d` (read and replaced), frame and stress
+/// columns (written).
+pub struct Frames<'a> {
+    pub l0: &'a [f64],
+    pub vol: &'a [f64],
+    pub d: &'a mut [Mat2],
+    pub frame: &'a mut [Qr2],
+    pub t1: &'a mut [Vec2],
+    pub t2: &'a mut [Vec2],
+}
+
 /// Frame update of every particle `k`: `d[k]` holds `[d1, d2]` (the fiber
 /// direction from the vertices, the cross-section direction advected by the
 /// grid) and is replaced by the return-mapped one (when `plastic`);
 /// `frame[k]` gets `qr(d[k] / l0[k])` and `(t1[k], t2[k])` the stress
 /// columns `dE/dd1`, `dE/dd2` times `vol[k] / l0[k]`, as
 /// [`super::constitutive::frame_gradient_qr`] gives them.
-#[allow(clippy::too_many_arguments)]
 #[inline(always)]
-pub fn update_frames(
-    energy: &YarnEnergy,
-    plastic: bool,
-    l0: &[f64],
-    vol: &[f64],
-    d: &mut [Mat2],
-    frame: &mut [Qr2],
-    t1: &mut [Vec2],
-    t2: &mut [Vec2],
-) {
-    let n = d.len();
-    debug_assert!(l0.len() == n && vol.len() == n && frame.len() == n);
-    debug_assert!(t1.len() == n && t2.len() == n);
+pub fn update_frames(energy: &YarnEnergy, plastic: bool, f: Frames) {
+    let n = f.d.len();
+    debug_assert!(f.l0.len() == n && f.vol.len() == n && f.frame.len() == n);
+    debug_assert!(f.t1.len() == n && f.t2.len() == n);
     let mut start = 0;
     while start < n {
-        let end = (start + BATCH).min(n);
-        batch(
-            energy,
-            plastic,
-            &l0[start..end],
-            &vol[start..end],
-            &mut d[start..end],
-            &mut frame[start..end],
-            &mut t1[start..end],
-            &mut t2[start..end],
-        );
-        start = end;
+        let r = start..(start + BATCH).min(n);
+        let part = Frames {
+            l0: &f.l0[r.clone()],
+            vol: &f.vol[r.clone()],
+            d: &mut f.d[r.clone()],
+            frame: &mut f.frame[r.clone()],
+            t1: &mut f.t1[r.clone()],
+            t2: &mut f.t2[r.clone()],
+        };
+        batch(energy, plastic, part);
+        start = r.end;
     }
 }
 
@@ -84,18 +85,16 @@ struct Scratch {
     ln22: [f64; BATCH],
 }
 
-#[allow(clippy::too_many_arguments)]
 #[inline(always)]
-fn batch(
-    energy: &YarnEnergy,
-    plastic: bool,
-    l0: &[f64],
-    vol: &[f64],
-    d: &mut [Mat2],
-    frame: &mut [Qr2],
-    t1: &mut [Vec2],
-    t2: &mut [Vec2],
-) {
+fn batch(energy: &YarnEnergy, plastic: bool, f: Frames) {
+    let Frames {
+        l0,
+        vol,
+        d,
+        frame,
+        t1,
+        t2,
+    } = f;
     let n = d.len();
     let mut w = Scratch {
         d1x: [0.0; BATCH],
@@ -183,29 +182,13 @@ fn batch(
     }
     for k in 0..n {
         let (c, s) = (w.c[k], w.s[k]);
-        let r11 = w.r11[k].max(R11_MIN);
         let r12 = w.r12[k];
+        let r11 = w.r11[k].max(R11_MIN);
         let r22 = w.r22[k].max(R22_MIN);
-        let fp = energy.k * (r11 - 1.0);
-        let gp = energy.gamma * r12;
-        let hr = if r22 < 1.0 {
-            energy.normal * w.ln22[k]
-        } else {
-            0.0
-        };
-        let a00 = fp * r11 + gp * r12;
-        let a01 = gp * r22;
-        let a11 = hr;
-        let i11 = 1.0 / r11;
-        let i22 = 1.0 / r22;
-        let i21 = -r12 * i11 * i22;
-        let b00 = a00 * i11 + a01 * i21;
-        let b01 = a01 * i22;
-        let b10 = a01 * i11 + a11 * i21;
-        let b11 = a11 * i22;
+        let p = energy.stress_clamped(c, s, r11, r12, r22, w.ln22[k]);
         let sc = vol[k] / w.l0[k];
-        t1[k] = Vec2::new((c * b00 - s * b10) * sc, (s * b00 + c * b10) * sc);
-        t2[k] = Vec2::new((c * b01 - s * b11) * sc, (s * b01 + c * b11) * sc);
+        t1[k] = p.column(0) * sc;
+        t2[k] = p.column(1) * sc;
         d[k] = Mat2::new(w.d1x[k], w.d2x[k], w.d1y[k], w.d2y[k]);
         frame[k] = Qr2 {
             c,
@@ -283,9 +266,15 @@ mod tests {
             let mut dd = d.clone();
             let mut frame = vec![qr(&Mat2::identity()); n];
             let (mut t1, mut t2) = (vec![Vec2::zeros(); n], vec![Vec2::zeros(); n]);
-            update_frames(
-                &e, plastic, &l0, &vol, &mut dd, &mut frame, &mut t1, &mut t2,
-            );
+            let frames = Frames {
+                l0: &l0,
+                vol: &vol,
+                d: &mut dd,
+                frame: &mut frame,
+                t1: &mut t1,
+                t2: &mut t2,
+            };
+            update_frames(&e, plastic, frames);
             let mut slow_cases = 0;
             for k in 0..n {
                 let (d_ref, f_ref, t1_ref, t2_ref) = one_by_one(&e, plastic, l0[k], vol[k], d[k]);

@@ -9,7 +9,7 @@ use rayon::prelude::*;
 
 use super::constitutive::{frame_gradient_qr, YarnEnergy};
 use super::contact::{clamp_to_grid, project_out};
-use super::frames::update_frames;
+use super::frames::{update_frames, Frames};
 use super::grid::{Grid, Node, DVX, DVY, VX, VY};
 use super::particles::Quads;
 use super::simd::{multiversion, PAR_MIN};
@@ -328,16 +328,15 @@ multiversion! {
         }
         // the particle's own part over the chunk: QR, return mapping and
         // stress (`frame` stays bitwise qr(d / l0), as after a state restore)
-        update_frames(
-            energy,
-            rest.plastic,
-            &rest.l0[base..base + n],
-            &rest.vol[base..base + n],
-            q.d,
-            q.frame,
-            q.t1,
-            q.t2,
-        );
+        let frames = Frames {
+            l0: &rest.l0[base..base + n],
+            vol: &rest.vol[base..base + n],
+            d: q.d,
+            frame: q.frame,
+            t1: q.t1,
+            t2: q.t2,
+        };
+        update_frames(energy, rest.plastic, frames);
         let mut bad = None;
         for k in 0..n {
             q.stencil[k] = Stencil::new(q.x[k], inv_dx);
