@@ -456,6 +456,9 @@ impl Instance {
             Ok(true)
         };
         let ran = match &self.pool {
+            // no substep to run: no hand-over to a pool either (it costs
+            // microseconds, the call itself nanoseconds)
+            _ if needed == 0 => run(m),
             Some((_, pool)) => pool.install(|| run(m)),
             // the global pool: the whole step on one of its workers, not
             // one hand-over per substep (see yarnsim::pool)
