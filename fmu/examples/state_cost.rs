@@ -16,14 +16,16 @@
 //! `STATE_COST_DUMP=FILE` the serialized state is written to FILE.
 
 use std::alloc::{GlobalAlloc, Layout, System};
-use std::ffi::{c_void, CString};
+use std::ffi::c_void;
 use std::hint::black_box;
 use std::sync::atomic::{AtomicUsize, Ordering::Relaxed};
 use std::time::Instant;
 
-use yarnsim::scene::{Scene, DEFAULT_SCENE};
+use yarnsim::scene::DEFAULT_SCENE;
 use YarnBundle::ffi::*;
 use YarnBundle::model::*;
+
+mod common;
 
 /// Counts the bytes allocated (not freed) through the global allocator.
 struct Counting;
@@ -68,20 +70,8 @@ fn main() {
     let scene_arg = args.first().cloned().unwrap_or(DEFAULT_SCENE.to_string());
     let repeats: usize = args.get(1).map(|s| s.parse().unwrap()).unwrap_or(200);
     let substeps: u64 = args.get(2).map(|s| s.parse().unwrap()).unwrap_or(250);
-    let scene = FmuScene::from(Scene::resolve(&scene_arg).unwrap());
-    let dir = std::env::temp_dir().join(format!("yarnbundle-state-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    std::fs::write(dir.join(SCENE_FILE), scene.to_toml_string()).unwrap();
-    let uri = CString::new(format!("file://{}", dir.display())).unwrap();
-    let guid = CString::new(scene.guid()).unwrap();
-    let name = CString::new("bench").unwrap();
-    let cb = fmi2CallbackFunctions {
-        logger: None,
-        allocateMemory: None,
-        freeMemory: None,
-        stepFinished: None,
-        componentEnvironment: std::ptr::null_mut(),
-    };
+    let fx = common::Fixture::new(&scene_arg, "state");
+    let scene = &fx.scene;
     let alloc_of = |f: &mut dyn FnMut()| {
         let a = ALLOCATED.load(Relaxed);
         f();
@@ -90,25 +80,10 @@ fn main() {
     // SAFETY: the FMI calling sequence of the standard, on a live instance
     // and states this program made and frees.
     unsafe {
-        let instantiate = || {
-            let c = fmi2Instantiate(
-                name.as_ptr(),
-                fmi2CoSimulation,
-                guid.as_ptr(),
-                uri.as_ptr(),
-                &cb,
-                0,
-                0,
-            );
-            assert!(!c.is_null());
-            assert_eq!(fmi2SetupExperiment(c, 0, 0.0, 0.0, 0, 0.0), fmi2OK);
-            assert_eq!(fmi2EnterInitializationMode(c), fmi2OK);
-            assert_eq!(fmi2ExitInitializationMode(c), fmi2OK);
-            c
-        };
+        let instantiate = || fx.instance();
         let c = instantiate();
         let mut dt = 0.0;
-        let vr_dt = match &scene {
+        let vr_dt = match scene {
             FmuScene::Yarn(_) => VR_DT,
             FmuScene::MassSpring(_) => YarnBundle::massspring::VR_DT,
         };
@@ -222,5 +197,5 @@ fn main() {
         free(&mut s);
         fmi2FreeInstance(c);
     }
-    let _ = std::fs::remove_dir_all(&dir);
+    let _ = std::fs::remove_dir_all(&fx.dir);
 }

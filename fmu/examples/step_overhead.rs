@@ -23,17 +23,17 @@
 //! SCENE is a yarn scene (default `fmu/scenes/small.toml`) or a mass-spring
 //! one (`wire`, `cloth`, a file), which measures the MassSpring FMU.
 
-use std::ffi::CString;
 use std::hint::black_box;
 use std::time::Instant;
 
 use yarnsim::massspring::Simulation;
 use yarnsim::mpm::YarnSim;
-use yarnsim::scene::Scene;
 use YarnBundle::ffi::*;
 use YarnBundle::fmu_model::FmuModel;
 use YarnBundle::massspring::{self as ms, MsModel};
 use YarnBundle::model::*;
+
+mod common;
 
 /// The library's own stepper, for the comparison in part 3.
 enum Library {
@@ -62,21 +62,9 @@ fn main() {
         .cloned()
         .unwrap_or_else(|| concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/small.toml").to_string());
     let calls: usize = args.get(1).map(|s| s.parse().unwrap()).unwrap_or(2_000_000);
-    let scene = FmuScene::from(Scene::resolve(&scene_arg).unwrap());
-    let dir = std::env::temp_dir().join(format!("yarnbundle-bench-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    std::fs::write(dir.join(SCENE_FILE), scene.to_toml_string()).unwrap();
-    let uri = CString::new(format!("file://{}", dir.display())).unwrap();
-    let guid = CString::new(scene.guid()).unwrap();
-    let name = CString::new("bench").unwrap();
-    let cb = fmi2CallbackFunctions {
-        logger: None,
-        allocateMemory: None,
-        freeMemory: None,
-        stepFinished: None,
-        componentEnvironment: std::ptr::null_mut(),
-    };
-    let new_library = || match &scene {
+    let fx = common::Fixture::new(&scene_arg, "bench");
+    let scene = &fx.scene;
+    let new_library = || match scene {
         FmuScene::Yarn(s) => Library::Yarn(Box::new(YarnSim::new(s).unwrap())),
         FmuScene::MassSpring(l) => {
             Library::MassSpring(Box::new(MsModel::new(l.clone()).unwrap().sim))
@@ -87,7 +75,7 @@ fn main() {
         Library::MassSpring(sim) => sim.dt(),
     };
     // Inputs to set and outputs to get in part 2, and the input values.
-    let (in_vr, out_vr): (Vec<u32>, Vec<u32>) = match &scene {
+    let (in_vr, out_vr): (Vec<u32>, Vec<u32>) = match scene {
         FmuScene::Yarn(_) => (
             vec![VR_ATTRACTOR_X, VR_ATTRACTOR_Y, VR_GRAVITY_X, VR_GRAVITY_Y],
             (VR_YARN_BASE..VR_YARN_BASE + 4).collect(),
@@ -103,26 +91,14 @@ fn main() {
     };
     let inputs = |k: usize| -> Vec<f64> {
         let wobble = 1e-3 * (k & 7) as f64;
-        match &scene {
+        match scene {
             FmuScene::Yarn(_) => vec![0.5, 0.5 + wobble, 0.0, -9.8],
             FmuScene::MassSpring(_) => vec![0.0, -9.81 + wobble, 0.0],
         }
     };
     let ports = in_vr.len();
     unsafe {
-        let c = fmi2Instantiate(
-            name.as_ptr(),
-            fmi2CoSimulation,
-            guid.as_ptr(),
-            uri.as_ptr(),
-            &cb,
-            0,
-            0,
-        );
-        assert!(!c.is_null());
-        assert_eq!(fmi2SetupExperiment(c, 0, 0.0, 0.0, 0, 0.0), fmi2OK);
-        assert_eq!(fmi2EnterInitializationMode(c), fmi2OK);
-        assert_eq!(fmi2ExitInitializationMode(c), fmi2OK);
+        let c = fx.instance();
 
         // 1. Bare DoStep: h = 1e-9 dt, so 5 x CALLS steps stay far below the
         // first substep's grid point and no substep runs.
@@ -172,18 +148,7 @@ fn main() {
         fmi2FreeInstance(c);
 
         // 3. One substep per DoStep against the library's step, interleaved.
-        let c = fmi2Instantiate(
-            name.as_ptr(),
-            fmi2CoSimulation,
-            guid.as_ptr(),
-            uri.as_ptr(),
-            &cb,
-            0,
-            0,
-        );
-        assert_eq!(fmi2SetupExperiment(c, 0, 0.0, 0.0, 0, 0.0), fmi2OK);
-        assert_eq!(fmi2EnterInitializationMode(c), fmi2OK);
-        assert_eq!(fmi2ExitInitializationMode(c), fmi2OK);
+        let c = fx.instance();
         let mut sim = new_library();
         let steps = 2000.min(calls);
         let (mut fmu_s, mut lib_s) = (0.0, 0.0);
@@ -211,7 +176,7 @@ fn main() {
         // of every output (the yarn's diagnostics are recomputed after a
         // substep) and the clone of the last good state.
         let reps = 200.min(calls).max(1);
-        let (check_s, clone_s) = match &scene {
+        let (check_s, clone_s) = match scene {
             FmuScene::Yarn(s) => {
                 let mut m = YarnBundle::yarn::YarnModel::new(s.clone()).unwrap();
                 for _ in 0..20 {
@@ -255,5 +220,5 @@ fn main() {
             100.0 * clone_s / one_substep
         );
     }
-    let _ = std::fs::remove_dir_all(dir);
+    let _ = std::fs::remove_dir_all(&fx.dir);
 }
