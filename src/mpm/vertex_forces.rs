@@ -54,7 +54,7 @@ pub fn curvature(e1: Vec2, e2: Vec2) -> f64 {
 }
 
 /// `(B (kappa - kappa0) / l) dkappa/de1` and `... dkappa/de2` at every
-/// vertex `j` of `lo..hi` (`[g1.x, g1.y, g2.x, g2.y]`, written to `out`),
+/// vertex `j` of `lo..hi` (`[g1.x, g1.y, g2.x, g2.y]`, entry `j - lo`),
 /// zero where `j` is not an interior vertex of its yarn or out of range.
 ///
 /// Written without branches over plain `f64`s so that it vectorizes across
@@ -62,23 +62,13 @@ pub fn curvature(e1: Vec2, e2: Vec2) -> f64 {
 /// cost); `sqrt` and division are correctly rounded in every SIMD width, so
 /// each vertex gets the same bits as one at a time.
 #[inline(always)]
-fn bend_gradients(
-    x: &[Vec2],
-    bend: &[BendRest],
-    b: f64,
-    lo: isize,
-    hi: isize,
-    out: &mut [[f64; 4]],
-) {
-    debug_assert_eq!(out.len(), (hi - lo) as usize);
+fn bend_gradients(x: &[Vec2], bend: &[BendRest], b: f64, lo: isize, hi: isize) -> Vec<[f64; 4]> {
+    let mut out = vec![[0.0; 4]; (hi - lo) as usize];
     let n = x.len() as isize;
     // interior vertices of the whole array (its two ends are yarn ends)
     let (a, z) = (lo.clamp(1, (n - 1).max(1)), hi.clamp(1, (n - 1).max(1)));
-    for g in out.iter_mut() {
-        *g = [0.0; 4];
-    }
     if a >= z {
-        return;
+        return out;
     }
     let (a, z) = (a as usize, z as usize);
     let o = &mut out[(a as isize - lo) as usize..(z as isize - lo) as usize];
@@ -105,6 +95,7 @@ fn bend_gradients(
         let ok = rest[k].inv_len != 0.0 && d > 0.0 && n1 > 0.0 && n2 > 0.0;
         *g = if ok { [g1x, g1y, g2x, g2y] } else { [0.0; 4] };
     }
+    out
 }
 
 /// Internal force on every vertex of `range`, written to `out` (same length):
@@ -135,8 +126,7 @@ pub fn vertex_forces(
         // the gradients at range.start - 1 ..= range.end: one curvature
         // evaluation per vertex
         let (lo, hi) = (range.start as isize - 1, range.end as isize + 1);
-        let mut g = vec![[0.0; 4]; (hi - lo) as usize];
-        bend_gradients(&v.x, &v.bend, bending, lo, hi, &mut g);
+        let g = bend_gradients(&v.x, &v.bend, bending, lo, hi);
         for (k, f) in out.iter_mut().enumerate() {
             let (prev, cur, next) = (g[k], g[k + 1], g[k + 2]);
             // dkappa_{i-1}/dx_i = de2 of i-1; dkappa_i/dx_i = de1 - de2; dkappa_{i+1}/dx_i = -de1
