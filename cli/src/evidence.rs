@@ -131,11 +131,7 @@ pub fn execute(cmd: &EvidenceCommand) -> Result<(String, Vec<String>), CliError>
             steps,
             repeats,
         } => {
-            if *steps == 0 || *repeats == 0 {
-                return Err(CliError::Usage(
-                    "--steps and --repeats must be at least 1".into(),
-                ));
-            }
+            steps_and_repeats(*steps, *repeats)?;
             let r = skip::run(&skip::SkipOptions {
                 steps: *steps,
                 warmup: 20,
@@ -149,11 +145,7 @@ pub fn execute(cmd: &EvidenceCommand) -> Result<(String, Vec<String>), CliError>
             steps,
             repeats,
         } => {
-            if *steps == 0 || *repeats == 0 {
-                return Err(CliError::Usage(
-                    "--steps and --repeats must be at least 1".into(),
-                ));
-            }
+            steps_and_repeats(*steps, *repeats)?;
             let r = roofline::run(&roofline::RooflineOptions {
                 steps: *steps,
                 repeats: *repeats,
@@ -220,4 +212,14 @@ mod tests {
         assert!(svg.starts_with("<svg") && svg.contains("polyline"));
         let _ = std::fs::remove_dir_all(&dir);
     }
+}
+
+/// `--steps` and `--repeats` of the benchmarks: both at least 1.
+fn steps_and_repeats(steps: u64, repeats: usize) -> Result<(), CliError> {
+    if steps == 0 || repeats == 0 {
+        return Err(CliError::Usage(
+            "--steps and --repeats must be at least 1".into(),
+        ));
+    }
+    Ok(())
 }
