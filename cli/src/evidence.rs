@@ -157,6 +157,16 @@ pub fn execute(cmd: &EvidenceCommand) -> Result<(String, Vec<String>), CliError>
     }
 }
 
+/// `--steps` and `--repeats` of the benchmarks: both at least 1.
+fn steps_and_repeats(steps: u64, repeats: usize) -> Result<(), CliError> {
+    if steps == 0 || repeats == 0 {
+        return Err(CliError::Usage(
+            "--steps and --repeats must be at least 1".into(),
+        ));
+    }
+    Ok(())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -212,14 +222,4 @@ mod tests {
         assert!(svg.starts_with("<svg") && svg.contains("polyline"));
         let _ = std::fs::remove_dir_all(&dir);
     }
-}
-
-/// `--steps` and `--repeats` of the benchmarks: both at least 1.
-fn steps_and_repeats(steps: u64, repeats: usize) -> Result<(), CliError> {
-    if steps == 0 || repeats == 0 {
-        return Err(CliError::Usage(
-            "--steps and --repeats must be at least 1".into(),
-        ));
-    }
-    Ok(())
 }
