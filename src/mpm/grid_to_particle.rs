@@ -12,7 +12,7 @@ use super::contact::{clamp_to_grid, project_out};
 use super::frames::{update_frames, Frames};
 use super::grid::{Grid, Node, DVX, DVY, VX, VY};
 use super::particles::Quads;
-use super::simd::{multiversion, PAR_MIN};
+use super::simd::{kernels, multiversion, Kernels, PAR_MIN};
 use super::transfer::{blend, Transfer};
 use crate::math::bspline::Stencil;
 use crate::math::qr::Qr2;
@@ -47,11 +47,15 @@ pub fn quad_stress(q: &mut Quads, geom: &GridGeom, energy: &YarnEnergy) {
 /// `C = 4 / dx sum w v_i (i - fx)^T`, and with `DELTA` the same of the
 /// grid's velocity change (zero otherwise).
 #[inline(always)]
-fn interpolate<const DELTA: bool>(grid: &Grid, st: &Stencil) -> (Vec2, Mat2, Vec2, Mat2) {
+fn interpolate<const DELTA: bool>(
+    grid: &Grid,
+    st: &Stencil,
+    avx: bool,
+) -> (Vec2, Mat2, Vec2, Mat2) {
     let s = 4.0 * grid.geom.inv_dx;
     if DELTA {
         // lanes: v.x, v.y, dv.x, dv.y
-        let [s0, sx, sy] = weighted_sums::<4>(grid, st);
+        let [s0, sx, sy] = weighted_sums4(grid, st, avx);
         let v = Vec2::new(s0[VX], s0[VY]);
         let c = Mat2::new(sx[VX] * s, sy[VX] * s, sx[VY] * s, sy[VY] * s);
         let dv = Vec2::new(s0[DVX], s0[DVY]);
@@ -85,19 +89,77 @@ fn weighted_sums<const N: usize>(grid: &Grid, st: &Stencil) -> [[f64; N]; 3] {
         let mut r0 = [0.0; N];
         let mut ry = [0.0; N];
         for j in 0..3 {
-            let w = st.w[1][j];
-            let n: [f64; N] = std::array::from_fn(|l| row[j][l]);
-            let wl: [f64; N] = std::array::from_fn(|l| w * n[l]);
-            r0 = std::array::from_fn(|l| r0[l] + wl[l]);
-            ry = std::array::from_fn(|l| ry[l] + wl[l] * oy[j]);
+            let (w, oyj) = (st.w[1][j], oy[j]);
+            for l in 0..N {
+                let wl = w * row[j][l];
+                r0[l] += wl;
+                ry[l] += wl * oyj;
+            }
         }
         let wi = st.w[0][i];
         let ox = i as f64 - st.fx[0];
-        s0 = std::array::from_fn(|l| s0[l] + wi * r0[l]);
-        sx = std::array::from_fn(|l| sx[l] + wi * r0[l] * ox);
-        sy = std::array::from_fn(|l| sy[l] + wi * ry[l]);
+        for l in 0..N {
+            let a = wi * r0[l];
+            s0[l] += a;
+            sx[l] += a * ox;
+            sy[l] += wi * ry[l];
+        }
     }
     [s0, sx, sy]
+}
+
+/// [`weighted_sums`] of all four lanes; with `avx` (the CPU has AVX2, see
+/// [`super::simd::kernels`]) in 256-bit registers, one node per load.
+#[inline(always)]
+fn weighted_sums4(grid: &Grid, st: &Stencil, avx: bool) -> [[f64; 4]; 3] {
+    #[cfg(target_arch = "x86_64")]
+    if avx {
+        // SAFETY: `avx` is set only when the CPU has AVX2.
+        return unsafe { weighted_sums4_avx(grid, st) };
+    }
+    let _ = avx;
+    weighted_sums::<4>(grid, st)
+}
+
+/// [`weighted_sums`]`::<4>` in AVX registers: the same multiplications and
+/// additions in the same order (no FMA), so the same bits.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx")]
+#[inline]
+unsafe fn weighted_sums4_avx(grid: &Grid, st: &Stencil) -> [[f64; 4]; 3] {
+    use std::arch::x86_64::*;
+    let geom = &grid.geom;
+    let (bi, bj) = (st.base[0] as usize, st.base[1] as usize);
+    let oy = [-st.fx[1], 1.0 - st.fx[1], 2.0 - st.fx[1]];
+    let mut s0 = _mm256_setzero_pd();
+    let mut sx = _mm256_setzero_pd();
+    let mut sy = _mm256_setzero_pd();
+    for i in 0..3 {
+        let start = geom.index(bi + i, bj);
+        let row: &[Node; 3] = (&grid.node[start..start + 3]).try_into().unwrap();
+        let mut r0 = _mm256_setzero_pd();
+        let mut ry = _mm256_setzero_pd();
+        for j in 0..3 {
+            // SAFETY: `row[j]` is four f64 in bounds
+            let n = unsafe { _mm256_loadu_pd(row[j].as_ptr()) };
+            let wl = _mm256_mul_pd(_mm256_set1_pd(st.w[1][j]), n);
+            r0 = _mm256_add_pd(r0, wl);
+            ry = _mm256_add_pd(ry, _mm256_mul_pd(wl, _mm256_set1_pd(oy[j])));
+        }
+        let wi = _mm256_set1_pd(st.w[0][i]);
+        let a = _mm256_mul_pd(wi, r0);
+        s0 = _mm256_add_pd(s0, a);
+        sx = _mm256_add_pd(sx, _mm256_mul_pd(a, _mm256_set1_pd(i as f64 - st.fx[0])));
+        sy = _mm256_add_pd(sy, _mm256_mul_pd(wi, ry));
+    }
+    let mut out = [[0.0; 4]; 3];
+    // SAFETY: each row of `out` is four f64
+    unsafe {
+        _mm256_storeu_pd(out[0].as_mut_ptr(), s0);
+        _mm256_storeu_pd(out[1].as_mut_ptr(), sx);
+        _mm256_storeu_pd(out[2].as_mut_ptr(), sy);
+    }
+    out
 }
 
 /// New `(v, C)` of a particle by the transfer scheme, and the grid velocity
@@ -107,10 +169,11 @@ fn transfer<const FLIP: bool>(
     grid: &Grid,
     st: &Stencil,
     ratio: f64,
+    avx: bool,
     v: &mut Vec2,
     c: &mut Mat2,
 ) -> (Vec2, Mat2) {
-    let (vn, cn, dv, dc) = interpolate::<FLIP>(grid, st);
+    let (vn, cn, dv, dc) = interpolate::<FLIP>(grid, st, avx);
     if FLIP {
         blend(ratio, v, c, vn, cn, dv, dc);
     } else {
@@ -179,11 +242,12 @@ multiversion! {
     ) -> Option<BadVertex> {
         let geom = g.grid.geom;
         let (dt, ratio) = (g.dt, g.transfer.flip_ratio());
+        let avx = kernels() >= Kernels::Avx2;
         let (lo, hi) = (geom.dx, (geom.n as f64 - 2.0) * geom.dx);
         let mut bad = None;
         let it = xs.iter_mut().zip(vs).zip(cs).zip(sts).zip(spins);
         for (k, ((((x, v), c), st), spin)) in it.enumerate() {
-            let (nv, _) = transfer::<FLIP>(g.grid, st, ratio, v, c);
+            let (nv, _) = transfer::<FLIP>(g.grid, st, ratio, avx, v, c);
             *x += nv * dt;
             if FLIP {
                 // the moment this move gives the particle's momentum (zero
@@ -310,12 +374,13 @@ multiversion! {
     ) -> Option<usize> {
         let (dt, energy) = (rest.dt, rest.energy);
         let inv_dx = grid.geom.inv_dx;
+        let avx = kernels() >= Kernels::Avx2;
         let n = q.x.len();
         // the grid's part, one particle at a time: velocity and C by the
         // transfer, position and d1 from the vertices, d2 advected
         for k in 0..n {
             let g = base + k;
-            let (_, nc) = transfer::<FLIP>(grid, &q.stencil[k], rest.ratio, &mut q.v[k], &mut q.c[k]);
+            let (_, nc) = transfer::<FLIP>(grid, &q.stencil[k], rest.ratio, avx, &mut q.v[k], &mut q.c[k]);
             let left = rest.left[g] as usize;
             let (xl, xr) = (rest.vx[left], rest.vx[left + 1]);
             let x = (xl + xr) * 0.5;
