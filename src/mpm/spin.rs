@@ -43,43 +43,48 @@ pub fn balance(p: &mut Particles, pinned: &[bool]) {
         .enumerate()
         .for_each(|(y, (v, qvel))| {
             let (v0, q0) = (yv[y], yv[y] - y);
-            let free = |i: usize| !pinned[v0 + i];
+            let (nv, nq) = (v.len(), qvel.len());
+            let pin = &pinned[v0..v0 + nv];
+            let (vm, vs, vx) = (&vm[v0..v0 + nv], &vs[v0..v0 + nv], &vx[v0..v0 + nv]);
+            let (qm, qs, qx) = (&qm[q0..q0 + nq], &qs[q0..q0 + nq], &qx[q0..q0 + nq]);
             // leak, mass and centre of the free particles
             let (mut s, mut m, mut c) = (0.0, 0.0, Vec2::zeros());
-            for i in (0..v.len()).filter(|&i| free(i)) {
-                let mi = vm[v0 + i];
-                s += mi * vs[v0 + i];
-                m += mi;
-                c += vx[v0 + i] * mi;
+            for (((&mi, &si), xi), &p) in vm.iter().zip(vs).zip(vx).zip(pin) {
+                if !p {
+                    s += mi * si;
+                    m += mi;
+                    c += xi * mi;
+                }
             }
-            for k in 0..qvel.len() {
-                let mk = qm[q0 + k];
-                s += mk * qs[q0 + k];
+            for ((&mk, &sk), xk) in qm.iter().zip(qs).zip(qx) {
+                s += mk * sk;
                 m += mk;
-                c += qx[q0 + k] * mk;
+                c += xk * mk;
             }
             if s == 0.0 || m <= 0.0 {
                 return;
             }
             c /= m;
             let mut inertia = 0.0;
-            for i in (0..v.len()).filter(|&i| free(i)) {
-                inertia += vm[v0 + i] * (vx[v0 + i] - c).norm_squared();
+            for ((&mi, xi), &p) in vm.iter().zip(vx).zip(pin) {
+                if !p {
+                    inertia += mi * (xi - c).norm_squared();
+                }
             }
-            for k in 0..qvel.len() {
-                inertia += qm[q0 + k] * (qx[q0 + k] - c).norm_squared();
+            for (&mk, xk) in qm.iter().zip(qx) {
+                inertia += mk * (xk - c).norm_squared();
             }
             if inertia <= 0.0 {
                 return;
             }
             let omega = -s / inertia;
-            for (i, vi) in v.iter_mut().enumerate() {
-                if free(i) {
-                    *vi += perp(vx[v0 + i] - c) * omega;
+            for ((vi, xi), &p) in v.iter_mut().zip(vx).zip(pin) {
+                if !p {
+                    *vi += perp(xi - c) * omega;
                 }
             }
-            for (k, vk) in qvel.iter_mut().enumerate() {
-                *vk += perp(qx[q0 + k] - c) * omega;
+            for (vk, xk) in qvel.iter_mut().zip(qx) {
+                *vk += perp(xk - c) * omega;
             }
         });
 }
