@@ -116,6 +116,19 @@ impl GridGeom {
         (i - self.i0) * self.stride + (j - self.j0)
     }
 
+    /// The three rows of three nodes of the 3x3 stencil whose lower-left
+    /// node is `(bi, bj)`, in `nodes` (a pool of this window), with one
+    /// bounds check for all nine.
+    #[inline(always)]
+    pub fn stencil_rows<'a, T>(&self, nodes: &'a [T], bi: usize, bj: usize) -> [&'a [T; 3]; 3] {
+        let first = self.index(bi, bj);
+        let s = self.stride;
+        let span = &nodes[first..first + 2 * s + 3];
+        // SAFETY: row `i` is `span[i * s..i * s + 3]`, inside `span` for
+        // i <= 2; shared references may overlap.
+        std::array::from_fn(|i| unsafe { &*(span.as_ptr().add(i * s) as *const [T; 3]) })
+    }
+
     /// Node `(i, j)` of storage index `idx`.
     #[inline(always)]
     pub fn node(&self, idx: usize) -> (usize, usize) {
@@ -432,6 +445,33 @@ mod tests {
             fast.add_positions(c, inv_dx);
             assert_eq!(fast, one_by_one(c), "{} positions", c.len());
         }
+    }
+
+    #[test]
+    fn stencil_rows_are_the_nodes_of_the_stencil() {
+        let g = GridGeom::new(37, 1.0).with_window(1, 2, 3, 2);
+        let nodes: Vec<usize> = (0..g.storage()).collect();
+        // every stencil inside the window, including its last row and column
+        for bi in 8..30 {
+            for bj in 16..30 {
+                let rows = g.stencil_rows(&nodes, bi, bj);
+                for (i, row) in rows.iter().enumerate() {
+                    for (j, &k) in row.iter().enumerate() {
+                        assert_eq!(k, g.index(bi + i, bj + j));
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    #[should_panic]
+    fn stencil_rows_past_the_window_panic() {
+        let g = GridGeom::new(37, 1.0).with_window(1, 2, 3, 2);
+        let nodes = vec![0u8; g.storage()];
+        // lower-left node on the window's last row but one: its third row
+        // would be outside
+        let _ = g.stencil_rows(&nodes, 30, 16);
     }
 
     #[test]

@@ -10,7 +10,7 @@ use rayon::prelude::*;
 use super::constitutive::{frame_gradient_qr, YarnEnergy};
 use super::contact::{clamp_to_grid, project_out};
 use super::frames::{update_frames, Frames};
-use super::grid::{Grid, Node, DVX, DVY, VX, VY};
+use super::grid::{Grid, DVX, DVY, VX, VY};
 use super::particles::Quads;
 use super::simd::{kernels, multiversion, Kernels, PAR_MIN};
 use super::transfer::{blend, Transfer};
@@ -83,9 +83,8 @@ fn weighted_sums<const N: usize>(grid: &Grid, st: &Stencil) -> [[f64; N]; 3] {
     let mut s0 = [0.0; N];
     let mut sx = [0.0; N];
     let mut sy = [0.0; N];
-    for i in 0..3 {
-        let start = geom.index(bi + i, bj);
-        let row: &[Node; 3] = (&grid.node[start..start + 3]).try_into().unwrap();
+    let rows = geom.stencil_rows(&grid.node, bi, bj);
+    for (i, row) in rows.iter().enumerate() {
         let mut r0 = [0.0; N];
         let mut ry = [0.0; N];
         for j in 0..3 {
@@ -134,9 +133,8 @@ unsafe fn weighted_sums4_avx(grid: &Grid, st: &Stencil) -> [[f64; 4]; 3] {
     let mut s0 = _mm256_setzero_pd();
     let mut sx = _mm256_setzero_pd();
     let mut sy = _mm256_setzero_pd();
-    for i in 0..3 {
-        let start = geom.index(bi + i, bj);
-        let row: &[Node; 3] = (&grid.node[start..start + 3]).try_into().unwrap();
+    let rows = geom.stencil_rows(&grid.node, bi, bj);
+    for (i, row) in rows.iter().enumerate() {
         let mut r0 = _mm256_setzero_pd();
         let mut ry = _mm256_setzero_pd();
         for j in 0..3 {

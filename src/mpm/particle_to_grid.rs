@@ -66,12 +66,18 @@ fn splat(buf: &mut ScatterBuffer, geom: &GridGeom, st: &Stencil, s: &Splat) {
     buf.touch_stencil(geom, st.base);
     let oy = [-st.fx[1], 1.0 - st.fx[1], 2.0 - st.fx[1]];
     let (bi, bj) = (st.base[0] as usize, st.base[1] as usize);
+    let stride = geom.stride;
+    // the stencil's three rows of three nodes, one bounds check for all
+    let first = geom.index(bi, bj);
+    let nodes = &mut buf.node[first..first + 2 * stride + 3];
+    let p = nodes.as_mut_ptr();
     for i in 0..3 {
         let ox = i as f64 - st.fx[0];
         let rb: P2gNode = std::array::from_fn(|l| s.base[l] + s.cx[l] * ox);
         let wi = st.w[0][i];
-        let start = geom.index(bi + i, bj);
-        let row: &mut [P2gNode; 3] = (&mut buf.node[start..start + 3]).try_into().unwrap();
+        // SAFETY: `i * stride + 3 <= nodes.len()`, and the rows are disjoint
+        // (`stride >= 3`), so this is the only reference to these nodes.
+        let row = unsafe { &mut *(p.add(i * stride) as *mut [P2gNode; 3]) };
         for j in 0..3 {
             let w = wi * st.w[1][j];
             let n = &mut row[j];
@@ -179,23 +185,27 @@ multiversion! {
         let normal_scale = -dt * 4.0 * geom.inv_dx;
         buf.clear();
         vertex_forces(vert, &quad.t1, ctx.bending, vr.clone(), fs);
-        for ((i, st), f) in vr.zip(sts.iter_mut()).zip(fs.iter()) {
-            *st = Stencil::new(vert.x[i], geom.inv_dx);
-            let m = vert.m[i];
+        let (vx, vm) = (&vert.x[vr.clone()], &vert.m[vr.clone()]);
+        let (vv, vc) = (&vert.v[vr.clone()], &vert.c[vr]);
+        let it = sts.iter_mut().zip(fs.iter()).zip(vx).zip(vm).zip(vv).zip(vc);
+        for (((((st, f), &x), &m), &v), &c) in it {
+            *st = Stencil::new(x, geom.inv_dx);
             let f0 = f * dt;
-            let mc = contact_mass(ctx.obstacles, margin, vert.x[i], m);
-            let a = vert.c[i] * (m * dx);
-            let s = Splat::new(m, mc, vert.v[i] * m + f0, a, f0, Mat2::zeros());
+            let mc = contact_mass(ctx.obstacles, margin, x, m);
+            let a = c * (m * dx);
+            let s = Splat::new(m, mc, v * m + f0, a, f0, Mat2::zeros());
             splat(buf, geom, st, &s);
         }
-        for q in qr {
-            let m = quad.m[q];
-            let d2 = quad.d[q].column(1).into_owned();
-            let af = quad.t2[q] * normal_scale * d2.transpose();
-            let mc = contact_mass(ctx.obstacles, margin, quad.x[q], m);
-            let a = quad.c[q] * (m * dx) + af;
-            let s = Splat::new(m, mc, quad.v[q] * m, a, Vec2::zeros(), af);
-            splat(buf, geom, &quad.stencil[q], &s);
+        let (qm, qd, qt2) = (&quad.m[qr.clone()], &quad.d[qr.clone()], &quad.t2[qr.clone()]);
+        let (qx, qc, qv) = (&quad.x[qr.clone()], &quad.c[qr.clone()], &quad.v[qr.clone()]);
+        let it = qm.iter().zip(qd).zip(qt2).zip(qx).zip(qc).zip(qv).zip(&quad.stencil[qr]);
+        for ((((((&m, d), &t2), &x), &c), &v), st) in it {
+            let d2 = d.column(1).into_owned();
+            let af = t2 * normal_scale * d2.transpose();
+            let mc = contact_mass(ctx.obstacles, margin, x, m);
+            let a = c * (m * dx) + af;
+            let s = Splat::new(m, mc, v * m, a, Vec2::zeros(), af);
+            splat(buf, geom, st, &s);
         }
     }
 }
