@@ -31,8 +31,8 @@ use std::time::Duration;
 
 use rerun::blueprint::components::PanelState;
 use rerun::blueprint::{
-    Blueprint, BlueprintPanel, Horizontal, SelectionPanel, Spatial2DView, Spatial3DView,
-    TextDocumentView, TimePanel, TimeSeriesView, Vertical,
+    Blueprint, BlueprintPanel, ContainerLike, Horizontal, SelectionPanel, Spatial2DView,
+    Spatial3DView, TextDocumentView, TimePanel, TimeSeriesView, Vertical,
 };
 use rerun::components::{Color, Scalar, Vector2D, Vector3D};
 use rerun::{
@@ -612,27 +612,41 @@ fn with_panels(b: Blueprint) -> Blueprint {
 /// The layout the recording opens with: the 2D scene and the colour scales
 /// on the left, one plot per unit on the right.
 pub fn yarn_blueprint() -> Blueprint {
+    two_columns(
+        Spatial2DView::new("scene")
+            .with_origin("/")
+            .with_contents(["/world/**"])
+            .into(),
+        &[
+            ("energy [J]", "/plots/energy"),
+            ("momentum [kg m/s]", "/plots/momentum"),
+            ("angular momentum [kg m^2/s]", "/plots/angular_momentum"),
+            ("stretch l/l0", "/plots/stretch"),
+            ("centre of mass [m]", "/plots/center_of_mass"),
+            ("wall time per substep [s]", "/timing"),
+        ],
+    )
+}
+
+/// `scene` above the colour scales on the left (3/5 of the width), one
+/// time-series view per `(title, origin)` on the right; the side panels
+/// collapsed ([`with_panels`]).
+fn two_columns(scene: ContainerLike, plots: &[(&str, &str)]) -> Blueprint {
     with_panels(Blueprint::new(
         Horizontal::new([
             Vertical::new([
-                Spatial2DView::new("scene")
-                    .with_origin("/")
-                    .with_contents(["/world/**"])
-                    .into(),
+                scene,
                 TextDocumentView::new("colours")
                     .with_origin(format!("/{}", paths::LEGEND))
                     .into(),
             ])
             .with_row_shares([6.0, 1.0])
             .into(),
-            Vertical::new([
-                plot("energy [J]", "/plots/energy").into(),
-                plot("momentum [kg m/s]", "/plots/momentum").into(),
-                plot("angular momentum [kg m^2/s]", "/plots/angular_momentum").into(),
-                plot("stretch l/l0", "/plots/stretch").into(),
-                plot("centre of mass [m]", "/plots/center_of_mass").into(),
-                plot("wall time per substep [s]", "/timing").into(),
-            ])
+            Vertical::new(
+                plots
+                    .iter()
+                    .map(|&(name, origin)| plot(name, origin).into()),
+            )
             .into(),
         ])
         .with_column_shares([3.0, 2.0]),
@@ -654,29 +668,18 @@ fn p2(v: &yarnsim::math::Vec2) -> [f32; 2] {
 /// The layout of a mass-spring recording: the 3D scene and the colour
 /// scales on the left, one plot per unit on the right.
 pub fn massspring_blueprint() -> Blueprint {
-    with_panels(Blueprint::new(
-        Horizontal::new([
-            Vertical::new([
-                Spatial3DView::new("scene").with_origin("/world").into(),
-                TextDocumentView::new("colours")
-                    .with_origin(format!("/{}", paths::LEGEND))
-                    .into(),
-            ])
-            .with_row_shares([6.0, 1.0])
-            .into(),
-            Vertical::new([
-                plot("energy [J]", "/plots/energy").into(),
-                plot("momentum [kg m/s]", "/plots/momentum").into(),
-                plot("angular momentum [kg m^2/s]", "/plots/angular_momentum").into(),
-                plot("strain |l/l0 - 1|", "/plots/strain").into(),
-                plot("centre of mass [m]", "/plots/center_of_mass").into(),
-                plot("CG iterations", "/plots/cg_iterations").into(),
-                plot("wall time per substep [s]", "/timing").into(),
-            ])
-            .into(),
-        ])
-        .with_column_shares([3.0, 2.0]),
-    ))
+    two_columns(
+        Spatial3DView::new("scene").with_origin("/world").into(),
+        &[
+            ("energy [J]", "/plots/energy"),
+            ("momentum [kg m/s]", "/plots/momentum"),
+            ("angular momentum [kg m^2/s]", "/plots/angular_momentum"),
+            ("strain |l/l0 - 1|", "/plots/strain"),
+            ("centre of mass [m]", "/plots/center_of_mass"),
+            ("CG iterations", "/plots/cg_iterations"),
+            ("wall time per substep [s]", "/timing"),
+        ],
+    )
 }
 
 /// Distinct colours for the series of one plot (Okabe-Ito palette, easy to

@@ -560,6 +560,20 @@ fn recordings_read_at_a_glance() {
         let states = all_values::<PanelState>(&bp[panel]);
         assert_eq!(states, vec![PanelState::Collapsed], "{panel}");
     }
+    // The views: the scene, the colour scales and one plot per unit.
+    let views = view_names(&bp);
+    for v in [
+        "scene",
+        "colours",
+        "energy [J]",
+        "momentum [kg m/s]",
+        "angular momentum [kg m^2/s]",
+        "stretch l/l0",
+        "centre of mass [m]",
+        "wall time per substep [s]",
+    ] {
+        assert!(views.contains(v), "no view {v:?} in {views:?}");
+    }
 
     // Labels at their objects: the obstacle's label is drawn at its centre
     // (no transform anywhere in a 2D recording, so nothing can mirror it),
@@ -590,6 +604,18 @@ fn recordings_read_at_a_glance() {
     let chunks = decode(&rrd);
     let vc = all_values::<ViewCoordinates>(&chunks["world"]);
     assert_eq!(vc, vec![rerun::components::ViewCoordinates::RUB]);
+    let views = view_names(&decode_store(&rrd, StoreKind::Blueprint));
+    for v in ["scene", "colours", "strain |l/l0 - 1|", "CG iterations"] {
+        assert!(views.contains(v), "no view {v:?} in {views:?}");
+    }
+}
+
+/// The display names in a blueprint store (views and containers).
+fn view_names(bp: &BTreeMap<String, Vec<Chunk>>) -> BTreeSet<String> {
+    bp.values()
+        .flat_map(|chunks| all_values::<rerun::components::Name>(chunks))
+        .map(|n| n.as_str().to_string())
+        .collect()
 }
 
 /// Reads the data chunks a `--serve` server sends, the way a viewer started
