@@ -234,9 +234,14 @@ pub fn run_frames<S: Stepper + Send>(
 mod tests {
     use super::*;
 
-    struct Counter(u64);
+    /// Counts its substeps in `.0`; fails at substep `.1 + 1` (when set),
+    /// like a diverging simulation.
+    struct Counter(u64, Option<u64>);
     impl Stepper for Counter {
         fn step(&mut self) -> Result<(), CliError> {
+            if Some(self.0) == self.1 {
+                return Err(CliError::Failed("diverged".into()));
+            }
             self.0 += 1;
             Ok(())
         }
@@ -253,7 +258,7 @@ mod tests {
         let schedule = Schedule::new(0.025, 1e-3, 0.01).unwrap();
         let mut seen = Vec::new();
         let out = run_frames(
-            &mut Counter(0),
+            &mut Counter(0, None),
             &schedule,
             &AtomicBool::new(false),
             &ProgressBar::hidden(),
@@ -283,7 +288,7 @@ mod tests {
         let schedule = Schedule::new(1.0, 1e-3, 0.01).unwrap();
         let mut frames = 0;
         let out = run_frames(
-            &mut Counter(0),
+            &mut Counter(0, None),
             &schedule,
             &AtomicBool::new(true),
             &ProgressBar::hidden(),
@@ -298,30 +303,12 @@ mod tests {
         assert_eq!((frames, out.substeps, out.last_frame), (1, 0, 0));
     }
 
-    /// Fails at its 15th substep, like a diverging simulation.
-    struct Diverging(u64);
-    impl Stepper for Diverging {
-        fn step(&mut self) -> Result<(), CliError> {
-            if self.0 == 14 {
-                return Err(CliError::Failed("diverged".into()));
-            }
-            self.0 += 1;
-            Ok(())
-        }
-        fn steps(&self) -> u64 {
-            self.0
-        }
-        fn num_particles(&self) -> usize {
-            1
-        }
-    }
-
     #[test]
     fn a_failing_substep_keeps_the_frames_before_it() {
         let schedule = Schedule::new(0.025, 1e-3, 0.01).unwrap();
         let mut seen = Vec::new();
         let run = run_frames(
-            &mut Diverging(0),
+            &mut Counter(0, Some(14)),
             &schedule,
             &AtomicBool::new(false),
             &ProgressBar::hidden(),
