@@ -129,6 +129,25 @@ impl GridGeom {
         std::array::from_fn(|i| unsafe { &*(span.as_ptr().add(i * s) as *const [T; 3]) })
     }
 
+    /// [`GridGeom::stencil_rows`] for writing (the scatter's splat). The
+    /// rows are disjoint: the stride is whole blocks, at least 8 nodes.
+    #[inline(always)]
+    pub fn stencil_rows_mut<'a, T>(
+        &self,
+        nodes: &'a mut [T],
+        bi: usize,
+        bj: usize,
+    ) -> [&'a mut [T; 3]; 3] {
+        let first = self.index(bi, bj);
+        let s = self.stride;
+        assert!(s >= 3, "a window row holds a stencil row");
+        let span = &mut nodes[first..first + 2 * s + 3];
+        let p = span.as_mut_ptr();
+        // SAFETY: row `i` is `span[i * s..i * s + 3]`, inside `span` for
+        // i <= 2, and the three rows do not overlap (s >= 3).
+        std::array::from_fn(|i| unsafe { &mut *(p.add(i * s) as *mut [T; 3]) })
+    }
+
     /// Node `(i, j)` of storage index `idx`.
     #[inline(always)]
     pub fn node(&self, idx: usize) -> (usize, usize) {
@@ -460,6 +479,20 @@ mod tests {
                         assert_eq!(k, g.index(bi + i, bj + j));
                     }
                 }
+                // the writable rows are the same nodes
+                let mut marks = vec![0usize; g.storage()];
+                for (i, row) in g
+                    .stencil_rows_mut(&mut marks, bi, bj)
+                    .into_iter()
+                    .enumerate()
+                {
+                    for (j, m) in row.iter_mut().enumerate() {
+                        *m = g.index(bi + i, bj + j) + 1;
+                    }
+                }
+                let written: Vec<usize> = (0..marks.len()).filter(|&k| marks[k] != 0).collect();
+                assert_eq!(written.len(), 9);
+                assert!(written.iter().all(|&k| marks[k] == k + 1));
             }
         }
     }
@@ -472,6 +505,14 @@ mod tests {
         // lower-left node on the window's last row but one: its third row
         // would be outside
         let _ = g.stencil_rows(&nodes, 30, 16);
+    }
+
+    #[test]
+    #[should_panic]
+    fn writable_stencil_rows_past_the_window_panic() {
+        let g = GridGeom::new(37, 1.0).with_window(1, 2, 3, 2);
+        let mut nodes = vec![0u8; g.storage()];
+        let _ = g.stencil_rows_mut(&mut nodes, 30, 16);
     }
 
     #[test]

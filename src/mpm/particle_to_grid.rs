@@ -66,18 +66,11 @@ fn splat(buf: &mut ScatterBuffer, geom: &GridGeom, st: &Stencil, s: &Splat) {
     buf.touch_stencil(geom, st.base);
     let oy = [-st.fx[1], 1.0 - st.fx[1], 2.0 - st.fx[1]];
     let (bi, bj) = (st.base[0] as usize, st.base[1] as usize);
-    let stride = geom.stride;
-    // the stencil's three rows of three nodes, one bounds check for all
-    let first = geom.index(bi, bj);
-    let nodes = &mut buf.node[first..first + 2 * stride + 3];
-    let p = nodes.as_mut_ptr();
-    for i in 0..3 {
+    let rows = geom.stencil_rows_mut(&mut buf.node, bi, bj);
+    for (i, row) in rows.into_iter().enumerate() {
         let ox = i as f64 - st.fx[0];
         let rb: P2gNode = std::array::from_fn(|l| s.base[l] + s.cx[l] * ox);
         let wi = st.w[0][i];
-        // SAFETY: `i * stride + 3 <= nodes.len()`, and the rows are disjoint
-        // (`stride >= 3`), so this is the only reference to these nodes.
-        let row = unsafe { &mut *(p.add(i * stride) as *mut [P2gNode; 3]) };
         for j in 0..3 {
             let w = wi * st.w[1][j];
             let n = &mut row[j];
