@@ -11,6 +11,7 @@
 //! buffer; the buffers are summed in chunk order, so results do not depend on
 //! the number of threads.
 
+use super::line_pool::LinePool;
 use crate::math::bspline::base_of;
 use crate::math::Vec2;
 
@@ -211,7 +212,7 @@ fn fit<T: Clone>(pool: &mut Vec<T>, len: usize, zero: T) {
 /// touched.
 #[derive(Clone, Debug)]
 pub struct ScatterBuffer {
-    pub node: Vec<P2gNode>,
+    pub node: LinePool<P2gNode>,
     pub touched: Vec<bool>,
     pub touched_list: Vec<u32>,
 }
@@ -219,7 +220,7 @@ pub struct ScatterBuffer {
 impl ScatterBuffer {
     pub fn new(geom: &GridGeom) -> Self {
         ScatterBuffer {
-            node: vec![[0.0; P2G_LANES]; geom.storage()],
+            node: LinePool::zeroed(geom.storage()),
             touched: vec![false; geom.blocks()],
             touched_list: Vec::new(),
         }
@@ -266,7 +267,7 @@ impl ScatterBuffer {
 #[derive(Clone, Debug)]
 pub struct Grid {
     pub geom: GridGeom,
-    pub node: Vec<Node>,
+    pub node: LinePool<Node>,
     /// Blocks touched this substep, sorted.
     pub active: Vec<u32>,
     /// `is_active[b]` for every block.
@@ -338,7 +339,7 @@ impl Grid {
         let geom = geom.with_window(0, 0, 0, 0);
         Grid {
             geom,
-            node: Vec::new(),
+            node: LinePool::default(),
             active: Vec::new(),
             is_active: Vec::new(),
             buffers: (0..CHUNKS).map(|_| ScatterBuffer::new(&geom)).collect(),
@@ -385,10 +386,10 @@ impl Grid {
         self.geom = geom;
         // every scatter node is zero here (the grid update zeroed what it
         // summed), so the pools need no clearing wherever the window moved
-        fit(&mut self.node, geom.storage(), [0.0; 4]);
+        self.node.fit(geom.storage());
         fit(&mut self.is_active, geom.blocks(), false);
         for buf in &mut self.buffers {
-            fit(&mut buf.node, geom.storage(), [0.0; P2G_LANES]);
+            buf.node.fit(geom.storage());
             fit(&mut buf.touched, geom.blocks(), false);
         }
     }
@@ -396,11 +397,11 @@ impl Grid {
     /// Bytes the grid holds now (its pools by capacity).
     pub fn memory_bytes(&self) -> usize {
         use std::mem::size_of;
-        let mut b = self.node.capacity() * size_of::<Node>()
+        let mut b = self.node.capacity_bytes()
             + self.active.capacity() * size_of::<u32>()
             + self.is_active.capacity();
         for buf in &self.buffers {
-            b += buf.node.capacity() * size_of::<P2gNode>()
+            b += buf.node.capacity_bytes()
                 + buf.touched.capacity()
                 + buf.touched_list.capacity() * size_of::<u32>();
         }

@@ -5,7 +5,9 @@
 //! * [`particles`]: type-2 vertices and type-3 quadrature particles.
 //! * [`vertex_forces`]: fiber and bending forces on the vertices (a plain
 //!   function of the positions, usable without the grid).
-//! * [`grid`]: the block-sparse background grid.
+//! * [`grid`]: the background grid, a window of 8x8-node blocks around the
+//!   particles, and the chunks' scatter buffers.
+//! * [`line_pool`]: the grid's node pools, starting on a cache line.
 //! * [`particle_to_grid`]: pass 1, P2G of mass, momentum and force impulses.
 //! * [`grid_update`]: pass 2, velocities, gravity, attractor, contact, walls.
 //! * [`contact`]: the obstacle (Coulomb), wall and grid-edge laws.
@@ -26,6 +28,7 @@ pub mod frames;
 pub mod grid;
 pub mod grid_to_particle;
 pub mod grid_update;
+pub mod line_pool;
 pub mod particle_to_grid;
 pub mod particles;
 pub mod pins;
