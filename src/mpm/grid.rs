@@ -11,7 +11,7 @@
 //! buffer; the buffers are summed in chunk order, so results do not depend on
 //! the number of threads.
 
-use super::line_pool::LinePool;
+use super::line_pool::{fit, LinePool};
 use crate::math::bspline::base_of;
 use crate::math::Vec2;
 
@@ -196,15 +196,6 @@ impl GridGeom {
             && lo[1] >= self.j0
             && hi[0] + 2 < self.i0 + self.nbi * BLOCK
             && hi[1] + 2 < self.j0 + self.nbj * BLOCK
-    }
-}
-
-/// Resizes a pool to `len` entries (new ones `zero`), giving memory back
-/// when the window has shrunk to under a quarter of the capacity.
-fn fit<T: Clone>(pool: &mut Vec<T>, len: usize, zero: T) {
-    pool.resize(len, zero);
-    if pool.capacity() > 4 * len {
-        pool.shrink_to(2 * len);
     }
 }
 
