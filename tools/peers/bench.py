@@ -12,7 +12,7 @@ its stepping loop only. The timed cases run in `--rounds` rounds; within a
 round the tools take turns (the order rotates from round to round) and the
 wall time is the median over the rounds; errors are deterministic. The
 capstan threshold is a bisection (slides at 0.7 mu*, holds at 1.4 mu*, then
-three halvings, as yarnsim's test) and the bundle a single window; both run
+five halvings: a bracket of 2.2 % of mu*; yarnsim's test does three) and the bundle a single window; both run
 once. `--quick` (under a minute) runs the coarsest chain and cantilever of
 each tool, once, and writes `peers_quick.csv` / `.svg` into `--out` (default
 for quick: the system temp directory) instead of `peers.csv` / `.svg`.
@@ -22,7 +22,6 @@ import argparse
 import csv
 import math
 import os
-import platform
 import statistics
 import sys
 import tempfile
@@ -102,7 +101,9 @@ def capstan(tool, slides, setting, integrator, rows):
     """Bisection of the slip threshold between 0.7 and 1.4 mu* with
     `slides(mu) -> (slid, wall, sim)`; one row."""
     c = O.CAPSTAN
-    r_eff = c["radius"] + (1e-3 if tool == "mujoco" else 0.0)
+    # the rope's centreline radius: MuJoCo's rope radius is 1 mm,
+    # PyElastica's 2 mm; yarnsim's yarn has no radius
+    r_eff = c["radius"] + {"mujoco": 1e-3, "pyelastica": 2e-3}.get(tool, 0.0)
     mu_star = O.capstan_threshold(r_eff, c["l1"], c["l2"])
     wall = sim = 0.0
     ok = True
@@ -118,7 +119,7 @@ def capstan(tool, slides, setting, integrator, rows):
     if not run(lo) or run(hi):
         ok = False
     else:
-        for _ in range(3):
+        for _ in range(5):
             mid = 0.5 * (lo + hi)
             if run(mid):
                 lo = mid
@@ -141,7 +142,7 @@ def bundle(rows, duration):
     for tool, integ, setting, fn in [
         ("yarnsim", "mpm-explicit", "256^2, dt 4e-5 (yarn-reference)",
          lambda: yarnsim_rope.bundle(duration)),
-        ("mujoco", "discrete", "CG, dt 1e-3, r 1.9 mm, free 3D",
+        ("mujoco", "discrete", "CG, dt 1e-3, r 1.9 mm, planar (y armature 1e6)",
          lambda: mujoco_rope.bundle(duration)),
     ]:
         res = fn()
@@ -161,6 +162,21 @@ def bundle(rows, duration):
                           "see README"))
 
 
+TITLE = "Rod peers against analytic oracles, one thread ({date})"
+
+
+def replot(path):
+    rows = []
+    with open(path) as f:
+        for r in csv.DictReader(f):
+            for k in ("error", "wall_s_per_sim_s"):
+                r[k] = float(r[k])
+            r["ok"] = r["ok"] == "True"
+            rows.append(r)
+    date = time.strftime("%Y-%m-%d", time.localtime(os.path.getmtime(path)))
+    plot.work_precision(rows, os.path.splitext(path)[0] + ".svg", title=TITLE.format(date=date))
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--quick", action="store_true")
@@ -168,7 +184,11 @@ def main():
     ap.add_argument("--out", default=None)
     ap.add_argument("--skip-bundle", action="store_true")
     ap.add_argument("--bundle-duration", type=float, default=0.2)
+    ap.add_argument("--replot", metavar="CSV", help="only redraw the SVG next to CSV")
     a = ap.parse_args()
+    if a.replot:
+        replot(a.replot)
+        return
     out = a.out or (tempfile.gettempdir() if a.quick else os.path.join(ROOT, "docs",
                                                                         "performance"))
     stem = "peers_quick" if a.quick else "peers"
@@ -177,6 +197,8 @@ def main():
         yarnsim_rope.build()
     # warm-up: Numba compiles PyElastica's kernels on the first run (cached)
     elastica_rope.chain(4, dt=1e-4, duration=0.01)
+    if not a.quick:
+        elastica_rope.capstan_slides(8, 0.3, load=1e-3, hold=1e-3)
     t_start = time.time()
     cs = cases(a.quick)
     res = interleave(cs, rounds)
@@ -192,6 +214,8 @@ def main():
         capstan("yarnsim", lambda mu: yarnsim_rope.capstan_slides(
             O.CAPSTAN["radius"], O.CAPSTAN["l1"], O.CAPSTAN["l2"], mu),
             "184 vertices, 128^2, dt 1e-4", "mpm-explicit", rows)
+        capstan("pyelastica", lambda mu: elastica_rope.capstan_slides(70, mu),
+                "70 elements, dt 5e-5, c_v 50", "position-verlet", rows)
         for n in (50, 100):
             capstan("mujoco", lambda mu, n=n: mujoco_rope.capstan_slides(n, 1e-3, mu),
                     f"{n} elements, dt 1e-3", "discrete", rows)
@@ -212,8 +236,7 @@ def main():
         for r in rows:
             w.writerow({k: (f"{r[k]:.6g}" if isinstance(r[k], float) else r[k]) for k in fields})
     svg = os.path.join(out, stem + ".svg")
-    plot.work_precision(rows, svg, title=f"Rod peers, one thread ({platform.node() or 'host'}, "
-                                         f"{time.strftime('%Y-%m-%d')})")
+    plot.work_precision(rows, svg, title=TITLE.format(date=time.strftime("%Y-%m-%d")))
     print(f"wrote {path} and {svg} ({time.time() - t_start:.1f} s)")
 
 

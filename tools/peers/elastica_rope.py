@@ -119,3 +119,77 @@ def cantilever(elements):
     oracle = O.cantilever_tip(free, p)
     return dict(ok=bool(np.all(np.isfinite(d))), error=(tip - oracle) / oracle, wall_s=wall,
                 sim_s=steps * dt, dt=dt)
+
+
+def capstan_slides(elements, mu, dt=5e-5, radius=2e-3, k_contact=1e4, nu=10.0, c_v=50.0,
+                   load_damping=20.0, load=None, hold=None):
+    """The heavy rope over a fixed rigid cylinder (axis y) with
+    `RodCylinderContact` (spring k, dashpot nu, Coulomb friction mu
+    regularised by the slip-velocity coefficient c_v), EA = 1000 as yarnsim's
+    capstan, B = 1e-6, g = 2. The rope starts on the surface (centreline at
+    R + r); its velocity is damped (rate `load_damping` 1/s) during the
+    0.2 s load, then it holds 1 s undamped: slid if a free end moved
+    vertically by more than 0.5 % of its hanging length. Returns (slid,
+    wall seconds, simulated seconds)."""
+    from elastica import Contact, Cylinder, RodCylinderContact
+
+    class Sim(BaseSystemCollection, Constraints, Forcing, Contact):
+        pass
+
+    c = O.CAPSTAN
+    R, l1, l2, g = c["radius"], c["l1"], c["l2"], c["g"]
+    Rc = R + radius
+    total = l1 + l2 + math.pi * Rc
+    pts = []
+    for i in range(elements + 1):
+        s = total * i / elements
+        if s <= l1:
+            pts.append((-Rc, -l1 + s))
+        elif s <= l1 + math.pi * Rc:
+            psi = math.pi - (s - l1) / Rc
+            pts.append((Rc * math.cos(psi), Rc * math.sin(psi)))
+        else:
+            pts.append((Rc, -(s - l1 - math.pi * Rc)))
+    pos = np.array([[x for x, _ in pts], [0.0] * (elements + 1), [z for _, z in pts]])
+    area = math.pi * radius ** 2
+    sim = Sim()
+    rod = CosseratRod.straight_rod(
+        elements, pos[:, 0], np.array([0.0, 0.0, 1.0]), np.array([0.0, 1.0, 0.0]), total,
+        radius, 1.0 / area, youngs_modulus=1000.0 / area, position=pos,
+        directors=_directors(pos))
+    rod.bend_matrix[0, 0, :] = 1e-6
+    rod.bend_matrix[1, 1, :] = 1e-6
+    rod.rest_lengths[:] = np.linalg.norm(np.diff(pos, axis=1), axis=0)
+    cyl = Cylinder(np.array([0.0, -0.05, 0.0]), np.array([0.0, 1.0, 0.0]),
+                   np.array([1.0, 0.0, 0.0]), 0.1, R, 1e3)
+    sim.append(rod)
+    sim.append(cyl)
+    sim.add_forcing_to(rod).using(GravityForces, acc_gravity=np.array([0.0, 0.0, -g]))
+    sim.detect_contact_between(rod, cyl).using(
+        RodCylinderContact, k=k_contact, nu=nu, velocity_damping_coefficient=c_v,
+        friction_coefficient=mu)
+    sim.finalize()
+    stepper = PositionVerlet()
+    t = np.float64(0.0)
+    n_load = int(round((c["load"] if load is None else load) / dt))
+    n_hold = int(round((c["hold"] if hold is None else hold) / dt))
+    decay = math.exp(-load_damping * dt)
+    t0 = time.perf_counter()
+    for _ in range(n_load):
+        t = stepper.step(sim, t, dt)
+        rod.velocity_collection *= decay
+        cyl.velocity_collection[:] = 0.0
+        cyl.omega_collection[:] = 0.0
+    a0, b0 = rod.position_collection[2, 0], rod.position_collection[2, -1]
+    slid = False
+    for k in range(n_hold):
+        t = stepper.step(sim, t, dt)
+        cyl.velocity_collection[:] = 0.0
+        cyl.omega_collection[:] = 0.0
+        if k % 50 == 49:
+            rel = max(abs(rod.position_collection[2, 0] - a0) / l1,
+                      abs(rod.position_collection[2, -1] - b0) / l2)
+            if not np.isfinite(rel) or rel > c["slip"]:
+                slid = True
+                break
+    return slid, time.perf_counter() - t0, float(t)

@@ -16,7 +16,7 @@ def work_precision(rows, path, title):
     pts = [r for r in rows if r["ok"] and r["case"] in DASH
            and math.isfinite(r["error"]) and r["error"] != 0
            and math.isfinite(r["wall_s_per_sim_s"]) and r["wall_s_per_sim_s"] > 0]
-    W, H, ml, mr, mt, mb = 760, 520, 80, 230, 40, 60
+    W, H, ml, mr, mt, mb = 900, 520, 80, 300, 40, 60
     if not pts:
         open(path, "w").write(f'<svg xmlns="http://www.w3.org/2000/svg" width="{W}" '
                               f'height="{H}"><text x="20" y="40">no data</text></svg>\n')
