@@ -895,7 +895,7 @@ pub fn write_model_description(d: &Description) -> String {
 #[derive(Clone, Debug, PartialEq)]
 pub enum FmuScene {
     Yarn(YarnScene),
-    MassSpring(yarnsim::massspring::Layout),
+    MassSpring(yarnsim::massspring::MassSpringScene),
 }
 
 impl From<Scene> for FmuScene {

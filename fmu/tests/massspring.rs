@@ -11,7 +11,7 @@ use std::ffi::{c_char, CString};
 
 use common::*;
 use yarnsim::massspring::scenes::{cloth, wire};
-use yarnsim::massspring::{Integrator, IntegratorOptions, Layout, Simulation, V3};
+use yarnsim::massspring::{Integrator, IntegratorOptions, MassSpringScene, Simulation, V3};
 use YarnBundle::ffi::*;
 use YarnBundle::massspring::*;
 use YarnBundle::model::FmuScene;
@@ -400,7 +400,7 @@ fn model_description_of_the_wire() {
         "modelDescription/MassSpring-wire.xml drifted from the generator; refresh it with\n  cargo run --release -p yarnsim-fmu-pack --bin build-fmu -- --scene wire --model-description modelDescription/MassSpring-wire.xml"
     );
     // The GUID follows the layout.
-    let mut other: Layout = layout.clone();
+    let mut other: MassSpringScene = layout.clone();
     other.gravity[1] = -9.8;
     assert_ne!(guid(&other), guid(&layout));
 }
