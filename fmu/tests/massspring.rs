@@ -12,9 +12,10 @@ use std::ffi::{c_char, CString};
 use common::*;
 use yarnsim::massspring::scenes::{cloth, wire};
 use yarnsim::massspring::{Integrator, IntegratorOptions, MassSpringScene, Simulation, V3};
+use yarnsim::scene::Scene;
 use YarnBundle::ffi::*;
 use YarnBundle::massspring::*;
-use YarnBundle::model::FmuScene;
+use YarnBundle::SceneFmu;
 
 /// The wire's frame time, used as the communication step.
 const H: f64 = 0.05;
@@ -375,7 +376,7 @@ fn wire_with_switching_gravity_trajectory() {
 fn model_description_of_the_wire() {
     let layout = wire();
     let vars = variables(&layout).unwrap();
-    let scene = FmuScene::MassSpring(layout.clone());
+    let scene = Scene::MassSpring(layout.clone());
     let xml = scene.model_description().unwrap();
     assert!(xml.contains("modelIdentifier=\"MassSpring\""));
     assert!(xml.contains(&format!("guid=\"{}\"", guid(&layout))));

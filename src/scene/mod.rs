@@ -95,6 +95,18 @@ impl Scene {
     }
 }
 
+impl From<YarnScene> for Scene {
+    fn from(s: YarnScene) -> Self {
+        Scene::Yarn(s)
+    }
+}
+
+impl From<MassSpringScene> for Scene {
+    fn from(s: MassSpringScene) -> Self {
+        Scene::MassSpring(s)
+    }
+}
+
 /// The top-level `kind` string of a scene file, if any.
 fn toml_kind(text: &str) -> Result<Option<String>, SceneError> {
     let value: toml::Table = toml::from_str(text).map_err(|e| error::from_toml_error(text, e))?;
