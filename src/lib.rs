@@ -4,7 +4,8 @@
 //! Method (Jiang, Gast, Teran 2017), and mass-spring wires and cloth.
 //!
 //! * [`math`]: 2x2 QR, B-spline weights.
-//! * [`scene`]: scene descriptions ("layouts") and their TOML files.
+//! * [`scene`]: scene descriptions and their TOML files (the bottom layer:
+//!   the models import it).
 //! * [`mpm`]: the yarn-bundle MPM solver.
 //! * [`massspring`]: mass-spring wires and cloth (seeds 002, 004, 001).
 //! * [`pool`]: running a call's parallel passes on a rayon worker.
@@ -16,4 +17,4 @@ pub mod pool;
 pub mod scene;
 
 pub use mpm::{SimError, YarnSim};
-pub use scene::{Scene, SceneError, YarnScene};
+pub use scene::{MassSpringScene, Scene, SceneError, YarnScene};

@@ -2,7 +2,7 @@
 //! free fall against each scheme's own analytic trajectory.
 
 use yarnsim::massspring::{
-    scenes, Integrator, IntegratorOptions, Layout, Simulation, StrainSolver, V3,
+    scenes, Integrator, IntegratorOptions, MassSpringScene, Simulation, StrainSolver, V3,
 };
 
 /// Options under which every integrator runs the cloth (forward Euler has
@@ -155,7 +155,7 @@ fn free_fall_drop(integ: Integrator, n: usize, h: f64, g: f64, d: f64) -> f64 {
 
 #[test]
 fn free_fall_matches_each_schemes_analytic_trajectory() {
-    let mut layout: Layout = scenes::cloth();
+    let mut layout: MassSpringScene = scenes::cloth();
     layout.pinned.clear();
     layout.spheres.clear();
     let sys = layout.build().unwrap();

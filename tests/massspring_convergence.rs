@@ -3,11 +3,11 @@
 //! schemes (forward, symplectic, backward, and backward Euler's
 //! minimisation form), 2 for the trapezoidal rule.
 
-use yarnsim::massspring::{scenes, Integrator, IntegratorOptions, Layout, Simulation, V3};
+use yarnsim::massspring::{scenes, Integrator, IntegratorOptions, MassSpringScene, Simulation, V3};
 
 /// Seed 004's three particles with damped springs (so the damping force
 /// and its Jacobian take part), in free flight under gravity.
-fn damped_three_particle() -> Layout {
+fn damped_three_particle() -> MassSpringScene {
     let mut l = scenes::three_particle();
     for s in &mut l.springs {
         s.damping = 2.0;
@@ -16,7 +16,7 @@ fn damped_three_particle() -> Layout {
 }
 
 /// Positions and velocities at `t_end` with step `h`.
-fn end_state(layout: &Layout, integ: Integrator, h: f64, t_end: f64) -> Vec<f64> {
+fn end_state(layout: &MassSpringScene, integ: Integrator, h: f64, t_end: f64) -> Vec<f64> {
     let mut o = IntegratorOptions {
         dt: Some(h),
         cg_tolerance: 1e-14,
@@ -48,7 +48,7 @@ fn distance(a: &[f64], b: &[f64]) -> f64 {
 }
 
 /// Observed order from the step sizes `h, h/2, h/4`.
-fn observed_order(layout: &Layout, integ: Integrator, h: f64, t_end: f64) -> f64 {
+fn observed_order(layout: &MassSpringScene, integ: Integrator, h: f64, t_end: f64) -> f64 {
     let a = end_state(layout, integ, h, t_end);
     let b = end_state(layout, integ, h / 2.0, t_end);
     let c = end_state(layout, integ, h / 4.0, t_end);

@@ -2,12 +2,12 @@
 //! rest, the single oscillator's amplification and period per step, and
 //! forward Euler's computed CFL bound.
 
-use yarnsim::massspring::{scenes, Integrator, IntegratorOptions, Layout, Simulation, V3};
+use yarnsim::massspring::{scenes, Integrator, IntegratorOptions, MassSpringScene, Simulation, V3};
 
 const G: f64 = 9.81;
 
 /// Seed 002's wire with the top particle pinned instead of driven.
-fn hanging_wire() -> Layout {
+fn hanging_wire() -> MassSpringScene {
     let mut l = scenes::wire();
     l.driven.clear();
     l.pinned = vec![0];
@@ -81,7 +81,7 @@ fn hanging_chain_rests_at_the_analytic_lengths_for_every_stable_integrator() {
 
 /// One particle of mass `m` on a spring `k` to a pinned particle, moving along
 /// the spring only; no gravity, no damping.
-fn oscillator(k: f64, m: f64, q0: f64, v0: f64) -> Layout {
+fn oscillator(k: f64, m: f64, q0: f64, v0: f64) -> MassSpringScene {
     let text = format!(
         r#"
 kind = "mass-spring"
@@ -105,7 +105,7 @@ rest_length = 1.0
         y = -(1.0 + q0),
         vy = -v0
     );
-    Layout::from_toml_str(&text).unwrap()
+    MassSpringScene::from_toml_str(&text).unwrap()
 }
 
 /// The observed one-step map of `(q, v)` for the oscillator.

@@ -5,7 +5,7 @@
 use std::path::PathBuf;
 
 use yarnsim::massspring::{
-    scenes, Integrator, IntegratorOptions, Layout, MassSpringError, Simulation,
+    scenes, Integrator, IntegratorOptions, MassSpringError, MassSpringScene, Simulation,
 };
 use yarnsim::scene::{builtin, Scene, SceneError};
 
@@ -119,7 +119,10 @@ fn shipped_scene_files_load_and_equal_the_builtins() {
         let Scene::MassSpring(l) = from_file else {
             panic!("{name} is not a mass-spring scene")
         };
-        assert_eq!(Layout::from_toml_str(&l.to_toml_string()).unwrap(), l);
+        assert_eq!(
+            MassSpringScene::from_toml_str(&l.to_toml_string()).unwrap(),
+            l
+        );
     }
 }
 

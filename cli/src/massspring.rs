@@ -2,7 +2,9 @@
 //! integrator, a fixed-step wrapper for the frame loop, and the diagnostics
 //! the summary table, CSV and recording show.
 
-use yarnsim::massspring::{Integrator, IntegratorOptions, Layout, MassSpringError, Simulation, V3};
+use yarnsim::massspring::{
+    Integrator, IntegratorOptions, MassSpringError, MassSpringScene, Simulation, V3,
+};
 
 use crate::driver::Stepper;
 use crate::error::CliError;
@@ -117,7 +119,7 @@ impl MassSpringRun {
     /// Refuses an explicit integrator whose `--option dt` lies above its
     /// stability bound (unless `args.allow_unstable`), and says on stderr
     /// when the step actually taken differs from the `dt` asked for.
-    pub fn new(layout: &Layout, args: &IntegratorArgs) -> Result<Self, CliError> {
+    pub fn new(layout: &MassSpringScene, args: &IntegratorArgs) -> Result<Self, CliError> {
         let (integrator, options) = args.parse()?;
         let asked_dt = options.dt;
         let sim = Simulation::new(layout, integrator, options).map_err(ms_error)?;

@@ -8,8 +8,10 @@
 
 use std::fmt::Write as _;
 
+use yarnsim::scene::Scene;
 pub use YarnBundle::ffi::FMI2_FUNCTIONS;
-use YarnBundle::model::{xml_escape, FmuScene, SCENE_FILE};
+use YarnBundle::model::{xml_escape, SCENE_FILE};
+use YarnBundle::SceneFmu;
 
 /// CRC-32 (IEEE 802.3, reflected, as zip uses it).
 pub fn crc32(data: &[u8]) -> u32 {
@@ -143,11 +145,11 @@ pub fn zip_entries(zip: &[u8]) -> Result<Vec<(String, Vec<u8>)>, String> {
 }
 
 /// `documentation/index.html`: the variables of this FMU.
-pub fn documentation_html(scene: &FmuScene) -> Result<String, String> {
+pub fn documentation_html(scene: &Scene) -> Result<String, String> {
     let d = scene.description()?;
     let ident = d.identifier;
     let (what, details) = match scene {
-        FmuScene::Yarn(s) => (
+        Scene::Yarn(s) => (
             "an MPM yarn bundle",
             format!(
                 "{}, substep {}, grid {}<sup>2</sup>",
@@ -156,7 +158,7 @@ pub fn documentation_html(scene: &FmuScene) -> Result<String, String> {
                 s.grid.resolution
             ),
         ),
-        FmuScene::MassSpring(l) => (
+        Scene::MassSpring(l) => (
             "a mass-spring system",
             format!(
                 "{}, frame time {} s, default integrator {}",
@@ -199,7 +201,7 @@ pub fn documentation_html(scene: &FmuScene) -> Result<String, String> {
 
 /// The complete `.fmu` archive for `scene` around the shared library `so`
 /// (packed as `binaries/linux64/<modelIdentifier>.so`).
-pub fn build_fmu(scene: &FmuScene, so: &[u8]) -> Result<Vec<u8>, String> {
+pub fn build_fmu(scene: &Scene, so: &[u8]) -> Result<Vec<u8>, String> {
     let mut z = Zip::default();
     z.add(
         "modelDescription.xml",

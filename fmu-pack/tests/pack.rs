@@ -5,9 +5,10 @@
 use std::path::PathBuf;
 
 use yarnsim::massspring::scenes::wire;
-use yarnsim::scene::YarnScene;
+use yarnsim::scene::{Scene, YarnScene};
 use yarnsim_fmu_pack::*;
 use YarnBundle::model::*;
+use YarnBundle::SceneFmu;
 
 /// The FMU library cargo built as this crate's dependency:
 /// `deps/libYarnBundle.so` next to the test executable (or one folder up).
@@ -95,7 +96,7 @@ fn crc32_known_value() {
 
 #[test]
 fn mass_spring_archive_layout() {
-    let scene = FmuScene::MassSpring(wire());
+    let scene = Scene::MassSpring(wire());
     let so = b"\x7fELF not really".to_vec();
     let zip = build_fmu(&scene, &so).unwrap();
     let entries = zip_entries(&zip).unwrap();
@@ -109,7 +110,8 @@ fn mass_spring_archive_layout() {
             "documentation/index.html"
         ]
     );
-    let packed = FmuScene::from_toml_str(std::str::from_utf8(&entries[2].1).unwrap()).unwrap();
+    let packed =
+        YarnBundle::scene_from_toml_str(std::str::from_utf8(&entries[2].1).unwrap()).unwrap();
     assert_eq!(packed.guid(), scene.guid());
     let doc = String::from_utf8(entries[3].1.clone()).unwrap();
     assert!(doc.contains("particle[10].x") && doc.contains("mass-spring"));

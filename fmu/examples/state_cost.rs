@@ -21,7 +21,7 @@ use std::hint::black_box;
 use std::sync::atomic::{AtomicUsize, Ordering::Relaxed};
 use std::time::Instant;
 
-use yarnsim::scene::DEFAULT_SCENE;
+use yarnsim::scene::{Scene, DEFAULT_SCENE};
 use YarnBundle::ffi::*;
 use YarnBundle::model::*;
 
@@ -86,8 +86,8 @@ fn main() {
         let c = instantiate();
         let mut dt = 0.0;
         let vr_dt = match scene {
-            FmuScene::Yarn(_) => VR_DT,
-            FmuScene::MassSpring(_) => YarnBundle::massspring::VR_DT,
+            Scene::Yarn(_) => VR_DT,
+            Scene::MassSpring(_) => YarnBundle::massspring::VR_DT,
         };
         assert_eq!(fmi2GetReal(c, &vr_dt, 1, &mut dt), fmi2OK);
         // MassSpring's dt = 0 means the integrator's own step.

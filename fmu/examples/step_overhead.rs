@@ -28,6 +28,7 @@ use std::time::Instant;
 
 use yarnsim::massspring::Simulation;
 use yarnsim::mpm::YarnSim;
+use yarnsim::scene::Scene;
 use YarnBundle::ffi::*;
 use YarnBundle::fmu_model::FmuModel;
 use YarnBundle::massspring::{self as ms, MsModel};
@@ -65,10 +66,8 @@ fn main() {
     let fx = common::Fixture::new(&scene_arg, "bench");
     let scene = &fx.scene;
     let new_library = || match scene {
-        FmuScene::Yarn(s) => Library::Yarn(Box::new(YarnSim::new(s).unwrap())),
-        FmuScene::MassSpring(l) => {
-            Library::MassSpring(Box::new(MsModel::new(l.clone()).unwrap().sim))
-        }
+        Scene::Yarn(s) => Library::Yarn(Box::new(YarnSim::new(s).unwrap())),
+        Scene::MassSpring(l) => Library::MassSpring(Box::new(MsModel::new(l.clone()).unwrap().sim)),
     };
     let dt = match new_library() {
         Library::Yarn(sim) => sim.dt(),
@@ -76,11 +75,11 @@ fn main() {
     };
     // Inputs to set and outputs to get in part 2, and the input values.
     let (in_vr, out_vr): (Vec<u32>, Vec<u32>) = match scene {
-        FmuScene::Yarn(_) => (
+        Scene::Yarn(_) => (
             vec![VR_ATTRACTOR_X, VR_ATTRACTOR_Y, VR_GRAVITY_X, VR_GRAVITY_Y],
             (VR_YARN_BASE..VR_YARN_BASE + 4).collect(),
         ),
-        FmuScene::MassSpring(l) => {
+        Scene::MassSpring(l) => {
             let last = ms::num_particles(l).unwrap() as u32 - 1;
             let first = ms::VR_PARTICLE_BASE + 3 * last;
             (
@@ -92,8 +91,8 @@ fn main() {
     let inputs = |k: usize| -> Vec<f64> {
         let wobble = 1e-3 * (k & 7) as f64;
         match scene {
-            FmuScene::Yarn(_) => vec![0.5, 0.5 + wobble, 0.0, -9.8],
-            FmuScene::MassSpring(_) => vec![0.0, -9.81 + wobble, 0.0],
+            Scene::Yarn(_) => vec![0.5, 0.5 + wobble, 0.0, -9.8],
+            Scene::MassSpring(_) => vec![0.0, -9.81 + wobble, 0.0],
         }
     };
     let ports = in_vr.len();
@@ -179,7 +178,7 @@ fn main() {
         // substep) and the clone of the last good state.
         let reps = 200.min(calls).max(1);
         let (check_s, clone_s) = match scene {
-            FmuScene::Yarn(s) => {
+            Scene::Yarn(s) => {
                 let mut m = YarnBundle::yarn::YarnModel::new(s.clone()).unwrap();
                 for _ in 0..20 {
                     m.substep().unwrap();
@@ -197,7 +196,7 @@ fn main() {
                 }
                 (check, t0.elapsed().as_secs_f64() / reps as f64)
             }
-            FmuScene::MassSpring(l) => {
+            Scene::MassSpring(l) => {
                 let mut m = MsModel::new(l.clone()).unwrap();
                 for k in 0..20 {
                     m.substep(k).unwrap();

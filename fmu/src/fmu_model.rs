@@ -11,10 +11,9 @@ use std::any::Any;
 use std::fmt;
 use std::path::Path;
 
-use crate::massspring::MsModel;
-use crate::model::FmuScene;
+use yarnsim::scene::Scene;
+
 use crate::state_bytes::{Reader, Writer};
-use crate::yarn::YarnModel;
 
 /// A model refused a call: a value out of range, an unknown variable, a
 /// scene or parameter set it cannot build. The front end answers fmi2Error
@@ -55,7 +54,7 @@ pub struct SetContext<'a> {
     /// The FMU's `resources/` folder (relative scene paths).
     pub resources: &'a Path,
     /// The scene bundled in `resources/`.
-    pub bundled: &'a FmuScene,
+    pub bundled: &'a Scene,
 }
 
 /// The state a failed communication step goes back to
@@ -163,12 +162,4 @@ impl Clone for Box<dyn FmuModel> {
     fn clone(&self) -> Self {
         self.box_clone()
     }
-}
-
-/// The model an FMU's bundled scene makes.
-pub fn new_model(scene: &FmuScene) -> ModelResult<Box<dyn FmuModel>> {
-    Ok(match scene {
-        FmuScene::Yarn(s) => Box::new(YarnModel::new(s.clone())?),
-        FmuScene::MassSpring(l) => Box::new(MsModel::new(l.clone())?),
-    })
 }

@@ -9,17 +9,22 @@
 use std::ffi::{c_int, c_void, CString};
 use std::path::PathBuf;
 
+use yarnsim::scene::Scene;
+
+pub use crate::clock::Clock;
 pub use crate::fmu_model::{
-    new_model, FmuModel, ModelError, ModelResult, ModelState, ParamCheck, SetContext, StepFailure,
+    FmuModel, ModelError, ModelResult, ModelState, ParamCheck, SetContext, StepFailure,
 };
 pub use crate::logging::*;
+pub use crate::models::{new_model, SceneFmu};
 use crate::resources::read_scene;
 pub use crate::resources::resource_path;
+pub use crate::snapshot::*;
 pub use crate::state_bytes::*;
 pub use crate::state_machine::{error, parameter_settable, phase_name, Fail, Phase, Res, Status};
 
 use crate::model::{
-    FmuScene, DEFAULT_MAX_SUBSTEPS, DEFAULT_THREADS, LOG_CATEGORIES, MAX_THREADS, SCENE_FILE,
+    DEFAULT_MAX_SUBSTEPS, DEFAULT_THREADS, LOG_CATEGORIES, MAX_THREADS, SCENE_FILE,
     VR_MAX_SUBSTEPS, VR_SUBSTEPS, VR_THREADS,
 };
 
@@ -36,36 +41,6 @@ pub struct Model {
     pub outputs_checked: bool,
 }
 
-/// The wrapper's time keeping and flags, as an FMU state holds them.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Clock {
-    /// The simulation must be rebuilt from the scene and the parameters
-    /// before use (a parameter changed).
-    pub dirty: bool,
-    pub start_time: f64,
-    pub stop_time: Option<f64>,
-    /// Current communication point.
-    pub time: f64,
-    pub last_successful_time: f64,
-    /// Substeps taken since initialization.
-    pub substeps: u64,
-    /// Set when a step diverged (`fmi2Terminated` status).
-    pub terminated: bool,
-}
-
-impl Clock {
-    /// At time 0, nothing run.
-    const START: Clock = Clock {
-        dirty: false,
-        start_time: 0.0,
-        stop_time: None,
-        time: 0.0,
-        last_successful_time: 0.0,
-        substeps: 0,
-        terminated: false,
-    };
-}
-
 impl Model {
     /// The time keeping and flags of an FMU state.
     pub fn clock(&self) -> Clock {
@@ -77,7 +52,7 @@ impl Model {
         self.outputs_checked = false;
     }
 
-    fn new(scene: &FmuScene) -> Res<Self> {
+    fn new(scene: &Scene) -> Res<Self> {
         Ok(Model {
             physics: new_model(scene)?,
             clock: Clock::START,
@@ -124,7 +99,7 @@ pub struct Instance {
     categories: [bool; LOG_CATEGORIES.len()],
     pub resources: PathBuf,
     /// The scene bundled in `resources/`.
-    bundled: FmuScene,
+    bundled: Scene,
     /// Yarns or particles: the objects the outputs describe.
     count: usize,
     pub phase: Phase,

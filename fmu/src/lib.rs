@@ -7,7 +7,7 @@
 //! yarn bundle (`YarnBundle`), a mass-spring layout (`wire`, `cloth`, ...) the
 //! mass-spring system (`MassSpring`). The scene fixes the outputs (yarns or
 //! particles), so `modelDescription.xml` is generated from it
-//! ([`model::FmuScene::model_description`]) by the `build-fmu` packager (crate
+//! ([`SceneFmu::model_description`] on [`yarnsim::scene::Scene`]) by the `build-fmu` packager (crate
 //! `yarnsim-fmu-pack` in `fmu-pack/`, so this library does not carry the zip
 //! writer and the ELF reader).
 //!
@@ -34,15 +34,19 @@
 // lints `unsafe_op_in_unsafe_fn` and `clippy::undocumented_unsafe_blocks`
 // (Cargo.toml) deny anything else.
 
+pub mod clock;
 pub mod ffi;
 pub mod fmu_model;
 pub mod instance;
 pub mod logging;
 pub mod massspring;
 pub mod model;
+pub mod models;
 pub mod resources;
+pub mod snapshot;
 pub mod state_bytes;
 pub mod state_machine;
 pub mod yarn;
 
-pub use model::{guid, model_description, FmuScene, MODEL_IDENTIFIER};
+pub use model::{guid, model_description, MODEL_IDENTIFIER};
+pub use models::{new_model, scene_from_toml_str, SceneFmu};

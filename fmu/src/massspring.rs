@@ -8,7 +8,7 @@
 //! and `integrator`; outputs the energies, the largest strain, the substep
 //! count and every particle's position `particle[i].x/y/z`.
 
-use yarnsim::massspring::{Integrator, IntegratorOptions, Layout, Simulation, V3};
+use yarnsim::massspring::{Integrator, IntegratorOptions, MassSpringScene, Simulation, V3};
 
 use crate::fmu_model::{
     refuse, Checkpoint, FmuModel, ModelResult, ModelState, ParamCheck, SetContext, StepFailure,
@@ -43,7 +43,7 @@ pub use crate::model::VR_SUBSTEPS;
 pub const VR_PARTICLE_BASE: u32 = 1000;
 
 /// Number of particles the layout creates (fixes the outputs).
-pub fn num_particles(layout: &Layout) -> Result<usize, String> {
+pub fn num_particles(layout: &MassSpringScene) -> Result<usize, String> {
     layout
         .build()
         .map(|s| s.len())
@@ -53,7 +53,7 @@ pub fn num_particles(layout: &Layout) -> Result<usize, String> {
 /// The MassSpring's variables before the ones every model has
 /// ([`crate::model::COMMON_VARIABLES`]) and the per-particle outputs, in
 /// `ModelVariables` order; start values come from the layout.
-pub static MASS_SPRING_VARIABLES: [VarSpec<Layout>; 10] = [
+pub static MASS_SPRING_VARIABLES: [VarSpec<MassSpringScene>; 10] = [
     input("gravity.x", VR_GRAVITY_X, VarType::Real, Some("m/s2"), Start::Real(|l| l.gravity[0]), "Gravity x, |g| at most 1e6"),
     input("gravity.y", VR_GRAVITY_Y, VarType::Real, Some("m/s2"), Start::Real(|l| l.gravity[1]), "Gravity y, |g| at most 1e6"),
     input("gravity.z", VR_GRAVITY_Z, VarType::Real, Some("m/s2"), Start::Real(|l| l.gravity[2]), "Gravity z, |g| at most 1e6"),
@@ -71,7 +71,7 @@ const DEFAULT_INTEGRATOR_NAME: &str = "backward-euler";
 
 /// Every variable of the FMU for this layout, in `ModelVariables` order:
 /// [`MASS_SPRING_VARIABLES`], the common ones, then `particle[i].x/y/z`.
-pub fn variables(layout: &Layout) -> Result<Vec<Variable>, String> {
+pub fn variables(layout: &MassSpringScene) -> Result<Vec<Variable>, String> {
     let n = num_particles(layout)?;
     let mut v: Vec<Variable> = MASS_SPRING_VARIABLES
         .iter()
@@ -130,7 +130,7 @@ pub fn dependencies() -> Vec<crate::model::Dependency> {
 
 /// The GUID of the FMU for this layout: a hash of the interface version and
 /// the layout's normalized TOML text.
-pub fn guid(layout: &Layout) -> String {
+pub fn guid(layout: &MassSpringScene) -> String {
     crate::model::guid_of(&format!(
         "{MODEL_IDENTIFIER} fmi2 interface {INTERFACE_VERSION}\n{}",
         layout.to_toml_string()
@@ -138,7 +138,7 @@ pub fn guid(layout: &Layout) -> String {
 }
 
 /// What `modelDescription.xml` is written from.
-pub fn description(layout: &Layout) -> Result<Description, String> {
+pub fn description(layout: &MassSpringScene) -> Result<Description, String> {
     let what = if layout.description.is_empty() {
         format!("Mass-spring scene {}", layout.name)
     } else {
@@ -159,7 +159,7 @@ pub fn description(layout: &Layout) -> Result<Description, String> {
 #[derive(Clone, Debug)]
 pub struct MsModel {
     /// The bundled layout.
-    pub base: Layout,
+    pub base: MassSpringScene,
     /// The `dt` parameter (`None`: 0, the integrator's own step).
     pub dt: Option<f64>,
     pub integrator: Integrator,
@@ -168,7 +168,11 @@ pub struct MsModel {
     pub sim: Simulation,
 }
 
-fn build(base: &Layout, integrator: Integrator, dt: Option<f64>) -> ModelResult<Simulation> {
+fn build(
+    base: &MassSpringScene,
+    integrator: Integrator,
+    dt: Option<f64>,
+) -> ModelResult<Simulation> {
     let options = IntegratorOptions {
         dt,
         ..IntegratorOptions::default()
@@ -177,7 +181,7 @@ fn build(base: &Layout, integrator: Integrator, dt: Option<f64>) -> ModelResult<
 }
 
 impl MsModel {
-    pub fn new(base: Layout) -> ModelResult<Self> {
+    pub fn new(base: MassSpringScene) -> ModelResult<Self> {
         let sim = build(&base, DEFAULT_INTEGRATOR, None)?;
         Ok(MsModel {
             gravity: base.gravity,
@@ -382,7 +386,7 @@ impl MsModel {
         let base = if text == current.base.to_toml_string() {
             current.base.clone()
         } else {
-            Layout::from_toml_str(&text).map_err(|e| format!("stored scene: {e}"))?
+            MassSpringScene::from_toml_str(&text).map_err(|e| format!("stored scene: {e}"))?
         };
         let t = r.f64()?;
         let n = r.u64()?;

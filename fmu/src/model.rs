@@ -10,7 +10,7 @@
 use std::fmt::Write as _;
 
 use yarnsim::mpm::state::fnv1a;
-use yarnsim::scene::{PinMotionKind, Scene, StepSize, TransferScheme, YarnScene};
+use yarnsim::scene::{PinMotionKind, StepSize, TransferScheme, YarnScene};
 
 /// The FMI model identifier: the shared library's and the C symbols' name.
 pub const MODEL_IDENTIFIER: &str = "YarnBundle";
@@ -888,100 +888,4 @@ pub fn write_model_description(d: &Description) -> String {
     }
     x.push_str("    </InitialUnknowns>\n  </ModelStructure>\n</fmiModelDescription>\n");
     x
-}
-
-/// The scene an FMU runs, which decides its physics and modelIdentifier:
-/// a yarn scene gives `YarnBundle`, a mass-spring layout `MassSpring`.
-#[derive(Clone, Debug, PartialEq)]
-pub enum FmuScene {
-    Yarn(YarnScene),
-    MassSpring(yarnsim::massspring::Layout),
-}
-
-impl From<Scene> for FmuScene {
-    fn from(s: Scene) -> Self {
-        match s {
-            Scene::Yarn(y) => FmuScene::Yarn(y),
-            Scene::MassSpring(l) => FmuScene::MassSpring(l),
-        }
-    }
-}
-
-impl From<YarnScene> for FmuScene {
-    fn from(s: YarnScene) -> Self {
-        FmuScene::Yarn(s)
-    }
-}
-
-impl FmuScene {
-    /// Reads a scene file's text (either kind).
-    pub fn from_toml_str(text: &str) -> Result<FmuScene, String> {
-        Scene::from_toml_str(text)
-            .map(FmuScene::from)
-            .map_err(|e| e.to_string())
-    }
-
-    /// The scene file text packed as `resources/scene.toml`.
-    pub fn to_toml_string(&self) -> String {
-        match self {
-            FmuScene::Yarn(s) => s.to_toml_string(),
-            FmuScene::MassSpring(l) => l.to_toml_string(),
-        }
-    }
-
-    /// The FMI modelIdentifier: `YarnBundle` or `MassSpring`.
-    pub fn identifier(&self) -> &'static str {
-        match self {
-            FmuScene::Yarn(_) => MODEL_IDENTIFIER,
-            FmuScene::MassSpring(_) => crate::massspring::MODEL_IDENTIFIER,
-        }
-    }
-
-    /// The scene's name.
-    pub fn name(&self) -> &str {
-        match self {
-            FmuScene::Yarn(s) => &s.name,
-            FmuScene::MassSpring(l) => &l.name,
-        }
-    }
-
-    pub fn guid(&self) -> String {
-        match self {
-            FmuScene::Yarn(s) => guid(s),
-            FmuScene::MassSpring(l) => crate::massspring::guid(l),
-        }
-    }
-
-    /// What the model description is written from; an error for a layout
-    /// that does not build.
-    pub fn description(&self) -> Result<Description, String> {
-        match self {
-            FmuScene::Yarn(s) => check_value_references(s).map(|_| description(s)),
-            FmuScene::MassSpring(l) => crate::massspring::description(l),
-        }
-    }
-
-    pub fn model_description(&self) -> Result<String, String> {
-        self.description().map(|d| write_model_description(&d))
-    }
-
-    /// What the outputs describe: `"yarns"` or `"particles"`.
-    pub fn objects(&self) -> &'static str {
-        match self {
-            FmuScene::Yarn(_) => "yarns",
-            FmuScene::MassSpring(_) => "particles",
-        }
-    }
-
-    /// How many of them: `"12 yarns"`, `"441 particles"` (a mass-spring
-    /// layout is expanded to count them).
-    pub fn summary(&self) -> String {
-        match self {
-            FmuScene::Yarn(s) => format!("{} {}", num_yarns(s), self.objects()),
-            FmuScene::MassSpring(l) => match crate::massspring::num_particles(l) {
-                Ok(n) => format!("{n} {}", self.objects()),
-                Err(e) => e,
-            },
-        }
-    }
 }

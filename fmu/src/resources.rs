@@ -4,7 +4,9 @@
 
 use std::path::{Path, PathBuf};
 
-use crate::model::FmuScene;
+use yarnsim::scene::Scene;
+
+use crate::models::scene_from_toml_str;
 
 /// Turns a resource location URI (`file:///a/b`, `file:/a/b`,
 /// `file://localhost/a/b`, with `%xx` escapes) or a plain path into a path.
@@ -50,7 +52,7 @@ pub fn resource_path(uri: &str) -> Result<PathBuf, String> {
     Ok(PathBuf::from(std::ffi::OsString::from_vec(out)))
 }
 
-pub fn read_scene(path: &Path) -> Result<FmuScene, String> {
+pub fn read_scene(path: &Path) -> Result<Scene, String> {
     let text = crate::model::read_scene_text(path)?;
-    FmuScene::from_toml_str(&text).map_err(|e| format!("scene file {}: {e}", path.display()))
+    scene_from_toml_str(&text).map_err(|e| format!("scene file {}: {e}", path.display()))
 }

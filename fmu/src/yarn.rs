@@ -828,7 +828,7 @@ impl FmuModel for YarnModel {
         check: ParamCheck,
         ctx: &SetContext,
     ) -> ModelResult<bool> {
-        let crate::model::FmuScene::Yarn(bundled) = ctx.bundled else {
+        let yarnsim::scene::Scene::Yarn(bundled) = ctx.bundled else {
             return Err(ModelError("a yarn model with a mass-spring scene".into()));
         };
         YarnModel::set_string(self, vrs, vals, check, ctx.resources, bundled)

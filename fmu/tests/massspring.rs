@@ -11,10 +11,11 @@ use std::ffi::{c_char, CString};
 
 use common::*;
 use yarnsim::massspring::scenes::{cloth, wire};
-use yarnsim::massspring::{Integrator, IntegratorOptions, Layout, Simulation, V3};
+use yarnsim::massspring::{Integrator, IntegratorOptions, MassSpringScene, Simulation, V3};
+use yarnsim::scene::Scene;
 use YarnBundle::ffi::*;
 use YarnBundle::massspring::*;
-use YarnBundle::model::FmuScene;
+use YarnBundle::SceneFmu;
 
 /// The wire's frame time, used as the communication step.
 const H: f64 = 0.05;
@@ -399,7 +400,7 @@ fn wire_with_switching_gravity_trajectory() {
 fn model_description_of_the_wire() {
     let layout = wire();
     let vars = variables(&layout).unwrap();
-    let scene = FmuScene::MassSpring(layout.clone());
+    let scene = Scene::MassSpring(layout.clone());
     let xml = scene.model_description().unwrap();
     assert!(xml.contains("modelIdentifier=\"MassSpring\""));
     assert!(xml.contains(&format!("guid=\"{}\"", guid(&layout))));
@@ -424,7 +425,7 @@ fn model_description_of_the_wire() {
         "modelDescription/MassSpring-wire.xml drifted from the generator; refresh it with\n  cargo run --release -p yarnsim-fmu-pack --bin build-fmu -- --scene wire --model-description modelDescription/MassSpring-wire.xml"
     );
     // The GUID follows the layout.
-    let mut other: Layout = layout.clone();
+    let mut other: MassSpringScene = layout.clone();
     other.gravity[1] = -9.8;
     assert_ne!(guid(&other), guid(&layout));
 }

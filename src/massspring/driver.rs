@@ -9,10 +9,10 @@
 //!
 //! Step size: the option `dt` if given; else for the explicit schemes
 //! `cfl_number x` the stability bound of [`StabilityInfo`] (computed once
-//! from the initial configuration); for the trapezoidal rule the layout's
+//! from the initial configuration); for the trapezoidal rule the scene's
 //! `time_step` but at most `2 / w_max` (beyond that the linearised rule,
 //! which does not damp stiff modes, lets the undamped cloth blow up: at
-//! h = 1/30 s it does after about 35 frames); else the layout's `time_step`. A frame
+//! h = 1/30 s it does after about 35 frames); else the scene's `time_step`. A frame
 //! is split into equal steps no longer than that.
 
 use super::forces::{elastic_energy, gravity_energy, kinetic_energy, max_strain};
@@ -21,8 +21,8 @@ use super::integrators::stability::{analyze, StabilityInfo};
 use super::integrators::{
     chebyshev, explicit, implicit, pbd, Integrator, IntegratorOptions, State, StepStats,
 };
-use super::layout::{Layout, System, V3};
 use super::MassSpringError;
+use crate::scene::massspring::{MassSpringScene, System, V3};
 
 /// Energies of the current state in J.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -103,13 +103,13 @@ pub struct Simulation {
 }
 
 impl Simulation {
-    /// Builds a simulation of `layout` with `integrator`.
+    /// Builds a simulation of `scene` with `integrator`.
     pub fn new(
-        layout: &Layout,
+        scene: &MassSpringScene,
         integrator: Integrator,
         options: IntegratorOptions,
     ) -> Result<Simulation, MassSpringError> {
-        Simulation::from_system(layout.build()?, integrator, options)
+        Simulation::from_system(scene.build()?, integrator, options)
     }
 
     /// Builds a simulation of an already expanded system.
@@ -265,7 +265,7 @@ impl Simulation {
         })
     }
 
-    /// Runs the layout's `frames` frames from the current frame on.
+    /// Runs the scene's `frames` frames from the current frame on.
     pub fn run(&mut self) -> Result<(), MassSpringError> {
         while self.frame < self.system.frames {
             self.step_frame()?;
@@ -413,11 +413,11 @@ impl Simulation {
             totals: self.totals,
         }
     }
-    /// Frames of a full run (the layout's `time.frames`).
+    /// Frames of a full run (the scene's `time.frames`).
     pub fn frames(&self) -> u32 {
         self.system.frames
     }
-    /// Frame interval in s (the layout's `time.frame_time`).
+    /// Frame interval in s (the scene's `time.frame_time`).
     pub fn frame_time(&self) -> f64 {
         self.system.frame_time
     }

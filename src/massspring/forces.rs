@@ -12,7 +12,7 @@
 
 use nalgebra::Matrix3;
 
-use super::layout::{Spring, System, V3};
+use crate::scene::massspring::{Spring, System, V3};
 
 /// Unit direction and length of a spring, `None` when its ends coincide.
 #[inline]

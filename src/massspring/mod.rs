@@ -1,8 +1,10 @@
-//! Mass-spring wires and cloth (seeds 002, 004 and 001), with the scene
-//! ("layout") kept apart from the scene-independent integrators ("driver").
+//! Mass-spring wires and cloth (seeds 002, 004 and 001). The scene
+//! ([`MassSpringScene`], its expansion [`System`] and the built-in
+//! [`scenes`]) lives in [`crate::scene::massspring`]; this module holds the
+//! scene-independent forces, solvers and integrators ("driver").
 //!
-//! * [`layout`]: the scene as data (TOML), expanded to a [`System`].
-//! * [`scenes`]: the built-in `wire`, `three-particle` and `cloth`.
+//! * [`scenes`]: the built-in `wire`, `three-particle` and `cloth`
+//!   (re-exported from [`crate::scene::massspring::builtin`]).
 //! * [`forces`]: spring, damping and gravity forces, energies, Hessian blocks.
 //! * [`linear`]: sparse matrix, PCG with Jacobi / IC(0), dense direct solve.
 //! * [`integrators`]: forward / symplectic Euler, trapezoidal, backward Euler,
@@ -20,16 +22,15 @@
 pub mod driver;
 pub mod forces;
 pub mod integrators;
-pub mod layout;
 pub mod linear;
-pub mod scenes;
 
 use std::fmt;
 
+pub use crate::scene::massspring::builtin as scenes;
+pub use crate::scene::massspring::{MassSpringScene, System, V3};
 pub use driver::{Diagnostics, Energies, FrameReport, RunTotals, Simulation};
 pub use integrators::stability::StabilityInfo;
 pub use integrators::{Integrator, IntegratorOptions, State, StepStats, StrainSolver};
-pub use layout::{Layout, System, V3};
 pub use linear::PreconditionerKind;
 
 use crate::scene::SceneError;
@@ -37,7 +38,7 @@ use crate::scene::SceneError;
 /// Why a mass-spring simulation could not be built or advanced.
 #[derive(Debug, Clone, PartialEq)]
 pub enum MassSpringError {
-    /// The layout is invalid.
+    /// The scene is invalid.
     Scene(SceneError),
     /// The integrator makes no sense for this scene (or these options).
     Unsupported {

@@ -25,7 +25,7 @@ pub fn builtin_names() -> Vec<(&'static str, &'static str)> {
         ),
     ]
     .into_iter()
-    .chain(crate::massspring::scenes::names())
+    .chain(super::massspring::builtin::names())
     .collect()
 }
 
@@ -36,7 +36,7 @@ pub fn builtin(name: &str) -> Option<Scene> {
         "yarn-vertical" => Some(Scene::Yarn(yarn_vertical())),
         "yarn-drape" => Some(Scene::Yarn(yarn_drape())),
         "wire" | "three-particle" | "cloth" => {
-            crate::massspring::scenes::by_name(name).map(Scene::MassSpring)
+            super::massspring::builtin::by_name(name).map(Scene::MassSpring)
         }
         _ => None,
     }

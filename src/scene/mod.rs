@@ -1,16 +1,21 @@
-//! Scene descriptions ("layouts"): what exists in a simulation, as data.
+//! Scene descriptions: what exists in a simulation, as data. This is the
+//! bottom layer: the models (`crate::mpm`, `crate::massspring`) import it,
+//! it imports no model.
 //!
 //! A scene file is TOML; its `kind` field picks the model (`"yarn"` for the
-//! MPM yarn bundle). Built-in scenes are listed by [`builtin_names`].
+//! MPM yarn bundle, one of [`massspring::KINDS`] for a mass-spring scene).
+//! Built-in scenes are listed by [`builtin_names`].
 
 pub mod builtin;
 pub mod error;
+pub mod massspring;
 pub mod overlap;
 pub(crate) mod readers;
 pub mod yarn;
 
 pub use builtin::{builtin, builtin_names, DEFAULT_SCENE};
 pub use error::SceneError;
+pub use massspring::MassSpringScene;
 pub use yarn::{
     AttractorSpec, GridSpec, Material, Obstacle, PinMotionKind, PinSpec, StepSize, TimeSpec,
     TransferScheme, TransferSpec, WallMode, Walls, YarnEnd, YarnScene, YarnSpec, DEFAULT_SAFETY,
@@ -22,7 +27,7 @@ pub enum Scene {
     /// A 2D MPM yarn bundle.
     Yarn(YarnScene),
     /// A 3D mass-spring wire or cloth (kinds "mass-spring", "wire", "cloth", "three-particle").
-    MassSpring(crate::massspring::Layout),
+    MassSpring(MassSpringScene),
 }
 
 impl Scene {
@@ -31,8 +36,8 @@ impl Scene {
         let kind = toml_kind(text)?;
         match kind.as_deref() {
             None | Some("yarn") => YarnScene::from_toml_str(text).map(Scene::Yarn),
-            Some(k) if crate::massspring::layout::KINDS.contains(&k) => {
-                crate::massspring::Layout::from_toml_str(text).map(Scene::MassSpring)
+            Some(k) if massspring::KINDS.contains(&k) => {
+                MassSpringScene::from_toml_str(text).map(Scene::MassSpring)
             }
             Some(other) => Err(SceneError::Invalid {
                 field: "kind".into(),
@@ -42,9 +47,7 @@ impl Scene {
                     .map(|i| i + 1),
                 message: format!(
                     "unknown scene kind {other:?}; known kinds: \"yarn\", {}",
-                    crate::massspring::layout::KINDS
-                        .map(|k| format!("{k:?}"))
-                        .join(", ")
+                    massspring::KINDS.map(|k| format!("{k:?}")).join(", ")
                 ),
             }),
         }
@@ -89,6 +92,18 @@ impl Scene {
             Scene::Yarn(s) => &s.name,
             Scene::MassSpring(s) => &s.name,
         }
+    }
+}
+
+impl From<YarnScene> for Scene {
+    fn from(s: YarnScene) -> Self {
+        Scene::Yarn(s)
+    }
+}
+
+impl From<MassSpringScene> for Scene {
+    fn from(s: MassSpringScene) -> Self {
+        Scene::MassSpring(s)
     }
 }
 

@@ -5,9 +5,8 @@
 //! both objects and the distances that triggered them.
 
 use super::error::{table_line, SceneError};
+use super::massspring::{SphereSpec, V3};
 use super::yarn::YarnScene;
-use crate::massspring::layout::SphereSpec;
-use crate::massspring::V3;
 use crate::math::Vec2;
 
 /// Distance from `c` to the segment `a`-`b`.

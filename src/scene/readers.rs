@@ -1,5 +1,5 @@
-//! Validating field readers for `#[serde(deserialize_with = ...)]`, shared by
-//! every scene kind. A reader's error carries the value's span, so the TOML
+//! Validating field readers for `#[serde(deserialize_with = ...)]` and serde
+//! defaults, shared by every scene kind. A reader's error carries the value's span, so the TOML
 //! loader reports the line and the field of a bad value.
 
 use serde::de::Error as _;
@@ -73,4 +73,59 @@ pub(crate) fn bounded_u32<'de, D: Deserializer<'de>>(
             "must be an integer from {lo} to {hi}, got {v}"
         )))
     }
+}
+
+/// A finite number in the closed interval `[0, 1]`.
+pub(crate) fn unit_interval_closed<'de, D: Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
+    let v = finite(d)?;
+    if (0.0..=1.0).contains(&v) {
+        Ok(v)
+    } else {
+        Err(D::Error::custom(format!(
+            "must be between 0 and 1, got {v}"
+        )))
+    }
+}
+
+/// A finite number in the half-open interval `(0, 1]`: a fraction that may
+/// not be zero.
+pub(crate) fn unit_interval_open_low<'de, D: Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
+    let v = finite(d)?;
+    if v > 0.0 && v <= 1.0 {
+        Ok(v)
+    } else {
+        Err(D::Error::custom(format!("must be in (0, 1], got {v}")))
+    }
+}
+
+/// An optional field that, when present, is a finite `f64`.
+pub(crate) fn opt_finite<'de, D: Deserializer<'de>>(d: D) -> Result<Option<f64>, D::Error> {
+    finite(d).map(Some)
+}
+
+/// Two finite numbers (a 2D vector).
+pub(crate) fn finite2<'de, D: Deserializer<'de>>(d: D) -> Result<[f64; 2], D::Error> {
+    finite_array::<D, 2>(d)
+}
+
+/// Three finite numbers (a 3D vector).
+pub(crate) fn finite3<'de, D: Deserializer<'de>>(d: D) -> Result<[f64; 3], D::Error> {
+    finite_array::<D, 3>(d)
+}
+
+// ---- serde defaults shared by the scene kinds ------------------------------
+
+/// Default `1.0`.
+pub(crate) fn one() -> f64 {
+    1.0
+}
+
+/// Default `0.5`.
+pub(crate) fn half() -> f64 {
+    0.5
+}
+
+/// Default `true`.
+pub(crate) fn yes() -> bool {
+    true
 }

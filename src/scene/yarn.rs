@@ -52,7 +52,7 @@ pub struct TransferSpec {
     pub scheme: TransferScheme,
     /// FLIP ratio in `[0, 1]` for `"flip"` (default 1: pure FLIP, no
     /// per-transfer dissipation); `r < 1` blends in APIC's damping.
-    #[serde(default = "one", deserialize_with = "unit_interval")]
+    #[serde(default = "one", deserialize_with = "unit_interval_closed")]
     pub flip_ratio: f64,
 }
 
@@ -766,14 +766,8 @@ fn resample(poly: &[Vec2], n: usize) -> Result<Vec<Vec2>, String> {
 fn kind_yarn() -> String {
     "yarn".into()
 }
-fn one() -> f64 {
-    1.0
-}
 fn one_u32() -> u32 {
     1
-}
-fn yes() -> bool {
-    true
 }
 fn centre() -> [f64; 2] {
     [0.5, 0.5]
@@ -796,7 +790,10 @@ fn default_obstacle_friction() -> f64 {
 
 // ---- validating field readers (the error carries the value's span) --------
 
-use super::readers::{bounded_u32, finite_array, nonnegative, opt_positive, positive};
+use super::readers::{
+    bounded_u32, finite2, nonnegative, one, opt_finite, opt_positive, positive,
+    unit_interval_closed, yes,
+};
 use serde::de::Error as _;
 
 fn kind_is_yarn<'de, D: Deserializer<'de>>(d: D) -> Result<String, D::Error> {
@@ -806,25 +803,6 @@ fn kind_is_yarn<'de, D: Deserializer<'de>>(d: D) -> Result<String, D::Error> {
     } else {
         Err(D::Error::custom(format!(
             "kind must be \"yarn\" for a yarn scene, got {s:?}"
-        )))
-    }
-}
-
-fn finite2<'de, D: Deserializer<'de>>(d: D) -> Result<[f64; 2], D::Error> {
-    finite_array::<D, 2>(d)
-}
-
-fn opt_finite<'de, D: Deserializer<'de>>(d: D) -> Result<Option<f64>, D::Error> {
-    super::readers::finite(d).map(Some)
-}
-
-fn unit_interval<'de, D: Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
-    let v = super::readers::finite(d)?;
-    if (0.0..=1.0).contains(&v) {
-        Ok(v)
-    } else {
-        Err(D::Error::custom(format!(
-            "must be between 0 and 1, got {v}"
         )))
     }
 }

@@ -19,7 +19,7 @@ use std::process::ExitCode;
 
 use yarnsim::scene::{Scene, DEFAULT_SCENE};
 use yarnsim_fmu_pack::{build_fmu, check_library, zip_entries};
-use YarnBundle::{FmuScene, MODEL_IDENTIFIER};
+use YarnBundle::{SceneFmu, MODEL_IDENTIFIER};
 
 const USAGE: &str = "usage: build-fmu [--scene NAME_OR_FILE] [-o OUT.fmu] [--lib libYarnBundle.so | --no-build] [--model-description FILE]";
 
@@ -46,13 +46,13 @@ fn run() -> Result<(), String> {
         }
     }
     let name = scene_arg.as_deref().unwrap_or(DEFAULT_SCENE);
-    let scene = FmuScene::from(Scene::resolve(name).map_err(|e| e.to_string())?);
+    let scene = Scene::resolve(name).map_err(|e| e.to_string())?;
     // The scene must run as the FMU will run it.
     match &scene {
-        FmuScene::Yarn(s) => yarnsim::mpm::YarnSim::new(s)
+        Scene::Yarn(s) => yarnsim::mpm::YarnSim::new(s)
             .map(|_| ())
             .map_err(|e| e.to_string()),
-        FmuScene::MassSpring(l) => YarnBundle::massspring::MsModel::new(l.clone())
+        Scene::MassSpring(l) => YarnBundle::massspring::MsModel::new(l.clone())
             .map(|_| ())
             .map_err(|e| e.0),
     }

@@ -7,12 +7,13 @@ use std::path::PathBuf;
 use yarnsim::scene::Scene;
 use YarnBundle::ffi::*;
 use YarnBundle::model::*;
+use YarnBundle::SceneFmu;
 
 /// A scene in a resource directory of its own (under the system's temporary
 /// directory, named after `tag` and the process), with the strings and
 /// callbacks `fmi2Instantiate` takes.
 pub struct Fixture {
-    pub scene: FmuScene,
+    pub scene: Scene,
     pub dir: PathBuf,
     uri: CString,
     guid: CString,
@@ -23,7 +24,7 @@ pub struct Fixture {
 impl Fixture {
     /// The scene `scene_arg` (a built-in name or a file) written for the FMU.
     pub fn new(scene_arg: &str, tag: &str) -> Self {
-        let scene = FmuScene::from(Scene::resolve(scene_arg).unwrap());
+        let scene = Scene::resolve(scene_arg).unwrap();
         let dir = std::env::temp_dir().join(format!("yarnbundle-{tag}-{}", std::process::id()));
         std::fs::create_dir_all(&dir).unwrap();
         std::fs::write(dir.join(SCENE_FILE), scene.to_toml_string()).unwrap();

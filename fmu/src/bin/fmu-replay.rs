@@ -29,7 +29,7 @@
 use std::fmt::Write as _;
 use std::process::ExitCode;
 
-use yarnsim::massspring::{Integrator, IntegratorOptions, Layout, Simulation, V3};
+use yarnsim::massspring::{Integrator, IntegratorOptions, MassSpringScene, Simulation, V3};
 use yarnsim::math::Vec2;
 use yarnsim::mpm::{Attractor, YarnSim};
 use yarnsim::scene::{PinMotionKind, Scene, YarnScene};
@@ -218,7 +218,7 @@ fn replay_yarn(scene: &YarnScene, rows: &[Vec<f64>], h: f64, stop: f64) -> Resul
 }
 
 fn replay_mass_spring(
-    layout: &Layout,
+    layout: &MassSpringScene,
     integrator: Integrator,
     rows: &[Vec<f64>],
     h: f64,

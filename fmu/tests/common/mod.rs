@@ -111,7 +111,7 @@ impl Fmu {
     }
 
     /// Instantiates the mass-spring FMU for `layout`.
-    pub fn mass_spring(layout: &yarnsim::massspring::Layout) -> Fmu {
+    pub fn mass_spring(layout: &yarnsim::massspring::MassSpringScene) -> Fmu {
         let n = YarnBundle::massspring::num_particles(layout).unwrap();
         let guid = YarnBundle::massspring::guid(layout);
         Self::try_with(&layout.to_toml_string(), n, &guid, "test").expect("fmi2Instantiate failed")

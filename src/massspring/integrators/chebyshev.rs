@@ -17,7 +17,7 @@
 
 use super::{set_kinematics, State, StepStats};
 use crate::massspring::forces::{add_elastic_forces, unit_directions};
-use crate::massspring::layout::{System, V3};
+use crate::scene::massspring::{System, V3};
 
 /// The Chebyshev weight sequence for `iterations` iterations.
 pub fn chebyshev_weights(rho: f64, iterations: usize) -> Vec<f64> {

@@ -2,7 +2,7 @@
 
 use super::{set_kinematics, State, StepStats};
 use crate::massspring::forces::total_forces;
-use crate::massspring::layout::{System, V3};
+use crate::scene::massspring::{System, V3};
 
 /// Forward Euler: `x += h v; v += h f(x, v) / m` for the free particles,
 /// then the kinematic particles are placed at `t + h`.

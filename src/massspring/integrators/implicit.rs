@@ -27,9 +27,9 @@ use nalgebra::Matrix3;
 
 use super::{set_kinematics, IntegratorOptions, State, StepStats};
 use crate::massspring::forces::{add_block_product, damping_block, hessian_block, total_forces};
-use crate::massspring::layout::{System, V3};
 use crate::massspring::linear::{assemble_block_system, pcg, CsrMatrix, DofMap, Preconditioner};
 use crate::massspring::MassSpringError;
+use crate::scene::massspring::{System, V3};
 
 /// Which implicit scheme.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -118,7 +118,7 @@ pub fn step_system(sys: &System, s: &State, h: f64, scheme: Scheme) -> StepSyste
 fn damping_position_block(
     x: &[V3],
     v: &[V3],
-    sp: &crate::massspring::layout::Spring,
+    sp: &crate::scene::massspring::Spring,
 ) -> Matrix3<f64> {
     let dx = x[sp.b] - x[sp.a];
     let l = dx.norm();

@@ -20,8 +20,8 @@ pub mod stability;
 use std::fmt;
 use std::str::FromStr;
 
-use super::layout::{System, V3};
 use super::linear::PreconditionerKind;
+use crate::scene::massspring::{System, V3};
 pub use pbd::StrainSolver;
 
 /// Positions, velocities and time of a simulation.
@@ -164,9 +164,9 @@ impl FromStr for Integrator {
 /// them by name with [`IntegratorOptions::set`].
 #[derive(Clone, Debug, PartialEq)]
 pub struct IntegratorOptions {
-    /// Step size in s; overrides the layout's `time_step` and the CFL choice.
+    /// Step size in s; overrides the scene's `time_step` and the CFL choice.
     pub dt: Option<f64>,
-    /// Fraction of the stability bound for the explicit schemes (default: the layout's).
+    /// Fraction of the stability bound for the explicit schemes (default: the scene's).
     pub cfl_number: Option<f64>,
     /// CG preconditioner of the implicit schemes (default IC(0)).
     pub preconditioner: PreconditionerKind,
@@ -183,7 +183,7 @@ pub struct IntegratorOptions {
     pub rho: f64,
     /// Jacobi iterations per step of `chebyshev-jacobi` (default 32, seed 001).
     pub iterations: usize,
-    /// Strain limit; overrides the layout's `time.strain_limit`.
+    /// Strain limit; overrides the scene's `time.strain_limit`.
     pub strain_limit: Option<f64>,
     /// Passes of the strain-limiting projection (default 32, seed 001).
     pub strain_iterations: usize,

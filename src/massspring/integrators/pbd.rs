@@ -7,7 +7,7 @@ use std::str::FromStr;
 
 use super::{set_kinematics, State, StepStats};
 use crate::massspring::forces::max_strain;
-use crate::massspring::layout::{System, V3};
+use crate::scene::massspring::{System, V3};
 
 /// Weight of a vertex's own position in the Jacobi averaging (seed 001: 0.2).
 pub const SELF_WEIGHT: f64 = 0.2;

@@ -26,8 +26,8 @@
 use nalgebra::{DMatrix, SymmetricEigen};
 
 use crate::massspring::forces::unit_directions;
-use crate::massspring::layout::{Spring, System, V3};
 use crate::massspring::linear::DofMap;
+use crate::scene::massspring::{Spring, System, V3};
 
 /// Stability data of a system at a configuration.
 #[derive(Clone, Copy, Debug, PartialEq)]

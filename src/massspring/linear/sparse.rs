@@ -6,7 +6,7 @@
 
 use nalgebra::{DMatrix, Matrix3};
 
-use crate::massspring::layout::Spring;
+use crate::scene::massspring::Spring;
 
 /// A square sparse matrix in CSR form with sorted column indices.
 #[derive(Clone, Debug, PartialEq)]

@@ -1,7 +1,8 @@
 //! The built-in mass-spring scenes.
 
-use super::layout::{
-    ChainSpec, DrivenSpec, Layout, ParticleSpec, SheetSpec, SphereSpec, SpringSpec, TimeParams,
+use super::{
+    ChainSpec, DrivenSpec, MassSpringScene, ParticleSpec, SheetSpec, SphereSpec, SpringSpec,
+    TimeParams,
 };
 
 /// `(name, one-line description)` of each built-in mass-spring scene.
@@ -23,7 +24,7 @@ pub fn names() -> Vec<(&'static str, &'static str)> {
 }
 
 /// A built-in mass-spring scene by name.
-pub fn by_name(name: &str) -> Option<Layout> {
+pub fn by_name(name: &str) -> Option<MassSpringScene> {
     match name {
         "wire" => Some(wire()),
         "three-particle" => Some(three_particle()),
@@ -36,8 +37,8 @@ pub fn by_name(name: &str) -> Option<Layout> {
 /// mass 1, `youngs_modulus` 100 (k = 1000 N/m per spring), damping 100 N s/m,
 /// gravity 9.81, the top particle driven on the circle of radius 0.5 about the
 /// origin in the x-z plane with period 5 s (= 100 frames of 0.05 s).
-pub fn wire() -> Layout {
-    Layout {
+pub fn wire() -> MassSpringScene {
+    MassSpringScene {
         kind: "wire".into(),
         name: "wire".into(),
         description: "seed 002: 11-particle wire, top end driven on a circle".into(),
@@ -77,7 +78,7 @@ pub fn wire() -> Layout {
 /// Seed 004's three-particle system: masses 1, 2 and 1.5 kg, springs 0-1 and
 /// 1-2 (stiffness 50 N/m, both stretched), no constraints, so the whole 9x9
 /// system `A = M - h^2 K` is solved.
-pub fn three_particle() -> Layout {
+pub fn three_particle() -> MassSpringScene {
     let p = |position: [f64; 3], velocity: [f64; 3], mass: f64| ParticleSpec {
         position,
         velocity,
@@ -89,7 +90,7 @@ pub fn three_particle() -> Layout {
         damping: 0.0,
         rest_length: Some(rest),
     };
-    Layout {
+    MassSpringScene {
         kind: "three-particle".into(),
         name: "three-particle".into(),
         description: "seed 004: three particles, two springs, one backward-Euler solve per step"
@@ -123,8 +124,8 @@ pub fn three_particle() -> Layout {
 /// h = 1/30 s, velocity damping 0.99 per step, gravity 9.8, and a sphere of
 /// radius 2.7 centred at `(0, -3, 0)` (the seed moves it with the mouse; this
 /// position puts it in the path of the swinging sheet).
-pub fn cloth() -> Layout {
-    Layout {
+pub fn cloth() -> MassSpringScene {
+    MassSpringScene {
         kind: "cloth".into(),
         name: "cloth".into(),
         description: "seed 001: 21x21 sheet pinned at two corners falls onto a sphere".into(),
@@ -169,7 +170,7 @@ mod tests {
         for (name, _) in names() {
             let l = by_name(name).unwrap();
             l.validate().unwrap();
-            let back = Layout::from_toml_str(&l.to_toml_string()).unwrap();
+            let back = MassSpringScene::from_toml_str(&l.to_toml_string()).unwrap();
             assert_eq!(back, l, "{name}");
         }
     }
