@@ -6,6 +6,7 @@
 pub mod builtin;
 pub mod error;
 pub mod overlap;
+pub mod overrides;
 pub(crate) mod readers;
 pub mod yarn;
 
