@@ -49,6 +49,10 @@ enum Command {
         /// Built-in scene name or scene file.
         #[arg(default_value = DEFAULT_SCENE)]
         scene: String,
+        /// Override a scene field, KEY=VALUE with VALUE in TOML (repeatable):
+        /// --set material.friction=0.1 --set gravity=[0,-3] --set yarns.0.count=4.
+        #[arg(long = "set", value_name = "KEY=VALUE")]
+        set: Vec<String>,
         /// Simulated time, in seconds: 2, 2.5s or 250ms.
         #[arg(short, long, default_value = "1", value_parser = parse_duration, allow_negative_numbers = true)]
         duration: f64,
@@ -68,6 +72,10 @@ enum Command {
         /// Built-in scene name or scene file.
         #[arg(default_value = DEFAULT_SCENE)]
         scene: String,
+        /// Override a scene field, KEY=VALUE with VALUE in TOML (repeatable):
+        /// --set material.friction=0.1 --set gravity=[0,-3] --set yarns.0.count=4.
+        #[arg(long = "set", value_name = "KEY=VALUE")]
+        set: Vec<String>,
         /// Simulated time, in seconds: 2, 2.5s or 250ms.
         #[arg(short, long, default_value = "1", value_parser = parse_duration, allow_negative_numbers = true)]
         duration: f64,
@@ -120,6 +128,10 @@ enum Command {
         /// Built-in scene name or scene file.
         #[arg(default_value = DEFAULT_SCENE)]
         scene: String,
+        /// Override a scene field, KEY=VALUE with VALUE in TOML (repeatable):
+        /// --set material.friction=0.1 --set gravity=[0,-3] --set yarns.0.count=4.
+        #[arg(long = "set", value_name = "KEY=VALUE")]
+        set: Vec<String>,
         /// Timed substeps.
         #[arg(short, long, default_value_t = 1000)]
         steps: u64,
@@ -169,6 +181,9 @@ enum SceneCommand {
     Show {
         /// Built-in scene name or scene file.
         name: String,
+        /// Override a scene field, KEY=VALUE (repeatable), as for `run`.
+        #[arg(long = "set", value_name = "KEY=VALUE")]
+        set: Vec<String>,
     },
 }
 
@@ -186,14 +201,15 @@ fn main() -> ExitCode {
 fn execute(command: Command) -> Result<u8, CliError> {
     match command {
         Command::Scenes => print!("{}", list_scenes()),
-        Command::Scene(SceneCommand::Show { name }) => print!("{}", show_scene(&name)?),
+        Command::Scene(SceneCommand::Show { name, set }) => print!("{}", show_scene(&name, &set)?),
         Command::Run {
             scene,
             duration,
             csv,
             integrator,
+            set,
         } => {
-            let scene = load_scene(&scene)?;
+            let scene = load_scene(&scene, &set)?;
             announce(&Estimate::of(&scene, duration, None));
             let summary = run(&scene, duration, csv.as_deref(), &integrator.args())?;
             print!("{}", format_summary(&summary, Timing::Show));
@@ -218,6 +234,7 @@ fn execute(command: Command) -> Result<u8, CliError> {
             server_memory_limit,
             every,
             integrator,
+            set,
         } => {
             let sink = if serve {
                 Sink::serve(bind, port, server_memory_limit, output.as_deref())?
@@ -228,7 +245,7 @@ fn execute(command: Command) -> Result<u8, CliError> {
             } else {
                 Sink::output(output.as_deref().unwrap_or("run.rrd".as_ref()))?
             };
-            let scene = load_scene(&scene)?;
+            let scene = load_scene(&scene, &set)?;
             announce(&Estimate::of(&scene, duration, Some(every)));
             let opts = RecordOptions { sink, every };
             let r = record(&scene, duration, &opts, &integrator.args())?;
@@ -292,8 +309,9 @@ fn execute(command: Command) -> Result<u8, CliError> {
             warmup,
             threads,
             integrator,
+            set,
         } => {
-            let scene = load_scene(&scene)?;
+            let scene = load_scene(&scene, &set)?;
             announce(&Estimate::of(&scene, 0.0, None));
             let r = bench(
                 &scene,

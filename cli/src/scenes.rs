@@ -31,12 +31,13 @@ pub fn list_scenes() -> String {
     out
 }
 
-/// Resolves a built-in scene name or a scene file path.
-pub fn load_scene(name_or_path: &str) -> Result<Scene, CliError> {
-    Scene::resolve(name_or_path).map_err(CliError::from)
+/// Resolves a built-in scene name or a scene file path, with the `--set
+/// KEY=VALUE` overrides applied (see [`yarnsim::scene::overrides`]).
+pub fn load_scene(name_or_path: &str, overrides: &[String]) -> Result<Scene, CliError> {
+    Scene::resolve_with(name_or_path, overrides).map_err(CliError::from)
 }
 
 /// The scene as TOML, ready to save and edit.
-pub fn show_scene(name_or_path: &str) -> Result<String, CliError> {
-    Ok(load_scene(name_or_path)?.to_toml_string())
+pub fn show_scene(name_or_path: &str, overrides: &[String]) -> Result<String, CliError> {
+    Ok(load_scene(name_or_path, overrides)?.to_toml_string())
 }

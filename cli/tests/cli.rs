@@ -417,3 +417,205 @@ fn adaptive_substeps_are_reported_and_hit_every_frame() {
         "{s}"
     );
 }
+
+/// The summary table of `run ARGS`, without its wall-clock lines.
+fn summary(args: &[&str]) -> String {
+    let out = yarnsim(args);
+    assert!(out.status.success(), "{args:?}: {}", stderr(&out));
+    stdout(&out)
+        .lines()
+        .filter(|l| !l.starts_with("wall time") && !l.starts_with("throughput"))
+        .collect::<Vec<_>>()
+        .join("\n")
+}
+
+/// `(initial, final)` of a row of the summary table.
+fn row(table: &str, name: &str) -> (f64, f64) {
+    let line = table
+        .lines()
+        .find(|l| l.starts_with(name))
+        .unwrap_or_else(|| panic!("no row {name} in {table}"));
+    let v: Vec<f64> = line[name.len()..]
+        .split_whitespace()
+        .map(|x| x.parse().unwrap())
+        .collect();
+    (v[0], v[1])
+}
+
+#[test]
+fn set_overrides_scene_fields() {
+    let small = small_scene();
+    let small = small.to_str().unwrap();
+    let run = |extra: &[&str]| {
+        let mut args = vec!["run", small, "--duration", "2ms"];
+        args.extend_from_slice(extra);
+        summary(&args)
+    };
+    let base = run(&[]);
+    // A field set to the file's own value changes nothing.
+    assert_eq!(
+        run(&[
+            "--set",
+            "material.friction=0.05",
+            "--set",
+            "gravity=[0.0, -9.8]"
+        ]),
+        base
+    );
+    // Without gravity and attractor, and no contact in 2 ms (the yarns
+    // move 2 mm, 5 cm above the obstacle, far from the walls), momentum is
+    // conserved: to the 6 digits of the table.
+    let free = run(&["--set", "gravity=[0,0]", "--set", "attractor.active=false"]);
+    assert_ne!(free, base);
+    let (p0, p1) = row(&free, "momentum y");
+    assert!((p1 - p0).abs() <= 1e-6 * p0.abs(), "{p0} -> {p1}");
+    let (q0, q1) = row(&base, "momentum y");
+    assert!(
+        (q1 - q0).abs() > 1e-2 * q0.abs(),
+        "gravity acts: {q0} -> {q1}"
+    );
+    // Into an array of tables: one yarn instead of two.
+    let one = run(&["--set", "yarns.0.count=1"]);
+    assert!(
+        one.contains("particles          59 (30 vertices + 29 quadrature, 1 yarns)"),
+        "{one}"
+    );
+    // Built-in scenes, yarn and mass-spring, and `scene show`.
+    let out = yarnsim(&[
+        "scene",
+        "show",
+        "yarn-reference",
+        "--set",
+        "material.friction=0.1",
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let shown = yarnsim::Scene::from_toml_str(&stdout(&out)).unwrap();
+    let yarnsim::Scene::Yarn(y) = shown else {
+        panic!("a yarn scene")
+    };
+    assert_eq!(y.material.friction, 0.1);
+    let wire = |extra: &[&str]| {
+        let mut args = vec![
+            "run",
+            "wire",
+            "--duration",
+            "0.05",
+            "--integrator",
+            "symplectic-euler",
+        ];
+        args.extend_from_slice(extra);
+        summary(&args)
+    };
+    let (w, w0) = (wire(&[]), wire(&["--set", "gravity=[0, 0, 0]"]));
+    assert_ne!(w, w0);
+    // Gravity off: no gravity energy, at the start or after.
+    assert_eq!(row(&w0, "gravity energy"), (0.0, 0.0), "{w0}");
+    assert_eq!(row(&w, "gravity energy").0, -4.905, "{w}");
+    // bench and record take it too.
+    let out = yarnsim(&[
+        "bench",
+        small,
+        "--steps",
+        "2",
+        "--warmup",
+        "0",
+        "--set",
+        "yarns.0.count=1",
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let rrd = tmp("set.rrd");
+    let out = yarnsim(&[
+        "record",
+        small,
+        "-d",
+        "1ms",
+        "-o",
+        rrd.to_str().unwrap(),
+        "--set",
+        "yarns.0.count=1",
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(stdout(&out).contains("59 particles"), "{}", stdout(&out));
+}
+
+#[test]
+fn bad_set_arguments_are_named_with_exit_code_3() {
+    let small = small_scene();
+    let small = small.to_str().unwrap();
+    for cmd in ["run", "record", "bench"] {
+        assert_fails(
+            &[
+                cmd,
+                small,
+                "--set",
+                "gravity=[0,0]",
+                "--set",
+                "material.friction=abc",
+            ],
+            3,
+            "error: scene error in --set argument 2 (`material.friction=abc`): \
+             invalid type: string \"abc\", expected f64",
+        );
+    }
+    assert_fails(
+        &["run", "wire", "--set", "material.friction=0.1"],
+        3,
+        "scene error in --set argument 1 (`material.friction=0.1`): unknown field `material`",
+    );
+    assert_fails(
+        &["run", small, "--set", "material.frction=0.1"],
+        3,
+        "scene error in --set argument 1 (`material.frction=0.1`): unknown field `frction`",
+    );
+    assert_fails(
+        &["run", small, "--set", "material.friction=-1"],
+        3,
+        "scene error in --set argument 1 (`material.friction=-1`): must be >= 0, got -1",
+    );
+    assert_fails(
+        &["run", small, "--set", "yarns.1.count=1"],
+        3,
+        "scene error in --set argument 1 (`yarns.1.count=1`): index 1 is out of range: \
+         `yarns` has 1 entries (0 to 0)",
+    );
+    assert_fails(
+        &["run", small, "--set", "material.friction"],
+        3,
+        "scene error in --set argument 1 (`material.friction`): expected KEY=VALUE",
+    );
+    assert_fails(
+        &["run", small, "--set", "gravity=[0,"],
+        3,
+        "scene error in --set argument 1 (`gravity=[0,`): `[0,` is not a TOML value",
+    );
+    // The file's own errors keep their line.
+    let bad = tmp("bad-friction.toml");
+    let text = std::fs::read_to_string(small_scene()).unwrap();
+    std::fs::write(&bad, text.replace("friction = 0.05", "friction = -0.05")).unwrap();
+    assert_fails(
+        &["run", bad.to_str().unwrap(), "--set", "gravity=[0,0]"],
+        3,
+        "scene error at line 19 in field `material.friction`: must be >= 0, got -0.05",
+    );
+}
+
+#[test]
+fn a_missing_table_is_named() {
+    let text = std::fs::read_to_string(small_scene()).unwrap();
+    let start = text.find("[material]").unwrap();
+    let end = text.find("[attractor]").unwrap();
+    let file = tmp("no-material.toml");
+    std::fs::write(&file, format!("{}{}", &text[..start], &text[end..])).unwrap();
+    assert_fails(
+        &["run", file.to_str().unwrap()],
+        3,
+        "error: scene error in field `material`: missing field `material`",
+    );
+    let file = tmp("no-dt.toml");
+    std::fs::write(&file, text.replace("dt = 0.00004\n", "")).unwrap();
+    assert_fails(
+        &["run", file.to_str().unwrap()],
+        3,
+        "error: scene error at line 11 in field `time.dt`: missing field `dt`",
+    );
+}

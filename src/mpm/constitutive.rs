@@ -166,3 +166,61 @@ pub fn frame_gradient_qr(energy: &YarnEnergy, g: &Qr2, l0: f64, volume: f64) -> 
     let s = volume / l0;
     (p.column(0) * s, p.column(1) * s)
 }
+
+/// Plastic state of a quadrature particle after the Mohr-Coulomb return
+/// mapping ([`YarnEnergy::return_map`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum PlasticState {
+    /// Inside the yield surface.
+    Elastic = 0,
+    /// On the yield surface: the return mapping limits the shear (sliding).
+    Yielding = 1,
+    /// `r22 = 1`: the cross-section is in tension and carries no stress.
+    Separated = 2,
+}
+
+impl YarnEnergy {
+    /// Classifies `(r12, r22)` of a frame after the return mapping:
+    /// separated at `r22 >= 1`, yielding where the yield function is 0 (to a
+    /// relative `1e-6` of `c_f (2 mu + lambda) |log r22|`, the size of its
+    /// terms) with some shear, elastic otherwise.
+    pub fn plastic_state(&self, r12: f64, r22: f64) -> PlasticState {
+        if r22 >= 1.0 - 1e-9 {
+            return PlasticState::Separated;
+        }
+        let f = self.yield_function(r12, r22);
+        let scale = self.friction * self.normal * (-r22.ln()).abs();
+        if f >= -1e-6 * scale && r12 != 0.0 {
+            PlasticState::Yielding
+        } else {
+            PlasticState::Elastic
+        }
+    }
+}
+
+#[cfg(test)]
+mod plastic_state_tests {
+    use super::*;
+
+    #[test]
+    fn plastic_state_follows_the_return_mapping() {
+        let e = YarnEnergy {
+            k: 1000.0,
+            gamma: 500.0,
+            normal: 1400.0,
+            friction: 0.3,
+        };
+        // Compressed, little shear: inside the yield surface.
+        assert_eq!(e.plastic_state(1e-4, 0.95), PlasticState::Elastic);
+        // Too much shear for the pressure: the return mapping puts it on the surface.
+        let (r12, r22) = e.return_map(0.5, 0.95);
+        assert!(r12 < 0.5);
+        assert_eq!(e.plastic_state(r12, r22), PlasticState::Yielding);
+        assert_eq!(e.plastic_state(-r12, r22), PlasticState::Yielding);
+        // Just inside the surface (shear 1 % below the returned one): elastic.
+        assert_eq!(e.plastic_state(0.99 * r12, r22), PlasticState::Elastic);
+        // Cross-section in tension: separated.
+        let (r12, r22) = e.return_map(0.1, 1.2);
+        assert_eq!(e.plastic_state(r12, r22), PlasticState::Separated);
+    }
+}

@@ -10,6 +10,7 @@ pub mod builtin;
 pub mod error;
 pub mod massspring;
 pub mod overlap;
+pub mod overrides;
 pub(crate) mod readers;
 pub mod yarn;
 

@@ -255,7 +255,16 @@ impl<'de> Deserialize<'de> for StepSize {
                 "must be a substep in s (a finite number > 0) or \"auto\", got {what}"
             ))
         };
-        match Raw::deserialize(d).map_err(|_| bad("another type".into()))? {
+        let raw = Raw::deserialize(d).map_err(|e| {
+            // serde reports an absent `dt` through this deserializer: keep
+            // its "missing field" message, which names the field.
+            if e.to_string().starts_with("missing field") {
+                e
+            } else {
+                bad("another type".into())
+            }
+        })?;
+        match raw {
             Raw::Number(v) if v.is_finite() && v > 0.0 => Ok(StepSize::Fixed(v)),
             Raw::Number(v) => Err(bad(v.to_string())),
             Raw::Text(t) if t == "auto" => Ok(StepSize::Auto),

@@ -1,0 +1,121 @@
+//! The frame loop of a recording: run the schedule, log the selected
+//! frames, close the stream whatever happened.
+
+use std::path::Path;
+
+use rerun::RecordingStream;
+use yarnsim::scene::Scene;
+use yarnsim::YarnSim;
+
+use super::massspring::record_massspring;
+use super::sink::{Server, Sink};
+use super::yarn::record_yarn;
+use crate::driver::{
+    interrupt_flag, progress_bar, run_frames, FrameInfo, FrameRun, Outcome, Stepper,
+};
+use crate::error::CliError;
+use crate::massspring::{IntegratorArgs, MassSpringRun};
+use crate::run::no_integrator_for_yarn;
+use crate::schedule::Schedule;
+
+/// What to record: the sink and which frames.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct RecordOptions {
+    pub sink: Sink,
+    /// Log every `every`-th frame (1 = all); frame 0 and the last frame are always logged.
+    pub every: u64,
+}
+
+impl RecordOptions {
+    /// All frames into `path` (checked like `-o`).
+    pub fn file(path: &Path) -> Result<Self, CliError> {
+        Ok(RecordOptions {
+            sink: Sink::output(path)?,
+            every: 1,
+        })
+    }
+
+    fn logs(&self, frame: &FrameInfo) -> bool {
+        frame.last || frame.frame.is_multiple_of(self.every.max(1))
+    }
+}
+
+/// How a `record` command ended.
+#[derive(Debug)]
+pub struct RecordOutcome {
+    pub outcome: Outcome,
+    pub particles: usize,
+    pub frames_logged: u64,
+    /// Adaptive substeps (`dt = "auto"`): their `min / mean / max`.
+    pub adaptive_dt: Option<String>,
+    /// The simulation error that stopped the run early; the recording holds
+    /// the frames before it and is complete.
+    pub failure: Option<CliError>,
+    /// The `--serve` server, still serving the recording after the run (not
+    /// after an interruption: Ctrl-C during the run stops both).
+    pub server: Option<Server>,
+}
+
+/// Records `scene` for `duration` seconds; `integrator` applies to
+/// mass-spring scenes only.
+pub fn record(
+    scene: &Scene,
+    duration: f64,
+    opts: &RecordOptions,
+    integrator: &IntegratorArgs,
+) -> Result<RecordOutcome, CliError> {
+    match scene {
+        Scene::Yarn(y) => {
+            no_integrator_for_yarn(integrator)?;
+            record_yarn(&mut YarnSim::new(y)?, duration, opts)
+        }
+        Scene::MassSpring(l) => {
+            record_massspring(&mut MassSpringRun::new(l, integrator)?, duration, opts)
+        }
+    }
+}
+
+/// Runs `schedule` on `sim`, logging the frames `opts` selects with `log`,
+/// then flushes and closes the stream whatever happened (divergence,
+/// Ctrl-C, SIGTERM), so a file ends readable.
+pub(super) fn record_frames<S: Stepper + Send>(
+    rec: RecordingStream,
+    sim: &mut S,
+    schedule: &Schedule,
+    label: &str,
+    opts: &RecordOptions,
+    mut log: impl FnMut(&RecordingStream, &S, FrameInfo) -> rerun::RecordingStreamResult<()>,
+) -> Result<RecordOutcome, CliError> {
+    let progress = progress_bar(schedule.total_steps, label);
+    let mut frames_logged = 0;
+    let result = run_frames(sim, schedule, &interrupt_flag(), &progress, |sim, frame| {
+        if opts.logs(&frame) {
+            log(&rec, sim, frame).map_err(|e| opts.sink.error(e))?;
+            frames_logged += 1;
+        }
+        Ok(())
+    });
+    let flushed = rec.flush_blocking();
+    let keep_serving = matches!(&result, Ok(run) if !run.outcome.interrupted);
+    let server = match &opts.sink {
+        Sink::Serve(s) if keep_serving => {
+            // Completes the file of `--save` (its footer); the server stays.
+            rec.finalize_deferred_sinks();
+            Some(Server { rec, url: s.url() })
+        }
+        _ => {
+            drop(rec);
+            None
+        }
+    };
+    let FrameRun { outcome, failure } = result?;
+    flushed.map_err(|e| opts.sink.error(e))?;
+    Ok(RecordOutcome {
+        outcome,
+        particles: sim.num_particles(),
+        frames_logged,
+        adaptive_dt: None,
+        failure,
+        server,
+    })
+}
