@@ -4,7 +4,7 @@
 
 mod common;
 
-use common::bare_scene;
+use common::{straight, SceneBuilder};
 use yarnsim::massspring::{scenes, Integrator, IntegratorOptions, MassSpringError, Simulation};
 use yarnsim::math::{Mat2, Vec2};
 use yarnsim::mpm::constitutive::{frame_gradient, YarnEnergy};
@@ -82,14 +82,9 @@ fn total_energy(sim: &YarnSim) -> f64 {
 
 #[test]
 fn yarn_stretched_to_three_times_its_length_snaps_back() {
-    let sc = bare_scene(
-        r#"
-[[yarns]]
-start = [0.4, 0.5]
-end = [0.6, 0.5]
-vertices = 30
-"#,
-    );
+    let sc = SceneBuilder::bare()
+        .yarn(straight([0.4, 0.5], [0.6, 0.5], 30))
+        .build();
     let mut sim = YarnSim::new(&sc).unwrap();
     let l_rest: f64 = sim.stretches().iter().sum::<f64>();
     {
