@@ -9,12 +9,16 @@
 //! * [`mpm`]: the yarn-bundle MPM solver.
 //! * [`massspring`]: mass-spring wires and cloth (seeds 002, 004, 001).
 //! * [`pool`]: running a call's parallel passes on a rayon worker.
+//! * `testing` (cargo feature `testing`): scenes and oracles for tests and
+//!   evidence studies.
 
 pub mod massspring;
 pub mod math;
 pub mod mpm;
 pub mod pool;
 pub mod scene;
+#[cfg(feature = "testing")]
+pub mod testing;
 
 pub use mpm::{SimError, YarnSim};
 pub use scene::{MassSpringScene, Scene, SceneError, YarnScene};

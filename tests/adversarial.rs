@@ -4,13 +4,13 @@
 
 mod common;
 
-use common::bare_scene;
+use common::{straight, SceneBuilder};
 use yarnsim::massspring::{scenes, Integrator, IntegratorOptions, MassSpringError, Simulation};
 use yarnsim::math::{Mat2, Vec2};
 use yarnsim::mpm::constitutive::{frame_gradient, YarnEnergy};
 use yarnsim::mpm::{Attractor, SimError};
-use yarnsim::scene::builtin::reference_material;
 use yarnsim::scene::WallMode;
+use yarnsim::testing::reference_material;
 use yarnsim::YarnSim;
 
 /// Every particle position and velocity finite.
@@ -82,14 +82,9 @@ fn total_energy(sim: &YarnSim) -> f64 {
 
 #[test]
 fn yarn_stretched_to_three_times_its_length_snaps_back() {
-    let sc = bare_scene(
-        r#"
-[[yarns]]
-start = [0.4, 0.5]
-end = [0.6, 0.5]
-vertices = 30
-"#,
-    );
+    let sc = SceneBuilder::bare()
+        .yarn(straight([0.4, 0.5], [0.6, 0.5], 30))
+        .build();
     let mut sim = YarnSim::new(&sc).unwrap();
     let l_rest: f64 = sim.stretches().iter().sum::<f64>();
     {
@@ -132,7 +127,7 @@ vertices = 30
 
 #[test]
 fn yarns_crushed_against_an_obstacle() {
-    let mut sc = yarnsim::scene::builtin::small_yarn_scene(4, 40, 64);
+    let mut sc = yarnsim::testing::small_yarn_scene(4, 40, 64);
     sc.gravity = [0.0, -200.0];
     sc.time.dt = 5e-5.into();
     sc.obstacles[0].center = [0.5, 0.4];
@@ -200,7 +195,7 @@ fn degenerate_and_inverted_deformation_gradients_give_finite_stress() {
 }
 
 fn wall_scene(mode: WallMode, vx: f64) -> yarnsim::YarnScene {
-    let mut sc = yarnsim::scene::builtin::small_yarn_scene(3, 40, 64);
+    let mut sc = yarnsim::testing::small_yarn_scene(3, 40, 64);
     sc.gravity = [0.0, 0.0];
     sc.obstacles.clear();
     sc.walls.mode = mode;
@@ -246,7 +241,7 @@ fn particles_driven_at_the_walls_at_high_speed_stay_on_the_grid() {
 
 #[test]
 fn huge_gravity_is_bounded_or_refused() {
-    let base = yarnsim::scene::builtin::small_yarn_scene(3, 40, 64);
+    let base = yarnsim::testing::small_yarn_scene(3, 40, 64);
     let mut sim = YarnSim::new(&base).unwrap();
     // Beyond the documented limit: refused, state untouched.
     assert!(matches!(
@@ -277,7 +272,7 @@ fn huge_gravity_is_bounded_or_refused() {
 
 #[test]
 fn attractor_inside_an_obstacle_cannot_pull_yarn_into_it() {
-    let base = yarnsim::scene::builtin::small_yarn_scene(3, 40, 64);
+    let base = yarnsim::testing::small_yarn_scene(3, 40, 64);
     let mut sim = YarnSim::new(&base).unwrap();
     let o = base.obstacles[0].clone();
     sim.set_attractor(Attractor {

@@ -5,46 +5,34 @@
 
 mod common;
 
-use common::scene;
+use common::{bundle, pin_end, SceneBuilder};
 use yarnsim::math::Vec2;
 use yarnsim::mpm::state::StateError;
+use yarnsim::scene::{PinMotionKind, PinSpec, TransferScheme, WallMode, YarnEnd, YarnScene};
 use yarnsim::YarnSim;
 
-fn text(scheme: &str) -> String {
-    format!(
-        r#"
-gravity = [0.0, -9.8]
-[grid]
-resolution = 32
-[time]
-dt = 2e-4
-[material]
-k = 1000.0
-gamma = 500.0
-youngs_modulus = 1000.0
-friction = 0.05
-bending = 1e-4
-plasticity = true
-[transfer]
-scheme = "{scheme}"
-[walls]
-mode = "sticky"
-[[obstacles]]
-center = [0.5, 0.45]
-radius = 0.1
-friction = 0.3
-[[yarns]]
-start = [0.25, 0.7]
-end = [0.75, 0.7]
-vertices = 20
-count = 2
-spacing = [0.0, 0.05]
-[[pins]]
-yarn = 0
-end = "start"
-motion = "input"
-"#
-    )
+/// Two yarns falling onto a circle under `scheme`, the first one's start
+/// vertex pinned with `motion`; `count` copies of the yarn.
+fn pinned(scheme: TransferScheme, count: u32, motion: PinMotionKind) -> YarnScene {
+    SceneBuilder::bare()
+        .resolution(32)
+        .dt(2e-4)
+        .gravity([0.0, -9.8])
+        .material(|m| m.plasticity = true)
+        .scheme(scheme)
+        .walls(WallMode::Sticky)
+        .obstacle([0.5, 0.45], 0.1, 0.3)
+        .yarn(bundle([0.25, 0.7], [0.75, 0.7], 20, count, [0.0, 0.05]))
+        .pin(PinSpec {
+            motion,
+            ..pin_end(0, YarnEnd::Start, 1)
+        })
+        .build()
+}
+
+/// The scene of the tests: two yarns, the first one's start driven (`input`).
+fn input_pinned(scheme: TransferScheme) -> YarnScene {
+    pinned(scheme, 2, PinMotionKind::Input)
 }
 
 /// Every particle array the stepper reads, and the pin reactions, as bits.
@@ -84,8 +72,8 @@ fn run(sim: &mut YarnSim, k0: u64, n: u64) {
 
 #[test]
 fn dynamic_state_continues_bit_for_bit() {
-    for scheme in ["apic", "flip"] {
-        let s = scene(&text(scheme));
+    for scheme in [TransferScheme::Apic, TransferScheme::Flip] {
+        let s = input_pinned(scheme);
         let mut sim = YarnSim::new(&s).unwrap();
         run(&mut sim, 0, 45);
         let saved = sim.dynamic_state();
@@ -97,13 +85,13 @@ fn dynamic_state_continues_bit_for_bit() {
         sim.set_dynamic_state(&saved).unwrap();
         assert_eq!(sim.steps(), 45);
         run(&mut sim, 45, 60);
-        assert_eq!(bits(&sim), first, "{scheme}: same simulation");
+        assert_eq!(bits(&sim), first, "{scheme:?}: same simulation");
 
         // Into a fresh simulation of the scene.
         let mut fresh = YarnSim::new(&s).unwrap();
         fresh.set_dynamic_state(&saved).unwrap();
         run(&mut fresh, 45, 60);
-        assert_eq!(bits(&fresh), first, "{scheme}: fresh simulation");
+        assert_eq!(bits(&fresh), first, "{scheme:?}: fresh simulation");
 
         // Its bytes are save_state's, and they decode to it.
         let mut at = YarnSim::new(&s).unwrap();
@@ -116,10 +104,10 @@ fn dynamic_state_continues_bit_for_bit() {
 
 #[test]
 fn a_dynamic_state_of_another_scene_is_refused_and_changes_nothing() {
-    let s = scene(&text("apic"));
+    let s = input_pinned(TransferScheme::Apic);
     let mut sim = YarnSim::new(&s).unwrap();
     run(&mut sim, 0, 5);
-    let other = scene(&text("apic").replace("count = 2", "count = 3"));
+    let other = pinned(TransferScheme::Apic, 3, PinMotionKind::Input);
     let foreign = YarnSim::new(&other).unwrap().dynamic_state();
     let before = bits(&sim);
     assert!(matches!(
@@ -129,7 +117,7 @@ fn a_dynamic_state_of_another_scene_is_refused_and_changes_nothing() {
     assert!(sim.encode_state(&foreign).is_err());
     assert_eq!(bits(&sim), before);
     // No input pin: the pin targets do not fit either.
-    let unpinned = scene(&text("apic").replace("motion = \"input\"", ""));
+    let unpinned = pinned(TransferScheme::Apic, 2, PinMotionKind::Fixed);
     let fixed = YarnSim::new(&unpinned).unwrap().dynamic_state();
     assert_eq!(sim.set_dynamic_state(&fixed), Err(StateError::OtherScene));
     assert_eq!(bits(&sim), before);

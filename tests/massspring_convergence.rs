@@ -60,30 +60,46 @@ fn observed_order(layout: &MassSpringScene, integ: Integrator, h: f64, t_end: f6
     (d1 / d2).log2()
 }
 
-#[test]
-// Thousands of projection passes / Jacobi iterations: release only.
-#[cfg_attr(debug_assertions, ignore)]
-fn observed_order_is_one_for_the_euler_schemes_and_two_for_trapezoidal() {
-    let layout = damped_three_particle();
-    let (h, t_end) = (0.004, 1.0);
-    for (integ, expected) in [
-        (Integrator::ForwardEuler, 1.0),
-        (Integrator::SymplecticEuler, 1.0),
-        (Integrator::BackwardEuler, 1.0),
-        (Integrator::ChebyshevJacobi, 1.0),
-        (Integrator::Trapezoidal, 2.0),
-    ] {
-        let p = observed_order(&layout, integ, h, t_end);
+/// Asserts the observed order of each `(integrator, expected)` on `layout`
+/// (step `h`, to `t_end`) within `tolerance`; `label` names the scene.
+fn assert_orders(
+    label: &str,
+    layout: &Layout,
+    (h, t_end): (f64, f64),
+    cases: &[(Integrator, f64)],
+    tolerance: f64,
+) {
+    for &(integ, expected) in cases {
+        let p = observed_order(layout, integ, h, t_end);
         eprintln!(
-            "{integ}: observed order {p:.4} (h = {h}, {}, {})",
+            "{label}{integ}: observed order {p:.4} (h = {h}, {}, {})",
             h / 2.0,
             h / 4.0
         );
         assert!(
-            (p - expected).abs() < 0.1,
+            (p - expected).abs() < tolerance,
             "{integ}: order {p}, expected {expected}"
         );
     }
+}
+
+#[test]
+// Thousands of projection passes / Jacobi iterations: release only.
+#[cfg_attr(debug_assertions, ignore)]
+fn observed_order_is_one_for_the_euler_schemes_and_two_for_trapezoidal() {
+    assert_orders(
+        "",
+        &damped_three_particle(),
+        (0.004, 1.0),
+        &[
+            (Integrator::ForwardEuler, 1.0),
+            (Integrator::SymplecticEuler, 1.0),
+            (Integrator::BackwardEuler, 1.0),
+            (Integrator::ChebyshevJacobi, 1.0),
+            (Integrator::Trapezoidal, 2.0),
+        ],
+        0.1,
+    );
 }
 
 #[test]
@@ -93,23 +109,16 @@ fn observed_order_on_the_driven_damped_wire() {
     // The stiff wire (damping rate up to about 4400 1/s; forward Euler's
     // bound is 4.7e-4 s): every scheme reaches its asymptotic order once h
     // resolves it. Driven end, damping and the Hessian clamp all take part.
-    let layout = scenes::wire();
-    let (h, t_end) = (2e-4, 0.2);
-    for (integ, expected) in [
-        (Integrator::BackwardEuler, 1.0),
-        (Integrator::Trapezoidal, 2.0),
-        (Integrator::SymplecticEuler, 1.0),
-        (Integrator::ForwardEuler, 1.0),
-    ] {
-        let p = observed_order(&layout, integ, h, t_end);
-        eprintln!(
-            "wire {integ}: observed order {p:.4} (h = {h}, {}, {})",
-            h / 2.0,
-            h / 4.0
-        );
-        assert!(
-            (p - expected).abs() < 0.15,
-            "{integ}: order {p}, expected {expected}"
-        );
-    }
+    assert_orders(
+        "wire ",
+        &scenes::wire(),
+        (2e-4, 0.2),
+        &[
+            (Integrator::BackwardEuler, 1.0),
+            (Integrator::Trapezoidal, 2.0),
+            (Integrator::SymplecticEuler, 1.0),
+            (Integrator::ForwardEuler, 1.0),
+        ],
+        0.15,
+    );
 }

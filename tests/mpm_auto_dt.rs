@@ -5,9 +5,9 @@
 
 mod common;
 
-use common::scene;
+use common::{bundle, SceneBuilder};
 use yarnsim::mpm::Stepping;
-use yarnsim::scene::{builtin, Scene, SceneError, StepSize, YarnScene, DEFAULT_SAFETY};
+use yarnsim::scene::{builtin, Scene, SceneError, StepSize, WallMode, YarnScene, DEFAULT_SAFETY};
 use yarnsim::YarnSim;
 
 fn reference() -> YarnScene {
@@ -68,30 +68,18 @@ fn reference_scene_runs_stable_in_fewer_substeps() {
 
 /// A small, fast scene: the reference bundle's material on a 64^2 grid.
 fn small() -> YarnScene {
-    scene(
-        r#"
-[grid]
-resolution = 64
-[time]
-dt = "auto"
-frame_dt = 0.01
-[material]
-k = 1000.0
-gamma = 500.0
-youngs_modulus = 1000.0
-friction = 0.05
-bending = 1e-3
-[[obstacles]]
-center = [0.5, 0.3]
-radius = 0.1
-[[yarns]]
-start = [0.2, 0.6]
-end = [0.8, 0.6]
-vertices = 60
-count = 3
-spacing = [0.0, 0.03]
-"#,
-    )
+    SceneBuilder::bare()
+        .dt(StepSize::Auto)
+        .frame_dt(0.01)
+        .gravity([0.0, -9.8])
+        .walls(WallMode::Sticky)
+        .material(|m| {
+            m.bending = 1e-3;
+            m.plasticity = true;
+        })
+        .obstacle([0.5, 0.3], 0.1, 0.3)
+        .yarn(bundle([0.2, 0.6], [0.8, 0.6], 60, 3, [0.0, 0.03]))
+        .build()
 }
 
 /// Frame times are hit exactly (the clock reads `k * frame_dt`, no

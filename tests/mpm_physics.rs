@@ -3,11 +3,11 @@
 
 mod common;
 
-use common::{bare_scene, Rng};
+use common::{bundle, momentum_scale, pin_end, polyline, straight, Rng, SceneBuilder};
 use yarnsim::math::{perp, Mat2, Vec2};
 use yarnsim::mpm::grid::{self, Grid};
 use yarnsim::mpm::{grid_to_particle, particle_to_grid, simd, vertex_forces};
-use yarnsim::scene::YarnScene;
+use yarnsim::scene::{TransferScheme, WallMode, YarnEnd, YarnScene, YarnSpec};
 use yarnsim::YarnSim;
 
 /// Weight of grid node `(i, j)` in a stencil (0 outside it).
@@ -23,14 +23,9 @@ fn weight_at(st: &yarnsim::math::bspline::Stencil, i: usize, j: usize) -> f64 {
 #[test]
 fn grid_forces_are_minus_the_energy_gradient() {
     // A deformed diagonal yarn (the orientation that exposes assembly bugs).
-    let scene = bare_scene(
-        r#"
-[[yarns]]
-start = [0.3, 0.35]
-end = [0.55, 0.6]
-vertices = 40
-"#,
-    );
+    let scene = SceneBuilder::bare()
+        .yarn(straight([0.3, 0.35], [0.55, 0.6], 40))
+        .build();
     let mut sim = YarnSim::new(&scene).unwrap();
     let geom = sim.grid_geom();
     let energy = *sim.energy_model();
@@ -124,18 +119,11 @@ fn com(sim: &YarnSim) -> Vec2 {
 
 #[test]
 fn free_fall_follows_the_schemes_trajectory() {
-    let mut scene = bare_scene(
-        r#"
-[[yarns]]
-start = [0.2, 0.7]
-end = [0.7, 0.85]
-vertices = 60
-[[yarns]]
-points = [[0.3, 0.6], [0.5, 0.62], [0.6, 0.5]]
-vertices = 50
-"#,
-    );
-    scene.gravity = [0.5, -9.8];
+    let scene = SceneBuilder::bare()
+        .gravity([0.5, -9.8])
+        .yarn(straight([0.2, 0.7], [0.7, 0.85], 60))
+        .yarn(polyline(&[[0.3, 0.6], [0.5, 0.62], [0.6, 0.5]], 50))
+        .build();
     let mut sim = YarnSim::new(&scene).unwrap();
     let g = Vec2::from(scene.gravity);
     let dt = sim.dt();
@@ -155,20 +143,10 @@ vertices = 50
 
 #[test]
 fn linear_momentum_is_conserved_and_angular_drift_is_small() {
-    let scene = bare_scene(
-        r#"
-[[yarns]]
-start = [0.3, 0.5]
-end = [0.7, 0.52]
-vertices = 80
-count = 3
-spacing = [0.0, 0.012]
-[[yarns]]
-start = [0.48, 0.3]
-end = [0.52, 0.7]
-vertices = 80
-"#,
-    );
+    let scene = SceneBuilder::bare()
+        .yarn(bundle([0.3, 0.5], [0.7, 0.52], 80, 3, [0.0, 0.012]))
+        .yarn(straight([0.48, 0.3], [0.52, 0.7], 80))
+        .build();
     let mut sim = YarnSim::new(&scene).unwrap();
     // spin the bundle rigidly about its centre of mass (velocity gradient
     // C = omega [[0, -1], [1, 0]]), and add a drift
@@ -199,16 +177,7 @@ vertices = 80
         }
     }
     let d0 = sim.diagnostics();
-    let scale: f64 = {
-        let p = sim.particles();
-        p.vert
-            .v
-            .iter()
-            .zip(&p.vert.m)
-            .chain(p.quad.v.iter().zip(&p.quad.m))
-            .map(|(v, m)| m * v.norm())
-            .sum()
-    };
+    let scale = momentum_scale(&sim);
     sim.steps_n(1000).unwrap();
     let d1 = sim.diagnostics();
     let dp = (d1.momentum - d0.momentum).norm() / scale;
@@ -249,20 +218,15 @@ fn rotated_scene(scene: &YarnScene, c: f64) -> YarnScene {
 
 #[test]
 fn rotating_the_scene_by_90_degrees_rotates_the_trajectory() {
-    let mut scene = bare_scene(
-        r#"
-[[yarns]]
-start = [0.25, 0.12]
-end = [0.7, 0.22]
-vertices = 70
-velocity = [0.5, -1.0]
-count = 2
-spacing = [0.0, 0.01]
-"#,
-    );
-    scene.gravity = [0.0, -9.8];
-    scene.walls.mode = yarnsim::scene::WallMode::Sticky;
-    scene.material.plasticity = true;
+    let scene = SceneBuilder::bare()
+        .gravity([0.0, -9.8])
+        .walls(WallMode::Sticky)
+        .material(|m| m.plasticity = true)
+        .yarn(YarnSpec {
+            velocity: [0.5, -1.0],
+            ..bundle([0.25, 0.12], [0.7, 0.22], 70, 2, [0.0, 0.01])
+        })
+        .build();
     let geom_n = scene.grid.resolution as f64;
     // the node set 0..n-1 is symmetric about (n - 1) dx / 2
     let c = (geom_n - 1.0) / (2.0 * geom_n);
@@ -304,17 +268,9 @@ fn two_runs_give_identical_bits() {
 
 #[test]
 fn state_round_trip_reproduces_the_run() {
-    let scene = bare_scene(
-        r#"
-gravity = [0.0, -9.8]
-[[yarns]]
-start = [0.2, 0.6]
-end = [0.8, 0.65]
-vertices = 60
-"#
-        .replace("gravity = [0.0, -9.8]\n", "")
-        .as_str(),
-    );
+    let scene = SceneBuilder::bare()
+        .yarn(straight([0.2, 0.6], [0.8, 0.65], 60))
+        .build();
     let mut sim = YarnSim::new(&scene).unwrap();
     sim.set_gravity(Vec2::new(0.0, -9.8)).unwrap();
     sim.steps_n(100).unwrap();
@@ -343,25 +299,17 @@ fn state_restored_into_a_new_instance_continues_bitwise_through_plastic_contact(
     // Two yarns thrown onto an obstacle: the return mapping projects states
     // every step, and the frame factorisations the stepper caches between
     // steps must be exactly those a restore recomputes from `d`.
-    let mut scene = bare_scene(
-        r#"
-[[yarns]]
-start = [0.25, 0.56]
-end = [0.75, 0.56]
-vertices = 80
-velocity = [0.0, -3.0]
-[[yarns]]
-start = [0.25, 0.575]
-end = [0.75, 0.575]
-vertices = 80
-velocity = [0.0, -3.0]
-[[obstacles]]
-center = [0.5, 0.45]
-radius = 0.1
-"#,
-    );
-    scene.gravity = [0.0, -9.8];
-    scene.material.plasticity = true;
+    let falling = |y: f64| YarnSpec {
+        velocity: [0.0, -3.0],
+        ..straight([0.25, y], [0.75, y], 80)
+    };
+    let scene = SceneBuilder::bare()
+        .gravity([0.0, -9.8])
+        .material(|m| m.plasticity = true)
+        .obstacle([0.5, 0.45], 0.1, 0.3)
+        .yarn(falling(0.56))
+        .yarn(falling(0.575))
+        .build();
     let mut a = YarnSim::new(&scene).unwrap();
     let e = *a.energy_model();
     let mut saved = Vec::new();
@@ -395,15 +343,10 @@ radius = 0.1
 
 #[test]
 fn divergence_is_reported_with_its_step_and_blocks_further_steps() {
-    let mut scene = bare_scene(
-        r#"
-[[yarns]]
-start = [0.3, 0.5]
-end = [0.7, 0.5]
-vertices = 60
-"#,
-    );
-    scene.time.dt = 2e-3.into(); // far above the stable step
+    let scene = SceneBuilder::bare()
+        .dt(2e-3) // far above the stable step
+        .yarn(straight([0.3, 0.5], [0.7, 0.5], 60))
+        .build();
     let mut sim = YarnSim::new(&scene).unwrap();
     {
         let p = sim.particles_mut();
@@ -431,7 +374,9 @@ vertices = 60
 
 #[test]
 fn bad_inputs_are_rejected() {
-    let scene = bare_scene("[[yarns]]\nstart = [0.3, 0.5]\nend = [0.7, 0.5]\nvertices = 10\n");
+    let scene = SceneBuilder::bare()
+        .yarn(straight([0.3, 0.5], [0.7, 0.5], 10))
+        .build();
     let mut sim = YarnSim::new(&scene).unwrap();
     assert!(sim.set_gravity(Vec2::new(f64::NAN, 0.0)).is_err());
     assert!(sim.set_gravity(Vec2::new(0.0, 1e9)).is_err());
@@ -494,23 +439,18 @@ fn every_kernel_width_gives_the_same_bits() {
 /// every substep).
 #[test]
 fn pinned_hanging_yarn_stays_bounded_under_flip() {
-    let mut scene = bare_scene(
-        r#"
-[transfer]
-scheme = "flip"
-[[yarns]]
-points = [[0.5, 0.8], [0.505, 0.3]]
-vertices = 33
-[[pins]]
-yarn = 0
-end = "start"
-"#,
-    );
-    scene.grid.resolution = 32;
-    scene.gravity = [0.0, -9.8];
-    scene.material.bending = 0.0;
-    scene.material.k = 4900.0;
-    scene.time.dt = 2e-4.into();
+    let scene = SceneBuilder::bare()
+        .resolution(32)
+        .dt(2e-4)
+        .gravity([0.0, -9.8])
+        .material(|m| {
+            m.bending = 0.0;
+            m.k = 4900.0;
+        })
+        .scheme(TransferScheme::Flip)
+        .yarn(polyline(&[[0.5, 0.8], [0.505, 0.3]], 33))
+        .pin(pin_end(0, YarnEnd::Start, 1))
+        .build();
     let mut sim = YarnSim::new(&scene).unwrap();
     sim.advance(0.1).unwrap();
     // the reaction averaged over 0.2 s (many periods of the yarn's

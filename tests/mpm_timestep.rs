@@ -1,45 +1,22 @@
 //! The yarn MPM's stable substep bound (`yarnsim::mpm::timestep`) and the
 //! divergence report of a substep that breaks it.
 
+mod common;
+
+use common::{straight, SceneBuilder};
 use yarnsim::mpm::timestep::{stable_dt, wave_speed};
 use yarnsim::{SimError, YarnScene, YarnSim};
 
-fn scene(extra: &str, yarns: &str) -> YarnScene {
-    YarnScene::from_toml_str(&format!(
-        r#"
-kind = "yarn"
-name = "t"
-gravity = [0.0, 0.0]
-{extra}
-[grid]
-resolution = 64
-[time]
-dt = 1e-4
-[material]
-k = 1000.0
-gamma = 500.0
-youngs_modulus = 1000.0
-friction = 0.05
-bending = 1e-4
-plasticity = false
-[walls]
-mode = "none"
-{yarns}
-"#
-    ))
-    .unwrap()
+/// The bare 64^2 scene with one straight yarn of 60 vertices.
+fn scene() -> YarnScene {
+    SceneBuilder::bare()
+        .yarn(straight([0.3, 0.5], [0.7, 0.5], 60))
+        .build()
 }
-
-const YARN: &str = r#"
-[[yarns]]
-start = [0.3, 0.5]
-end = [0.7, 0.5]
-vertices = 60
-"#;
 
 #[test]
 fn stable_dt_is_the_cfl_wave_bound() {
-    let s = scene("", YARN);
+    let s = scene();
     let m = &s.material;
     // 2 mu + lambda = 1.4 E is the stiffest of k, gamma, 1.4 E here.
     assert_eq!(wave_speed(m), (1.4f64 * 1000.0).sqrt());
@@ -72,7 +49,7 @@ fn stable_dt_is_the_cfl_wave_bound() {
 /// Inside the bound a run is quiet; at 4x the bound it diverges.
 #[test]
 fn a_substep_beyond_the_bound_diverges() {
-    let base = scene("", YARN);
+    let base = scene();
     let bound = YarnSim::new(&base).unwrap().stable_dt();
     let run = |dt: f64| {
         let mut s = base.clone();
@@ -96,7 +73,7 @@ fn a_substep_beyond_the_bound_diverges() {
 /// wall projection set it to zero.
 #[test]
 fn divergence_message_reports_the_velocity_that_tripped_the_check() {
-    let mut s = scene("", YARN);
+    let mut s = scene();
     s.gravity = [0.0, -1.0e6];
     s.time.dt = 2e-3.into();
     let mut sim = YarnSim::new(&s).unwrap();

@@ -4,37 +4,31 @@
 
 mod common;
 
-use common::scene;
+use common::{pin_end, pin_vertex, straight, SceneBuilder};
 use yarnsim::math::Vec2;
 use yarnsim::mpm::{PinMotion, SimError};
+use yarnsim::scene::{PinMotionKind, PinSpec, YarnEnd, YarnScene};
 use yarnsim::YarnSim;
 
-fn two_yarns(pins: &str) -> String {
-    format!(
-        r#"
-[grid]
-resolution = 32
-[time]
-dt = 2e-4
-[material]
-k = 1000.0
-gamma = 500.0
-youngs_modulus = 1000.0
-friction = 0.05
-bending = 1e-4
-[walls]
-mode = "none"
-[[yarns]]
-start = [0.25, 0.7]
-end = [0.65, 0.7]
-vertices = 20
-[[yarns]]
-start = [0.3, 0.4]
-end = [0.7, 0.4]
-vertices = 20
-{pins}
-"#
-    )
+/// Two yarns of 20 vertices on a 32^2 grid, plastic, under gravity, with `pins`.
+fn two_yarns(pins: &[PinSpec]) -> YarnScene {
+    pins.iter()
+        .fold(
+            SceneBuilder::bare()
+                .resolution(32)
+                .dt(2e-4)
+                .gravity([0.0, -9.8])
+                .material(|m| m.plasticity = true)
+                .yarn(straight([0.25, 0.7], [0.65, 0.7], 20))
+                .yarn(straight([0.3, 0.4], [0.7, 0.4], 20)),
+            |b, pin| b.pin(pin.clone()),
+        )
+        .build()
+}
+
+/// `pin` moved by `motion`.
+fn moved(motion: PinMotionKind, pin: PinSpec) -> PinSpec {
+    PinSpec { motion, ..pin }
 }
 
 fn bits(sim: &YarnSim) -> Vec<u64> {
@@ -52,12 +46,12 @@ fn bits(sim: &YarnSim) -> Vec<u64> {
 /// the `line` pin's path bit for bit: same trajectory of every particle.
 #[test]
 fn input_pin_set_once_equals_the_line_pin_bitwise() {
-    let line = scene(&two_yarns(
-        "[[pins]]\nyarn = 0\nend = \"start\"\ncount = 2\nmotion = \"line\"\nvelocity = [0.2, -0.1]\n",
-    ));
-    let input = scene(&two_yarns(
-        "[[pins]]\nyarn = 0\nend = \"start\"\ncount = 2\nmotion = \"input\"\n",
-    ));
+    let start = pin_end(0, YarnEnd::Start, 2);
+    let line = two_yarns(&[PinSpec {
+        velocity: Some([0.2, -0.1]),
+        ..moved(PinMotionKind::Line, start.clone())
+    }]);
+    let input = two_yarns(&[moved(PinMotionKind::Input, start)]);
     let mut a = YarnSim::new(&line).unwrap();
     let mut b = YarnSim::new(&input).unwrap();
     let x0 = b.particles().vert.x[0];
@@ -85,7 +79,7 @@ fn input_pin_set_once_equals_the_line_pin_bitwise() {
     assert_eq!(p.vert.x[1] - p.vert.x[0], input_offset(&input));
 }
 
-fn input_offset(s: &yarnsim::scene::YarnScene) -> Vec2 {
+fn input_offset(s: &YarnScene) -> Vec2 {
     let sim = YarnSim::new(s).unwrap();
     sim.particles().vert.x[1] - sim.particles().vert.x[0]
 }
@@ -93,10 +87,8 @@ fn input_offset(s: &yarnsim::scene::YarnScene) -> Vec2 {
 /// Left alone, an input pin is a fixed pin.
 #[test]
 fn input_pin_without_a_target_is_fixed() {
-    let fixed = scene(&two_yarns("[[pins]]\nyarn = 1\nvertex = 9\ncount = 3\n"));
-    let input = scene(&two_yarns(
-        "[[pins]]\nyarn = 1\nvertex = 9\ncount = 3\nmotion = \"input\"\n",
-    ));
+    let fixed = two_yarns(&[pin_vertex(1, 9, 3)]);
+    let input = two_yarns(&[moved(PinMotionKind::Input, pin_vertex(1, 9, 3))]);
     let mut a = YarnSim::new(&fixed).unwrap();
     let mut b = YarnSim::new(&input).unwrap();
     a.steps_n(200).unwrap();
@@ -108,9 +100,7 @@ fn input_pin_without_a_target_is_fixed() {
 /// with the target it was saved with.
 #[test]
 fn input_targets_survive_a_state_round_trip() {
-    let s = scene(&two_yarns(
-        "[[pins]]\nyarn = 0\nend = \"end\"\nmotion = \"input\"\n",
-    ));
+    let s = two_yarns(&[moved(PinMotionKind::Input, pin_end(0, YarnEnd::End, 1))]);
     let mut sim = YarnSim::new(&s).unwrap();
     let x = sim.particles().vert.x[19];
     sim.set_pin_target(0, x, Vec2::new(0.0, 0.3)).unwrap();
@@ -128,9 +118,10 @@ fn input_targets_survive_a_state_round_trip() {
 
 #[test]
 fn bad_pin_targets_are_refused() {
-    let s = scene(&two_yarns(
-        "[[pins]]\nyarn = 0\nend = \"end\"\nmotion = \"input\"\n[[pins]]\nyarn = 1\nend = \"end\"\n",
-    ));
+    let s = two_yarns(&[
+        moved(PinMotionKind::Input, pin_end(0, YarnEnd::End, 1)),
+        pin_end(1, YarnEnd::End, 1),
+    ]);
     let mut sim = YarnSim::new(&s).unwrap();
     let ok = Vec2::new(0.5, 0.5);
     let bad = |r: Result<(), SimError>, what: &str| match r {

@@ -8,8 +8,8 @@ use yarnsim::massspring::{scenes, Integrator, IntegratorOptions, Simulation};
 use yarnsim::math::Mat2;
 use yarnsim::mpm::constitutive::YarnEnergy;
 use yarnsim::mpm::SimError;
-use yarnsim::scene::builtin::reference_material;
 use yarnsim::scene::{Obstacle, WallMode, YarnScene};
+use yarnsim::testing::reference_material;
 use yarnsim::YarnSim;
 
 fn energy() -> YarnEnergy {
@@ -34,7 +34,7 @@ fn random_scene(
     stiffness: f64,
     dt: f64,
 ) -> YarnScene {
-    let mut s = yarnsim::scene::builtin::small_yarn_scene(count, vertices, 64);
+    let mut s = yarnsim::testing::small_yarn_scene(count, vertices, 64);
     // Keep the yarn (and its parallel copies) inside the margin.
     let dir = [angle.cos(), angle.sin()];
     let y = &mut s.yarns[0];

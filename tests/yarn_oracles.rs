@@ -7,9 +7,9 @@
 mod common;
 
 use common::scene;
-use yarnsim::math::{bessel_j0, perp, Mat2, Vec2};
-use yarnsim::scene::builtin::small_yarn_scene;
+use yarnsim::math::{perp, Mat2, Vec2};
 use yarnsim::scene::{SceneError, TransferScheme, WallMode, YarnScene};
+use yarnsim::testing::{bessel_j0, small_yarn_scene};
 use yarnsim::YarnSim;
 
 // ---- capstan ---------------------------------------------------------------

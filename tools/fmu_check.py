@@ -45,6 +45,20 @@ def write_inputs(path, cols):
             fh.write(",".join(repr(float(v)) for v in row) + "\n")
 
 
+def input_signals(path, cols):
+    """The input columns `cols` as fmpy's structured array (booleans for
+    attractor.active), also written to `path` for fmu-replay."""
+    write_inputs(path, cols)
+    dtype = [(name, np.bool_ if name == "attractor.active" else np.double) for name, _ in cols]
+    return np.array(list(zip(*[c for _, c in cols])), dtype=dtype)
+
+
+def time_grid(h, stop):
+    """`(n, t)`: the n communication points 0, h, ..., stop."""
+    n = int(round(stop / h)) + 1
+    return n, np.array([k * h for k in range(n)])
+
+
 def compare(label, result, rust_csv, outputs):
     """Every output of the fmpy run against the Rust run, bit for bit."""
     with open(rust_csv) as fh:
@@ -124,17 +138,21 @@ def state_round_trip(label, path, h, vrs):
     fmu.freeInstance()
 
 
+def validate(path):
+    """fmpy's validation of the FMU at `path`; its problems become failures."""
+    problems = validate_fmu(path)
+    if problems:
+        failures.append(f"{path}: fmpy validation: {problems}")
+    print(f"validate {path}: {len(problems)} problems")
+
+
 # 1. validation
 for f in (small_fmu, ref_fmu, wire_fmu):
-    problems = validate_fmu(f)
-    if problems:
-        failures.append(f"{f}: fmpy validation: {problems}")
-    print(f"validate {f}: {len(problems)} problems")
+    validate(f)
 
 # 2. simulate with an input signal and compare with the Rust side
 H, STOP = 0.01, 0.4
-n = int(round(STOP / H)) + 1
-t = np.array([k * H for k in range(n)])
+n, t = time_grid(H, STOP)
 w = 2 * math.pi * t / 0.4
 cols = [
     ("time", t),
@@ -145,10 +163,8 @@ cols = [
     ("gravity.x", 4.0 * np.sin(3.0 * t)),
     ("gravity.y", -9.8 * np.cos(3.0 * t)),
 ]
-dtype = [(name, np.bool_ if name == "attractor.active" else np.double) for name, _ in cols]
-signals = np.array(list(zip(*[c for _, c in cols])), dtype=dtype)
 in_csv = f"{work}/inputs.csv"
-write_inputs(in_csv, cols)
+signals = input_signals(in_csv, cols)
 
 md = read_model_description(small_fmu)
 outputs = [v.name for v in md.modelVariables if v.causality == "output"]
@@ -189,17 +205,15 @@ if not ok:
 
 # 5. the MassSpring FMU of the wire
 HW, STOPW = 0.05, 1.0
-n = int(round(STOPW / HW)) + 1
-t = np.array([k * HW for k in range(n)])
+n, t = time_grid(HW, STOPW)
 cols = [
     ("time", t),
     ("gravity.x", 3.0 * np.sin(4.0 * t)),
     ("gravity.y", np.full(n, -9.81)),
     ("gravity.z", 2.0 * np.cos(3.0 * t)),
 ]
-signals = np.array(list(zip(*[c for _, c in cols])), dtype=[(name, np.double) for name, _ in cols])
 in_csv = f"{work}/wire_inputs.csv"
-write_inputs(in_csv, cols)
+signals = input_signals(in_csv, cols)
 md = read_model_description(wire_fmu)
 outputs = [v.name for v in md.modelVariables if v.causality == "output"]
 for integrator in ("backward-euler", "symplectic-euler"):
@@ -212,13 +226,9 @@ vrs = [v.valueReference for v in md.modelVariables if v.causality == "output" an
 state_round_trip("MassSpring (wire)", wire_fmu, HW, vrs)
 
 # 6. a driven yarn end from an input table
-problems = validate_fmu(driven_fmu)
-if problems:
-    failures.append(f"{driven_fmu}: fmpy validation: {problems}")
-print(f"validate {driven_fmu}: {len(problems)} problems")
+validate(driven_fmu)
 HD, STOPD = 0.01, 0.3
-n = int(round(STOPD / HD)) + 1
-t = np.array([k * HD for k in range(n)])
+n, t = time_grid(HD, STOPD)
 w = 2 * math.pi / 0.3
 cols = [
     ("time", t),
@@ -233,10 +243,8 @@ cols = [
     ("pin[0].vx", 0.05 * w * np.cos(w * t)),
     ("pin[0].vy", np.full(n, 0.1)),
 ]
-dtype = [(name, np.bool_ if name == "attractor.active" else np.double) for name, _ in cols]
-signals = np.array(list(zip(*[c for _, c in cols])), dtype=dtype)
 in_csv = f"{work}/driven_inputs.csv"
-write_inputs(in_csv, cols)
+signals = input_signals(in_csv, cols)
 md = read_model_description(driven_fmu)
 outputs = [v.name for v in md.modelVariables if v.causality == "output"]
 for name in ("pin[0].force.x", "pin[0].force.y", "pin[1].force.x", "pin[1].force.y"):

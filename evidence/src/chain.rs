@@ -39,13 +39,13 @@ use std::time::Instant;
 
 use crate::plot::{LinePlot, Marker, Series};
 use crate::{num, Table};
-use yarnsim::math::bessel_j0;
 use yarnsim::mpm::timestep::wave_speed;
 use yarnsim::mpm::YarnSim;
 use yarnsim::scene::{
     GridSpec, Material, PinSpec, StepSize, TimeSpec, TransferScheme, TransferSpec, WallMode, Walls,
     YarnEnd, YarnScene, YarnSpec, DEFAULT_SAFETY,
 };
+use yarnsim::testing::bessel_j0;
 
 /// First zero of `J0`.
 pub const J01: f64 = 2.404_825_557_695_773;

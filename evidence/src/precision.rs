@@ -62,6 +62,23 @@ pub struct Run {
     pub status: String,
 }
 
+impl Run {
+    /// A run of `method` on `scene` at step `dt`, from its
+    /// `(error, wall, steps, status)`.
+    fn new(scene: &str, method: &str, dt: f64, outcome: (f64, f64, u64, String)) -> Run {
+        let (error, wall, steps, status) = outcome;
+        Run {
+            scene: scene.into(),
+            method: method.into(),
+            dt,
+            steps,
+            wall,
+            error,
+            status,
+        }
+    }
+}
+
 /// One scene's results.
 #[derive(Clone, Debug)]
 pub struct SceneResult {
@@ -208,27 +225,18 @@ fn massspring_scene(
     let mut runs = Vec::new();
     for (mname, integ, opt) in methods {
         for &h in &hs {
-            let (error, wall, steps, status) =
-                match run_massspring(sys, integ, opt.clone(), h, t_end) {
-                    Ok((x, wall, n)) => {
-                        let e = max_diff(&x, &x_ref) / scale;
-                        if e.is_finite() && e < 10.0 {
-                            (e, wall, n, "ok".to_string())
-                        } else {
-                            (f64::NAN, wall, n, "unbounded (error > 10x extent)".into())
-                        }
+            let outcome = match run_massspring(sys, integ, opt.clone(), h, t_end) {
+                Ok((x, wall, n)) => {
+                    let e = max_diff(&x, &x_ref) / scale;
+                    if e.is_finite() && e < 10.0 {
+                        (e, wall, n, "ok".to_string())
+                    } else {
+                        (f64::NAN, wall, n, "unbounded (error > 10x extent)".into())
                     }
-                    Err(e) => (f64::NAN, f64::NAN, 0, e),
-                };
-            runs.push(Run {
-                scene: name.into(),
-                method: mname.clone(),
-                dt: h,
-                steps,
-                wall,
-                error,
-                status,
-            });
+                }
+                Err(e) => (f64::NAN, f64::NAN, 0, e),
+            };
+            runs.push(Run::new(name, &mname, h, outcome));
         }
     }
     Ok(SceneResult {
@@ -259,19 +267,11 @@ fn yarn_scene(
     let ref_err = max_diff(&x_ref, &x_ref2) / scale;
     let mut runs = Vec::new();
     for &h in &hs {
-        let (error, wall, steps, status) = match run_yarn(scene, h, t_end) {
+        let outcome = match run_yarn(scene, h, t_end) {
             Ok((x, wall, n)) => (max_diff(&x, &x_ref) / scale, wall, n, "ok".to_string()),
             Err(e) => (f64::NAN, f64::NAN, 0, e),
         };
-        runs.push(Run {
-            scene: name.into(),
-            method: "mpm".into(),
-            dt: h,
-            steps,
-            wall,
-            error,
-            status,
-        });
+        runs.push(Run::new(name, "mpm", h, outcome));
     }
     Ok(SceneResult {
         scene: name.into(),

@@ -26,7 +26,8 @@ use yarnsim::massspring::integrators::stability::analyze;
 use yarnsim::massspring::{scenes, Integrator, IntegratorOptions, Simulation, System};
 use yarnsim::math::Vec2;
 use yarnsim::mpm::{Attractor, YarnSim};
-use yarnsim::scene::{builtin::small_yarn_scene, YarnScene};
+use yarnsim::scene::YarnScene;
+use yarnsim::testing::small_yarn_scene;
 
 /// Simulated time of one probe run, in s.
 pub const PROBE_TIME: f64 = 0.5;

@@ -22,6 +22,28 @@ fn cdylib_path() -> PathBuf {
         .unwrap_or_else(|| panic!("{name} was not built next to {}", deps.display()))
 }
 
+/// The bytes that stand in for the FMU's library in an archive.
+const STAND_IN: &[u8] = b"\x7fELF not really";
+
+/// The archive of `scene` around [`STAND_IN`] and its entries, checked to
+/// be the FMI 2.0 layout with the library `binaries/linux64/{library}.so`.
+fn archive(scene: &Scene, library: &str) -> (Vec<u8>, Vec<(String, Vec<u8>)>) {
+    let zip = build_fmu(scene, STAND_IN).unwrap();
+    let entries = zip_entries(&zip).unwrap();
+    let names: Vec<&str> = entries.iter().map(|(n, _)| n.as_str()).collect();
+    let library = format!("binaries/linux64/{library}.so");
+    assert_eq!(
+        names,
+        [
+            "modelDescription.xml",
+            library.as_str(),
+            "resources/scene.toml",
+            "documentation/index.html"
+        ]
+    );
+    (zip, entries)
+}
+
 fn small_scene() -> YarnScene {
     YarnScene::from_toml_str(include_str!("../../fmu/scenes/small.toml")).unwrap()
 }
@@ -62,25 +84,13 @@ fn shared_library_exports_all_34_functions_and_needs_only_libc() {
 #[test]
 fn fmu_archive_layout_and_contents() {
     let scene = small_scene();
-    let so = b"\x7fELF not really".to_vec();
-    let zip = build_fmu(&scene.clone().into(), &so).unwrap();
-    let entries = zip_entries(&zip).unwrap();
-    let names: Vec<&str> = entries.iter().map(|(n, _)| n.as_str()).collect();
-    assert_eq!(
-        names,
-        [
-            "modelDescription.xml",
-            "binaries/linux64/YarnBundle.so",
-            "resources/scene.toml",
-            "documentation/index.html"
-        ]
-    );
+    let (zip, entries) = archive(&scene.clone().into(), "YarnBundle");
     assert_eq!(entries[0].1, model_description(&scene).into_bytes());
-    assert_eq!(entries[1].1, so);
+    assert_eq!(entries[1].1, STAND_IN);
     let packed = YarnScene::from_toml_str(std::str::from_utf8(&entries[2].1).unwrap()).unwrap();
     assert_eq!(guid(&packed), guid(&scene));
     // Reproducible: the same inputs give the same bytes.
-    assert_eq!(build_fmu(&scene.clone().into(), &so).unwrap(), zip);
+    assert_eq!(build_fmu(&scene.clone().into(), STAND_IN).unwrap(), zip);
     // A corrupted archive is detected.
     let mut bad = zip.clone();
     let at = zip.windows(4).position(|w| w == b"kind").unwrap();
@@ -97,21 +107,8 @@ fn crc32_known_value() {
 #[test]
 fn mass_spring_archive_layout() {
     let scene = Scene::MassSpring(wire());
-    let so = b"\x7fELF not really".to_vec();
-    let zip = build_fmu(&scene, &so).unwrap();
-    let entries = zip_entries(&zip).unwrap();
-    let names: Vec<&str> = entries.iter().map(|(n, _)| n.as_str()).collect();
-    assert_eq!(
-        names,
-        [
-            "modelDescription.xml",
-            "binaries/linux64/MassSpring.so",
-            "resources/scene.toml",
-            "documentation/index.html"
-        ]
-    );
-    let packed =
-        YarnBundle::scene_from_toml_str(std::str::from_utf8(&entries[2].1).unwrap()).unwrap();
+    let (_, entries) = archive(&scene, "MassSpring");
+    let packed = YarnBundle::scene_from_toml_str(std::str::from_utf8(&entries[2].1).unwrap()).unwrap();
     assert_eq!(packed.guid(), scene.guid());
     let doc = String::from_utf8(entries[3].1.clone()).unwrap();
     assert!(doc.contains("particle[10].x") && doc.contains("mass-spring"));

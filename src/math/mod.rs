@@ -15,24 +15,6 @@ pub fn perp(v: Vec2) -> Vec2 {
     Vec2::new(-v.y, v.x)
 }
 
-/// `J0(x)`, the Bessel function of the first kind of order 0, by its power
-/// series `sum_k (-1)^k (x/2)^(2k) / (k!)^2` (to round-off for `|x| <= 10`):
-/// the mode shapes of the hanging chain, the oracle of the yarn tests and of
-/// the work-precision study.
-pub fn bessel_j0(x: f64) -> f64 {
-    let q = -(x * x) / 4.0;
-    let mut term = 1.0;
-    let mut sum = 1.0;
-    for k in 1..60 {
-        term *= q / (k * k) as f64;
-        sum += term;
-        if term.abs() < 1e-17 * sum.abs().max(1e-300) {
-            break;
-        }
-    }
-    sum
-}
-
 /// The 2D cross product `a.x b.y - a.y b.x`.
 #[inline]
 pub fn cross(a: Vec2, b: Vec2) -> f64 {

@@ -61,7 +61,10 @@ impl std::fmt::Display for StateError {
 
 impl std::error::Error for StateError {}
 
-/// 64-bit FNV-1a.
+/// 64-bit FNV-1a (Fowler, Noll, Vo): the checksum of the saved state's
+/// payload, and so part of the state format, not a test helper. Public
+/// because the FMU's state bytes carry the same checksum and its GUID is
+/// derived with it.
 pub fn fnv1a(bytes: &[u8]) -> u64 {
     let mut h: u64 = 0xcbf29ce484222325;
     for &b in bytes {

@@ -131,32 +131,51 @@ pub fn bending_energy(v: &Vertices, bending: f64) -> f64 {
 mod tests {
     use super::*;
     use crate::mpm::particles::Particles;
-    use crate::scene::YarnScene;
+    use crate::scene::{builtin::yarn_reference, Material, YarnScene, YarnSpec};
+
+    /// The reference scene's settings on a 64^2 grid at dt 1e-4, without
+    /// obstacles, holding `yarns` of a fibre with `[k, gamma, E] = fibre`, no
+    /// friction, and `bending`.
+    fn scene(fibre: [f64; 3], bending: f64, yarns: Vec<YarnSpec>) -> YarnScene {
+        let mut s = yarn_reference();
+        s.name.clear();
+        s.description.clear();
+        s.grid.resolution = 64;
+        s.time.dt = 1e-4.into();
+        s.material = Material {
+            k: fibre[0],
+            gamma: fibre[1],
+            youngs_modulus: fibre[2],
+            friction: 0.0,
+            bending,
+            ..s.material
+        };
+        s.obstacles.clear();
+        s.yarns = yarns;
+        s.validate().unwrap();
+        s
+    }
+
+    /// A yarn along the polyline `points` with `vertices` vertices.
+    fn polyline(points: &[[f64; 2]], vertices: u32) -> YarnSpec {
+        YarnSpec {
+            points: Some(points.to_vec()),
+            vertices,
+            count: 1,
+            ..Default::default()
+        }
+    }
 
     /// A curved yarn (rest curvature) bent further, with random offsets.
     fn bent_vertices() -> crate::mpm::particles::Vertices {
-        let scene = YarnScene::from_toml_str(
-            r#"
-[grid]
-resolution = 64
-[time]
-dt = 1e-4
-[material]
-k = 1000.0
-gamma = 500.0
-youngs_modulus = 1000.0
-friction = 0.0
-bending = 0.01
-[[yarns]]
-points = [[0.2, 0.3], [0.4, 0.45], [0.6, 0.4], [0.7, 0.6]]
-vertices = 30
-[[yarns]]
-start = [0.2, 0.8]
-end = [0.8, 0.8]
-vertices = 12
-"#,
-        )
-        .unwrap();
+        let scene = scene(
+            [1000.0, 500.0, 1000.0],
+            0.01,
+            vec![
+                polyline(&[[0.2, 0.3], [0.4, 0.45], [0.6, 0.4], [0.7, 0.6]], 30),
+                YarnSpec::straight([0.2, 0.8], [0.8, 0.8], 12),
+            ],
+        );
         let mut p = Particles::from_scene(&scene);
         let l = p.quad.l0[0];
         for (i, x) in p.vert.x.iter_mut().enumerate() {
@@ -201,24 +220,11 @@ vertices = 12
 
     #[test]
     fn straight_rest_yarn_has_no_bending_energy_or_force() {
-        let scene = YarnScene::from_toml_str(
-            r#"
-[grid]
-resolution = 64
-[time]
-dt = 1e-4
-[material]
-k = 1.0
-gamma = 1.0
-youngs_modulus = 1.0
-friction = 0.0
-bending = 1.0
-[[yarns]]
-points = [[0.2, 0.3], [0.5, 0.5], [0.7, 0.4]]
-vertices = 20
-"#,
-        )
-        .unwrap();
+        let scene = scene(
+            [1.0; 3],
+            1.0,
+            vec![polyline(&[[0.2, 0.3], [0.5, 0.5], [0.7, 0.4]], 20)],
+        );
         let p = Particles::from_scene(&scene);
         // curved at rest: zero energy and force at rest, whatever the shape
         assert_eq!(bending_energy(&p.vert, 1.0), 0.0);

@@ -43,7 +43,7 @@ pub fn builtin(name: &str) -> Option<Scene> {
 }
 
 /// The material of the reference scene.
-pub fn reference_material() -> Material {
+fn reference_material() -> Material {
     Material {
         k: 1000.0,
         gamma: 500.0,
@@ -131,59 +131,4 @@ pub fn yarn_drape() -> YarnScene {
     }];
     s.yarns = vec![YarnSpec::straight([0.15, 0.55], [0.85, 0.85], 400)];
     s
-}
-
-/// A small yarn scene for quick measurements: `yarns` yarns of `vertices`
-/// vertices (0.8 m long, 0.02 m apart) on a `resolution`^2 grid over 1 m,
-/// falling from y = 0.75 onto one circle (centre (0.5, 0.55), radius 0.1),
-/// reference material, gravity -9.8, sticky walls, dt 1e-4. Used by the
-/// evidence studies (`yarnsim-evidence`) and by the library's own tests.
-pub fn small_yarn_scene(yarns: u32, vertices: u32, resolution: u32) -> YarnScene {
-    YarnScene {
-        kind: "yarn".into(),
-        name: "yarn-small".into(),
-        description: format!(
-            "{yarns} yarns x {vertices} vertices on {resolution}^2 falling onto one circle"
-        ),
-        grid: GridSpec {
-            resolution,
-            size: 1.0,
-        },
-        time: TimeSpec {
-            dt: StepSize::Fixed(1e-4),
-            safety: None,
-            dt_max: None,
-            frame_dt: 1.0 / 60.0,
-        },
-        material: reference_material(),
-        gravity: [0.0, -9.8],
-        attractor: Default::default(),
-        walls: Default::default(),
-        obstacles: vec![Obstacle {
-            center: [0.5, 0.55],
-            radius: 0.1,
-            friction: 0.3,
-        }],
-        transfer: Default::default(),
-        pins: Vec::new(),
-        yarns: vec![YarnSpec {
-            start: Some([0.1, 0.75]),
-            direction: Some([1.0, 0.0]),
-            length: Some(0.8),
-            vertices,
-            count: yarns,
-            spacing: [0.0, 0.02],
-            ..Default::default()
-        }],
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn small_scene_is_valid() {
-        small_yarn_scene(2, 40, 64).validate().unwrap();
-    }
 }

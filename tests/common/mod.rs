@@ -1,7 +1,11 @@
 //! Shared helpers of the integration tests.
 #![allow(dead_code)]
 
-use yarnsim::scene::YarnScene;
+use yarnsim::scene::{
+    AttractorSpec, GridSpec, Material, Obstacle, PinMotionKind, PinSpec, StepSize, TimeSpec,
+    TransferScheme, TransferSpec, WallMode, Walls, YarnEnd, YarnScene, YarnSpec,
+};
+use yarnsim::YarnSim;
 
 /// A small deterministic generator (xorshift64*), so tests need no `rand`.
 pub struct Rng(u64);
@@ -24,31 +28,201 @@ impl Rng {
     }
 }
 
+/// The scale of momentum errors: `sum m |v|` over every particle.
+pub fn momentum_scale(sim: &YarnSim) -> f64 {
+    let p = sim.particles();
+    p.vert
+        .v
+        .iter()
+        .zip(&p.vert.m)
+        .chain(p.quad.v.iter().zip(&p.quad.m))
+        .map(|(v, m)| m * v.norm())
+        .sum()
+}
+
 /// A yarn scene from TOML text; panics with the loader's message on error.
 pub fn scene(text: &str) -> YarnScene {
     YarnScene::from_toml_str(text).unwrap_or_else(|e| panic!("{e}"))
 }
 
-/// A 64^2 scene without gravity, walls, obstacles or plasticity; `yarns` is
-/// the `[[yarns]]` part.
+/// The bare test scene of [`SceneBuilder::bare`] with its `[[yarns]]` given
+/// as TOML text, read by the scene loader.
 pub fn bare_scene(yarns: &str) -> YarnScene {
-    scene(&format!(
-        r#"
-gravity = [0.0, 0.0]
-[grid]
-resolution = 64
-[time]
-dt = 1e-4
-[material]
-k = 1000.0
-gamma = 500.0
-youngs_modulus = 1000.0
-friction = 0.05
-bending = 1e-4
-plasticity = false
-[walls]
-mode = "none"
-{yarns}
-"#
-    ))
+    let text = SceneBuilder::bare()
+        .yarn(straight([0.3, 0.5], [0.7, 0.5], 10))
+        .build()
+        .to_toml_string();
+    let head = &text[..text.find("[[yarns]]").expect("the scene has a yarn")];
+    scene(&format!("{head}{yarns}"))
+}
+
+/// A straight yarn from `start` to `end` with `vertices` vertices.
+pub fn straight(start: [f64; 2], end: [f64; 2], vertices: u32) -> YarnSpec {
+    YarnSpec::straight(start, end, vertices)
+}
+
+/// A yarn along the polyline `points`, resampled to `vertices` vertices.
+pub fn polyline(points: &[[f64; 2]], vertices: u32) -> YarnSpec {
+    YarnSpec {
+        points: Some(points.to_vec()),
+        vertices,
+        count: 1,
+        ..YarnSpec::default()
+    }
+}
+
+/// `count` parallel copies of a straight yarn, each `spacing` from the last.
+pub fn bundle(
+    start: [f64; 2],
+    end: [f64; 2],
+    vertices: u32,
+    count: u32,
+    spacing: [f64; 2],
+) -> YarnSpec {
+    YarnSpec {
+        count,
+        spacing,
+        ..straight(start, end, vertices)
+    }
+}
+
+/// A fixed pin of `count` vertices of yarn `yarn` from its `end`.
+pub fn pin_end(yarn: u32, end: YarnEnd, count: u32) -> PinSpec {
+    PinSpec {
+        yarn,
+        end: Some(end),
+        vertex: None,
+        count,
+        motion: PinMotionKind::Fixed,
+        velocity: None,
+        center: None,
+        angular_velocity: None,
+    }
+}
+
+/// A fixed pin of `count` vertices of yarn `yarn` from index `vertex` on.
+pub fn pin_vertex(yarn: u32, vertex: u32, count: u32) -> PinSpec {
+    PinSpec {
+        end: None,
+        vertex: Some(vertex),
+        ..pin_end(yarn, YarnEnd::Start, count)
+    }
+}
+
+/// Test scenes without TOML text: [`SceneBuilder::bare`] and the settings
+/// tests vary; [`SceneBuilder::build`] validates like the scene loader.
+#[derive(Clone, Debug)]
+pub struct SceneBuilder(YarnScene);
+
+impl SceneBuilder {
+    /// A 64^2 grid over 1 m without gravity, walls, obstacles or
+    /// plasticity: dt 1e-4, k 1000, gamma 500, E 1000, friction 0.05,
+    /// bending 1e-4, density 1, FLIP (the default transfer); no
+    /// yarns yet.
+    pub fn bare() -> Self {
+        SceneBuilder(YarnScene {
+            kind: "yarn".into(),
+            name: String::new(),
+            description: String::new(),
+            grid: GridSpec {
+                resolution: 64,
+                size: 1.0,
+            },
+            time: TimeSpec {
+                dt: StepSize::Fixed(1e-4),
+                safety: None,
+                dt_max: None,
+                frame_dt: 1.0 / 60.0,
+            },
+            material: Material {
+                k: 1000.0,
+                gamma: 500.0,
+                youngs_modulus: 1000.0,
+                friction: 0.05,
+                bending: 1e-4,
+                density: 1.0,
+                plasticity: false,
+            },
+            gravity: [0.0, 0.0],
+            attractor: AttractorSpec::default(),
+            walls: Walls {
+                mode: WallMode::None,
+                ..Walls::default()
+            },
+            obstacles: Vec::new(),
+            transfer: TransferSpec::default(),
+            yarns: Vec::new(),
+            pins: Vec::new(),
+        })
+    }
+
+    /// `n`^2 grid cells.
+    pub fn resolution(mut self, n: u32) -> Self {
+        self.0.grid.resolution = n;
+        self
+    }
+
+    /// The substep: a size in s or [`StepSize::Auto`].
+    pub fn dt(mut self, dt: impl Into<StepSize>) -> Self {
+        self.0.time.dt = dt.into();
+        self
+    }
+
+    /// Output frame interval in s.
+    pub fn frame_dt(mut self, frame_dt: f64) -> Self {
+        self.0.time.frame_dt = frame_dt;
+        self
+    }
+
+    /// Gravity `[gx, gy]` in m/s^2.
+    pub fn gravity(mut self, g: [f64; 2]) -> Self {
+        self.0.gravity = g;
+        self
+    }
+
+    /// Changes the material.
+    pub fn material(mut self, edit: impl FnOnce(&mut Material)) -> Self {
+        edit(&mut self.0.material);
+        self
+    }
+
+    /// The boundary condition at the domain edges.
+    pub fn walls(mut self, mode: WallMode) -> Self {
+        self.0.walls.mode = mode;
+        self
+    }
+
+    /// The transfer scheme (APIC or FLIP).
+    pub fn scheme(mut self, scheme: TransferScheme) -> Self {
+        self.0.transfer.scheme = scheme;
+        self
+    }
+
+    /// Adds a circular obstacle.
+    pub fn obstacle(mut self, center: [f64; 2], radius: f64, friction: f64) -> Self {
+        self.0.obstacles.push(Obstacle {
+            center,
+            radius,
+            friction,
+        });
+        self
+    }
+
+    /// Adds a `[[yarns]]` entry.
+    pub fn yarn(mut self, yarn: YarnSpec) -> Self {
+        self.0.yarns.push(yarn);
+        self
+    }
+
+    /// Adds a `[[pins]]` entry.
+    pub fn pin(mut self, pin: PinSpec) -> Self {
+        self.0.pins.push(pin);
+        self
+    }
+
+    /// The scene, validated; panics with the validator's message.
+    pub fn build(self) -> YarnScene {
+        self.0.validate().unwrap_or_else(|e| panic!("{e}"));
+        self.0
+    }
 }

@@ -227,6 +227,15 @@ def bad(write_sweep, text, preflight=False):
     return str(err.value)
 
 
+def refused(write_sweep, text, prefix, *parts, preflight=False):
+    """Asserts that the sweep `text` is refused with a message that starts
+    with `prefix` and contains every one of `parts`."""
+    msg = bad(write_sweep, text, preflight=preflight)
+    assert msg.startswith(prefix), msg
+    for part in parts:
+        assert part in msg, msg
+
+
 HEAD = """
 fmu = "{fmu}"
 stop_time = 0.5
@@ -238,49 +247,34 @@ total_energy = ["final"]
 
 def test_unknown_names_are_refused_naming_the_field(wire_fmu, write_sweep):
     h = HEAD.format(fmu=wire_fmu)
-    msg = bad(write_sweep, h + '[parameters]\n"dtt" = [0.001]\n')
-    assert msg.startswith("parameters.dtt:") and "no parameter named 'dtt'" in msg and "integrator" in msg
-    msg = bad(write_sweep, h + '[inputs]\n"gravity.w" = [1.0]\n')
-    assert msg.startswith('inputs."gravity.w":') and "no input named" in msg and "gravity.x" in msg
-    msg = bad(write_sweep, h + '[parameters]\n"gravity.x" = [1.0]\n')
-    assert msg.startswith('parameters."gravity.x":') and "is an input, expected parameter" in msg
-    msg = bad(write_sweep, h.replace("total_energy", "total_enrgy") + '[parameters]\ndt = [0.001]\n')
-    assert msg.startswith("outputs.total_enrgy:") and "no variable named" in msg
-    msg = bad(write_sweep, h.replace('["final"]', '["last"]') + '[parameters]\ndt = [0.001]\n')
-    assert msg.startswith("outputs.total_energy:") and "unknown reduction 'last'" in msg
-    msg = bad(write_sweep, h + '[signals]\ntime = [0.0, 1.0]\n"gravity.q" = [0.0, 1.0]\n[parameters]\ndt = [0.001]\n')
-    assert msg.startswith('signals."gravity.q":')
-    msg = bad(write_sweep, h + '[parameters]\nintegrator = [3]\n')
-    assert msg.startswith("parameters.integrator[0]:") and "String" in msg
+    refused(write_sweep, h + '[parameters]\n"dtt" = [0.001]\n', "parameters.dtt:", "no parameter named 'dtt'", "integrator")
+    refused(write_sweep, h + '[inputs]\n"gravity.w" = [1.0]\n', 'inputs."gravity.w":', "no input named", "gravity.x")
+    refused(write_sweep, h + '[parameters]\n"gravity.x" = [1.0]\n', 'parameters."gravity.x":', "is an input, expected parameter")
+    refused(write_sweep, h.replace("total_energy", "total_enrgy") + '[parameters]\ndt = [0.001]\n', "outputs.total_enrgy:", "no variable named")
+    refused(write_sweep, h.replace('["final"]', '["last"]') + '[parameters]\ndt = [0.001]\n', "outputs.total_energy:", "unknown reduction 'last'")
+    refused(write_sweep, h + '[signals]\ntime = [0.0, 1.0]\n"gravity.q" = [0.0, 1.0]\n[parameters]\ndt = [0.001]\n', 'signals."gravity.q":')
+    refused(write_sweep, h + '[parameters]\nintegrator = [3]\n', "parameters.integrator[0]:", "String")
 
 
 def test_values_outside_the_range_are_refused_before_running(wire_fmu, small_fmu, write_sweep):
     h = HEAD.format(fmu=wire_fmu)
-    msg = bad(write_sweep, h + '[inputs]\n"gravity.x" = [0.0, 2e6]\n', preflight=True)
-    assert msg.startswith('inputs."gravity.x":') and "2000000.0" in msg
-    msg = bad(write_sweep, h + '[parameters]\nintegrator = ["backward-euler", "rk4"]\n', preflight=True)
-    assert msg.startswith("parameters.integrator:") and "'rk4'" in msg
-    msg = bad(write_sweep, h + '[parameters]\ndt = [0.001, -1.0]\n', preflight=True)
-    assert msg.startswith("parameters.dt:") and "-1.0" in msg
-    msg = bad(write_sweep, HEAD.format(fmu=small_fmu).replace("total_energy", "kinetic_energy")
-              + '[parameters]\n"material.friction" = [0.1, -0.5]\n', preflight=True)
-    assert msg.startswith('parameters."material.friction":') and "-0.5" in msg
-    msg = bad(write_sweep, h + '[parameters]\ndt = { start = 0.0, stop = 0.01, num = 0 }\n')
-    assert msg.startswith("parameters.dt.num:")
-    msg = bad(write_sweep, h + '[parameters]\ndt = { min = 0.0, max = 0.01 }\n')
-    assert msg.startswith("parameters.dt:") and "lhs" in msg
+    refused(write_sweep, h + '[inputs]\n"gravity.x" = [0.0, 2e6]\n', 'inputs."gravity.x":', "2000000.0", preflight=True)
+    refused(write_sweep, h + '[parameters]\nintegrator = ["backward-euler", "rk4"]\n', "parameters.integrator:", "'rk4'", preflight=True)
+    refused(write_sweep, h + '[parameters]\ndt = [0.001, -1.0]\n', "parameters.dt:", "-1.0", preflight=True)
+    refused(write_sweep, HEAD.format(fmu=small_fmu).replace("total_energy", "kinetic_energy")
+            + '[parameters]\n"material.friction" = [0.1, -0.5]\n', 'parameters."material.friction":', "-0.5",
+            preflight=True)
+    refused(write_sweep, h + '[parameters]\ndt = { start = 0.0, stop = 0.01, num = 0 }\n', "parameters.dt.num:")
+    refused(write_sweep, h + '[parameters]\ndt = { min = 0.0, max = 0.01 }\n', "parameters.dt:", "lhs")
 
 
 def test_empty_sweep_and_missing_fmu(wire_fmu, write_sweep, tmp_path):
     h = HEAD.format(fmu=wire_fmu)
-    assert bad(write_sweep, h).startswith("parameters/inputs: the sweep is empty")
-    assert bad(write_sweep, h + "[parameters]\ndt = []\n").startswith("parameters.dt: empty list")
-    msg = bad(write_sweep, 'design = "lhs"\nsamples = 0\n' + h + "[parameters]\ndt = { min = 0.001, max = 0.002 }\n")
-    assert msg.startswith("samples:")
-    msg = bad(write_sweep, HEAD.format(fmu=str(tmp_path / "nope.fmu")) + "[parameters]\ndt = [0.001]\n")
-    assert msg.startswith("fmu:") and "nope.fmu: no such file" in msg
-    msg = bad(write_sweep, h.replace('fmu = "' + wire_fmu + '"', "") + "[parameters]\ndt = [0.001]\n")
-    assert msg.startswith("fmu: missing")
+    refused(write_sweep, h, "parameters/inputs: the sweep is empty")
+    refused(write_sweep, h + "[parameters]\ndt = []\n", "parameters.dt: empty list")
+    refused(write_sweep, 'design = "lhs"\nsamples = 0\n' + h + "[parameters]\ndt = { min = 0.001, max = 0.002 }\n", "samples:")
+    refused(write_sweep, HEAD.format(fmu=str(tmp_path / "nope.fmu")) + "[parameters]\ndt = [0.001]\n", "fmu:", "nope.fmu: no such file")
+    refused(write_sweep, h.replace('fmu = "' + wire_fmu + '"', "") + "[parameters]\ndt = [0.001]\n", "fmu: missing")
 
 
 def test_unreachable_scheduler_times_out_with_the_address():
