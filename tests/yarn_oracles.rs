@@ -52,28 +52,63 @@ fn capstan_threshold(r: f64, l1: f64, l2: f64) -> f64 {
     0.5 * (lo + hi)
 }
 
-/// Grid of the capstan scenes.
-const CAPSTAN_RES: u32 = 128;
-/// Gravity of the capstan scenes (the threshold does not depend on it; a
-/// small one keeps the elastic stretch and the time step small and large).
-const CAPSTAN_G: f64 = 2.0;
+/// Resolution, time step, gravity and material of a capstan scene.
+#[derive(Clone, Copy, Debug)]
+struct Capstan {
+    res: u32,
+    dt: f64,
+    /// Gravity (the threshold does not depend on it).
+    g: f64,
+    gamma: f64,
+    youngs_modulus: f64,
+    friction: f64,
+    bending: f64,
+    plasticity: bool,
+}
 
-/// Material: a pure string. Bending 0 (all the resistance is friction),
-/// k = 1000 (strain below 0.1 %), plasticity off, and no cross-section
-/// energy (gamma = 0, E = 0). Measured on this contact law with the
-/// cross-section on: gamma 500, E 1000 holds at 1.1 mu* but the free end's
-/// cross-section grows without bound (r22 > 1 has no energy) until the shear
-/// stiffness, which scales with it, diverges (t = 1.19 s at 1.4 mu*, R 0.1,
-/// l2 0.3); gamma 0, E 1000 creeps at 1.4 mu* (3e-3 l1 in 1 s, kinetic energy
-/// growing): the cross-section pressure pushes the outer grid nodes of the
-/// yarn outward, where the Coulomb law (on inward velocity only) gives them
-/// no friction, and without shear nothing ties that layer to the held one.
-/// With E = 0 it holds firmly at 1.1 mu* (kinetic energy 3e-8).
-///
-/// A bending-free yarn over a half circle of radius `r` centred at
-/// (0.5, 0.75), hanging `l1` on the left and `l2` on the right, on a
-/// circle with friction `mu`.
-fn capstan_scene(r: f64, l1: f64, l2: f64, mu: f64) -> YarnScene {
+/// Material: a pure string at 128^2, dt 1e-4. Bending 0 (all the
+/// resistance is friction), k = 1000 (strain below 0.1 %), plasticity off,
+/// and no cross-section energy (gamma = 0, E = 0); a small gravity keeps the
+/// elastic stretch small.
+const PURE_STRING: Capstan = Capstan {
+    res: 128,
+    dt: 1e-4,
+    g: 2.0,
+    gamma: 0.0,
+    youngs_modulus: 0.0,
+    friction: 0.0,
+    bending: 0.0,
+    plasticity: false,
+};
+
+/// The material of every built-in scene (`reference_material`) without its
+/// bending: k = 1000, gamma = 500, E = 1000, fibre friction 0.05,
+/// plasticity on; at the test resolution 128^2, dt 1e-4, and g = 2 m/s^2
+/// as for the string: the elastic stretch of the wrapped arc under g = 9.8
+/// (T pi R / k = 9e-4 m at l2 = 0.3) is 0.9 % of l1, and its undamped
+/// oscillation alone reads as a slip (measured: R 0.1, l2 / l1 = 2 then
+/// crosses at +18 %, the other five cases at +9.4 %).
+const BUILTIN: Capstan = Capstan {
+    res: 128,
+    dt: 1e-4,
+    g: 2.0,
+    gamma: 500.0,
+    youngs_modulus: 1000.0,
+    friction: 0.05,
+    bending: 0.0,
+    plasticity: true,
+};
+
+/// [`BUILTIN`] at the resolution of the built-in scenes, 256^2, dt 4e-5.
+const BUILTIN_256: Capstan = Capstan {
+    res: 256,
+    dt: 4e-5,
+    ..BUILTIN
+};
+
+/// A yarn over a half circle of radius `r` centred at (0.5, 0.75), hanging
+/// `l1` on the left and `l2` on the right, on a circle with friction `mu`.
+fn capstan_scene(r: f64, l1: f64, l2: f64, mu: f64, c: &Capstan) -> YarnScene {
     let (cx, cy) = (0.5, 0.75);
     let mut pts = vec![[cx - r, cy - l1]];
     let arc = 64;
@@ -83,7 +118,7 @@ fn capstan_scene(r: f64, l1: f64, l2: f64, mu: f64) -> YarnScene {
     }
     pts.push([cx + r, cy - l2]);
     let length = l1 + l2 + std::f64::consts::PI * r;
-    let dx = 1.0 / CAPSTAN_RES as f64;
+    let dx = 1.0 / c.res as f64;
     // vertex spacing about dx / 2
     let vertices = (length / (0.5 * dx)).round() as u32 + 1;
     let points = pts
@@ -93,18 +128,18 @@ fn capstan_scene(r: f64, l1: f64, l2: f64, mu: f64) -> YarnScene {
         .join(", ");
     scene(&format!(
         r#"
-gravity = [0.0, -{CAPSTAN_G}]
+gravity = [0.0, -{}]
 [grid]
-resolution = {CAPSTAN_RES}
+resolution = {}
 [time]
-dt = 1e-4
+dt = {}
 [material]
 k = 1000.0
-gamma = 0.0
-youngs_modulus = 0.0
-friction = 0.0
-bending = 0.0
-plasticity = false
+gamma = {}
+youngs_modulus = {}
+friction = {}
+bending = {}
+plasticity = {}
 [walls]
 mode = "none"
 [[obstacles]]
@@ -114,7 +149,8 @@ friction = {mu}
 [[yarns]]
 points = [{points}]
 vertices = {vertices}
-"#
+"#,
+        c.g, c.res, c.dt, c.gamma, c.youngs_modulus, c.friction, c.bending, c.plasticity
     ))
 }
 
@@ -129,18 +165,19 @@ const CAPSTAN_LOAD: f64 = 0.2;
 /// more than 0.5 % of its hanging length; the lateral pendulum swing of the
 /// hanging strands that the loading excites is not a slip) and the largest
 /// relative vertical end displacement. Stops as soon as it slid.
-fn capstan_slides(r: f64, l1: f64, l2: f64, mu: f64) -> (bool, f64) {
-    let s = capstan_scene(r, l1, l2, mu);
+fn capstan_slides(r: f64, l1: f64, l2: f64, mu: f64, setup: &Capstan) -> (bool, f64) {
+    let s = capstan_scene(r, l1, l2, mu, setup);
     let mut sim = YarnSim::new(&s).unwrap();
     let half_dx = 0.5 * s.dx();
     let c = Vec2::from(s.obstacles[0].center);
     sim.advance(CAPSTAN_LOAD).unwrap();
     let (a0, b0) = sim.yarn_endpoints(0);
     let steps = (1.0 / sim.dt()).round() as u64;
+    let check = (5e-3 / sim.dt()).round().max(1.0) as u64;
     let mut worst: f64 = 0.0;
     for k in 0..steps {
         sim.step().unwrap();
-        if k % 50 == 49 || k + 1 == steps {
+        if k % check == check - 1 || k + 1 == steps {
             let (a, b) = sim.yarn_endpoints(0);
             let rel = ((a.y - a0.y).abs() / l1).max((b.y - b0.y).abs() / l2);
             worst = worst.max(rel);
@@ -173,42 +210,158 @@ fn heavy_rope_capstan_ode_matches_the_documented_threshold() {
     );
 }
 
+/// One capstan case: yarn over radius `r`, l1 = 0.1, l2 = `ratio` l1.
+/// Checks that it slides at 0.7 mu* and holds at 1.4 mu* (< 0.5 % of the
+/// hanging length in 1 s after loading) and, with `bisect`, that the
+/// threshold measured by three bisection steps between them (bracket
+/// 0.0875 mu*, so the midpoint is within 4.4 % of the measured crossing)
+/// is within 15 % of the heavy-rope mu*. Returns the printed line and
+/// whether it passed.
+fn capstan_case(r: f64, ratio: f64, setup: &Capstan, bisect: bool) -> (String, bool) {
+    let l1 = 0.1;
+    let l2 = ratio * l1;
+    let mu_star = capstan_threshold(r, l1, l2);
+    let (slid_low, m_low) = capstan_slides(r, l1, l2, 0.7 * mu_star, setup);
+    let (slid_high, m_high) = capstan_slides(r, l1, l2, 1.4 * mu_star, setup);
+    let mut line = format!(
+        "capstan {}^2 dt {:.0e} g {} gamma {} E {} B {} R {r} l1 {l1} l2 {l2:.2}: mu* {mu_star:.4}, \
+         0.7 mu* slid {slid_low} (moved {m_low:.2e}), 1.4 mu* slid {slid_high} (moved {m_high:.2e})",
+        setup.res, setup.dt, setup.g, setup.gamma, setup.youngs_modulus, setup.bending
+    );
+    let mut ok = slid_low && !slid_high;
+    if bisect {
+        let (mut lo, mut hi) = (0.7 * mu_star, 1.4 * mu_star);
+        for _ in 0..3 {
+            let mid = 0.5 * (lo + hi);
+            if capstan_slides(r, l1, l2, mid, setup).0 {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+        let mu_meas = 0.5 * (lo + hi);
+        let err = (mu_meas - mu_star) / mu_star;
+        line += &format!(
+            ", measured threshold {mu_meas:.4} in [{lo:.4}, {hi:.4}], error {:+.1} %",
+            100.0 * err
+        );
+        // tolerance: threshold within 15 % of mu*
+        ok &= err.abs() <= 0.15;
+    }
+    (line, ok)
+}
+
+/// Runs capstan cases `(R, l2 / l1, bisect)` in parallel threads (each
+/// simulation is deterministic for any thread count) and asserts all pass.
+fn capstan_suite(setup: &Capstan, cases: &[(f64, f64, bool)]) {
+    let results: Vec<(String, bool)> = std::thread::scope(|sc| {
+        let handles: Vec<_> = cases
+            .iter()
+            .map(|&(r, ratio, bisect)| sc.spawn(move || capstan_case(r, ratio, setup, bisect)))
+            .collect();
+        handles.into_iter().map(|h| h.join().unwrap()).collect()
+    });
+    for (line, ok) in &results {
+        eprintln!("{line}{}", if *ok { "" } else { "  FAILED" });
+    }
+    let failed: Vec<&String> = results.iter().filter(|r| !r.1).map(|r| &r.0).collect();
+    assert!(failed.is_empty(), "{failed:#?}");
+}
+
+/// R = 0.1 and 0.05, l2 / l1 = 2, 3, 5, with the bisection on every case.
+const CAPSTAN_ALL: [(f64, f64, bool); 6] = [
+    (0.1, 2.0, true),
+    (0.1, 3.0, true),
+    (0.1, 5.0, true),
+    (0.05, 2.0, true),
+    (0.05, 3.0, true),
+    (0.05, 5.0, true),
+];
+
 #[test]
 #[cfg_attr(debug_assertions, ignore = "release-mode test (cargo test --release)")]
 fn capstan_yarn_slides_below_and_holds_above_the_heavy_rope_threshold() {
-    let l1 = 0.1;
-    let mut failures = Vec::new();
-    for &r in &[0.1, 0.05] {
-        for &ratio in &[2.0, 3.0, 5.0] {
-            let l2 = ratio * l1;
-            let mu_star = capstan_threshold(r, l1, l2);
-            let (slid_low, m_low) = capstan_slides(r, l1, l2, 0.7 * mu_star);
-            let (slid_high, m_high) = capstan_slides(r, l1, l2, 1.4 * mu_star);
-            // bisection on mu between 0.7 and 1.4 mu* (3 steps: bracket 0.0875 mu*)
-            let (mut lo, mut hi) = (0.7 * mu_star, 1.4 * mu_star);
-            for _ in 0..3 {
-                let mid = 0.5 * (lo + hi);
-                if capstan_slides(r, l1, l2, mid).0 {
-                    lo = mid;
-                } else {
-                    hi = mid;
-                }
-            }
-            let mu_meas = 0.5 * (lo + hi);
-            let err = (mu_meas - mu_star) / mu_star;
-            eprintln!(
-                "capstan R {r} l1 {l1} l2 {l2:.2}: mu* {mu_star:.4}, 0.7 mu* slid {slid_low} (moved {m_low:.2e}), \
-                 1.4 mu* slid {slid_high} (moved {m_high:.2e}), measured threshold {mu_meas:.4} in [{lo:.4}, {hi:.4}], error {:+.1} %",
-                100.0 * err
-            );
-            // must slide at 0.7 mu*, hold at 1.4 mu* (< 0.5 % of the hanging
-            // length in 1 s), threshold within 15 % of mu*
-            if !slid_low || slid_high || err.abs() > 0.15 {
-                failures.push(format!("R {r} l2/l1 {ratio}: err {err:+.3}"));
-            }
-        }
+    capstan_suite(&PURE_STRING, &CAPSTAN_ALL);
+}
+
+/// The same oracle with the material of the built-in scenes (cross-section
+/// stiffness gamma 500, E 1000), at the test resolution 128^2, dt 1e-4:
+/// the contact law's friction follows the normal impulse the obstacle
+/// delivers to the whole cross-section, so the cross-section pressure
+/// neither weakens nor strengthens the hold.
+#[test]
+#[cfg_attr(debug_assertions, ignore = "release-mode test (cargo test --release)")]
+fn capstan_oracle_holds_for_the_builtin_yarn_material() {
+    capstan_suite(&BUILTIN, &CAPSTAN_ALL);
+}
+
+/// The built-in material at the built-in scenes' 256^2, dt 4e-5: hold and
+/// slide on every case, the bisection on R 0.1, l2 / l1 = 3 (the case of
+/// the documented mu* = 0.2015), to keep the test's cost near a minute.
+#[test]
+#[cfg_attr(debug_assertions, ignore = "release-mode test (cargo test --release)")]
+fn capstan_oracle_holds_for_the_builtin_yarn_material_at_256() {
+    let mut cases = CAPSTAN_ALL;
+    for c in cases.iter_mut() {
+        c.2 = c.0 == 0.1 && c.1 == 3.0;
     }
-    assert!(failures.is_empty(), "{failures:?}");
+    capstan_suite(&BUILTIN_256, &cases);
+}
+
+/// With the built-in scenes' bending stiffness B = 1e-3 N m (bending
+/// length (B / (rho g))^(1/3) = 7.9 cm at g = 2): the bending-free
+/// heavy-rope threshold is kept as the oracle, with the same 15 %
+/// tolerance; the shift the bending gives is measured below it (see
+/// docs/obstacle-contact.md).
+#[test]
+#[cfg_attr(debug_assertions, ignore = "release-mode test (cargo test --release)")]
+fn capstan_oracle_holds_with_bending() {
+    let setup = Capstan {
+        bending: 1e-3,
+        ..BUILTIN
+    };
+    capstan_suite(&setup, &CAPSTAN_ALL);
+}
+
+/// A frictionless drape (mu = 0) with the built-in material slides like a
+/// rigid string: with s the distance the heavy end has dropped, s'' = g
+/// (l2 - l1 + 2 s) / L (L the whole length), from rest s(t) = (l2 - l1) / 2
+/// (cosh(k t) - 1), k = sqrt(2 g / L). The mean acceleration 2 s(T) / T^2
+/// over T = 0.2 s must match that value within 10 %: the contact adds no
+/// sticking where mu = 0.
+#[test]
+#[cfg_attr(debug_assertions, ignore = "release-mode test (cargo test --release)")]
+fn frictionless_drape_slides_at_the_rigid_string_rate() {
+    let (r, l1, l2) = (0.1, 0.1, 0.3);
+    for setup in [
+        Capstan { g: 9.8, ..BUILTIN },
+        Capstan {
+            g: 9.8,
+            ..BUILTIN_256
+        },
+    ] {
+        let s = capstan_scene(r, l1, l2, 0.0, &setup);
+        let mut sim = YarnSim::new(&s).unwrap();
+        let b0 = sim.yarn_endpoints(0).1;
+        let t = 0.2;
+        sim.advance(t).unwrap();
+        let drop = b0.y - sim.yarn_endpoints(0).1.y;
+        let len = l1 + l2 + std::f64::consts::PI * r;
+        let k = (2.0 * setup.g / len).sqrt();
+        let rigid = 0.5 * (l2 - l1) * ((k * t).cosh() - 1.0);
+        let (a, a_rigid) = (2.0 * drop / (t * t), 2.0 * rigid / (t * t));
+        let err = (a - a_rigid) / a_rigid;
+        eprintln!(
+            "frictionless drape {}^2 dt {:.0e} g {}: mean acceleration over {t} s {a:.4} m/s^2, \
+             rigid string {a_rigid:.4} m/s^2, error {:+.1} %",
+            setup.res,
+            setup.dt,
+            setup.g,
+            100.0 * err
+        );
+        // tolerance 10 % on the acceleration
+        assert!(err.abs() < 0.10, "error {err:+.3}");
+    }
 }
 
 // ---- cantilever -------------------------------------------------------------

@@ -5,12 +5,28 @@
 //! Obstacle contact acts on every grid node that carries the weight of a
 //! particle touching the obstacle (within [`super::particle_to_grid::CONTACT_CELLS`]
 //! cells of its surface), not only on nodes inside the circle, so a yarn
-//! resting on an obstacle gets friction on all of its grid weight. At such a
-//! node with outward normal `n` (from the centre) an inward velocity
-//! `v . n < 0` is removed, and the tangential velocity is reduced by `mu`
-//! times the removed normal velocity, or stopped if that is more: Coulomb's
-//! law in impulse terms (`|dp_t| <= mu dp_n`). A node carrying both touching
-//! and free particles gets the law in proportion to the touching mass.
+//! resting on an obstacle gets friction on all of its grid weight. It has
+//! two parts:
+//!
+//! * the normal part, per node ([`obstacle_normal`]): at a node with outward
+//!   normal `n` (from the centre) an inward velocity `v . n < 0` is removed;
+//!   the momentum removed is the normal impulse the obstacle delivers there;
+//! * the friction part, per cross-section of whatever lies on the obstacle
+//!   ([`obstacle_friction`]): the contact nodes are pooled in wedges of
+//!   [`FRICTION_ARC_CELLS`] cells of arc, and each wedge's tangential
+//!   momentum is reduced by `mu` times the wedge's normal impulse, or
+//!   stopped if that is more (Coulomb's law in impulse terms,
+//!   `|dp_t| <= mu dp_n`), by one tangential velocity change shared by the
+//!   wedge's nodes.
+//!
+//! Pooling makes the friction follow the normal impulse the obstacle
+//! actually delivers to the yarn's cross-section, wherever in the stencil it
+//! lands: a yarn with cross-section stiffness presses its inner nodes onto
+//! the obstacle and pushes its outer ones outward, and a node-by-node law
+//! would give those outer nodes no friction at all.
+//!
+//! A node carrying both touching and free particles gets the law in
+//! proportion to the touching mass.
 
 use crate::math::Vec2;
 use crate::scene::{Obstacle, WallMode};
@@ -32,28 +48,144 @@ pub fn coulomb(v: Vec2, n: Vec2, mu: f64) -> Vec2 {
     }
 }
 
-/// Velocity of a grid node at `xi` after contact with obstacle `o`:
-/// `touching` is the fraction of the node's mass that belongs to particles
-/// touching an obstacle. Inside the circle the law acts in full.
+/// Arc length, in cells at the obstacle's radius, of the wedges over which
+/// obstacle friction is pooled: a yarn cross-section's stencil (3 nodes)
+/// with a margin, short against any arc over which the tension changes.
+pub const FRICTION_ARC_CELLS: f64 = 2.0;
+
+/// A grid node in contact with an obstacle, as the normal part of the law
+/// left it, for the friction part.
+#[derive(Clone, Copy, Debug)]
+pub struct ContactNode {
+    /// Index of the node in the grid's node pool.
+    pub index: usize,
+    /// Grid coordinates (for the walls).
+    pub ij: [u32; 2],
+    /// Index of the obstacle.
+    pub obstacle: u32,
+    /// Fraction of the node's mass the law acts on.
+    pub share: f64,
+    /// Mass the law acts on, `share m`.
+    pub mass: f64,
+    /// Normal impulse the obstacle delivered to it (`>= 0`).
+    pub impulse: f64,
+    /// Outward unit normal at the node.
+    pub normal: Vec2,
+}
+
+/// Normal part of the contact of a grid node at `xi` with velocity `v` and
+/// mass `m` with obstacle `o`: `touching` is the fraction of the node's mass
+/// that belongs to particles touching an obstacle (inside the circle the
+/// law acts in full). Removes the inward velocity of that share; returns
+/// the share, the outward normal and the normal impulse delivered, or
+/// `None` when the node is not in contact.
 #[inline]
-pub fn obstacle_velocity(o: &Obstacle, xi: Vec2, v: Vec2, touching: f64) -> Vec2 {
+pub fn obstacle_normal(
+    o: &Obstacle,
+    xi: Vec2,
+    v: &mut Vec2,
+    m: f64,
+    touching: f64,
+) -> Option<(f64, Vec2, f64)> {
     let c = Vec2::from(o.center);
     let r = xi - c;
     let dist = r.norm();
-    let share = if dist < o.radius { 1.0 } else { touching };
+    let share = if dist < o.radius {
+        1.0
+    } else {
+        touching.min(1.0)
+    };
     if share <= 0.0 {
-        return v;
+        return None;
     }
     let n = if dist > 0.0 {
         r / dist
     } else {
         Vec2::new(0.0, 1.0)
     };
-    let vc = coulomb(v, n, o.friction);
-    if share >= 1.0 {
-        vc
+    let vn = v.dot(&n);
+    let impulse = if vn < 0.0 {
+        *v -= n * (vn * share);
+        -vn * share * m
     } else {
-        v + (vc - v) * share
+        0.0
+    };
+    Some((share, n, impulse))
+}
+
+/// Number of friction wedges around obstacle `o` on a grid of spacing `dx`.
+#[inline]
+pub fn friction_wedges(o: &Obstacle, dx: f64) -> usize {
+    let arc = 2.0 * std::f64::consts::PI * o.radius / (FRICTION_ARC_CELLS * dx);
+    (arc.round() as usize).max(1)
+}
+
+/// Friction wedge of a contact node with outward normal `n` among `wedges`.
+#[inline]
+fn wedge(n: Vec2, wedges: usize) -> usize {
+    let a = n.y.atan2(n.x) + std::f64::consts::PI; // [0, 2 pi]
+    let k = (a * (wedges as f64 / (2.0 * std::f64::consts::PI))) as usize;
+    k.min(wedges - 1)
+}
+
+/// Friction part of obstacle contact (see the module documentation) on
+/// the contact nodes `nodes` (in a fixed order, so the sums are the same
+/// for any thread count) of the node velocities `node` (`[vx, vy, dvx,
+/// dvy]`; with `flip` the change is kept in step). Returns the indices of
+/// the nodes it changed, through `changed`, for the walls to act on again.
+pub fn obstacle_friction(
+    obstacles: &[Obstacle],
+    dx: f64,
+    nodes: &[ContactNode],
+    node: &mut [[f64; 4]],
+    flip: bool,
+    changed: &mut dyn FnMut(&ContactNode, &mut [f64; 4]),
+) {
+    for (oi, o) in obstacles.iter().enumerate() {
+        let mu = o.friction;
+        if mu <= 0.0 {
+            continue;
+        }
+        let wedges = friction_wedges(o, dx);
+        // per wedge: mass, tangential momentum (along perp(n)), normal impulse
+        let mut sums = vec![[0.0f64; 3]; wedges];
+        let mine = || nodes.iter().filter(move |c| c.obstacle as usize == oi);
+        for c in mine() {
+            let v = node[c.index];
+            let t = Vec2::new(-c.normal.y, c.normal.x);
+            let s = &mut sums[wedge(c.normal, wedges)];
+            s[0] += c.mass;
+            s[1] += c.mass * (v[0] * t.x + v[1] * t.y);
+            s[2] += c.impulse;
+        }
+        // the shared tangential velocity change of each wedge
+        let dv: Vec<f64> = sums
+            .iter()
+            .map(|&[m, pt, jn]| {
+                if m <= 0.0 || pt == 0.0 {
+                    0.0
+                } else if pt.abs() <= mu * jn {
+                    -pt / m
+                } else {
+                    -pt.signum() * mu * jn / m
+                }
+            })
+            .collect();
+        for c in mine() {
+            let d = dv[wedge(c.normal, wedges)];
+            if d == 0.0 {
+                continue;
+            }
+            let t = Vec2::new(-c.normal.y, c.normal.x) * (d * c.share);
+            let out = &mut node[c.index];
+            out[0] += t.x;
+            out[1] += t.y;
+            if flip {
+                out[2] += t.x;
+                out[3] += t.y;
+            }
+            changed(c, out);
+        }
     }
 }
 

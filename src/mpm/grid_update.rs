@@ -3,11 +3,13 @@
 //! attractor, obstacle contact and walls ([`super::contact`]). Each node
 //! keeps its new velocity and, for the FLIP transfer, the change over the
 //! substep. Work is done per active block; obstacle and wall laws run only
-//! on blocks near one.
+//! on blocks near one. Obstacle friction, pooled over the contact nodes of
+//! a cross-section, runs after the parallel pass on the contact nodes it
+//! collected, in a fixed order.
 
 use rayon::prelude::*;
 
-use super::contact::{obstacle_velocity, wall_velocity};
+use super::contact::{obstacle_friction, obstacle_normal, wall_velocity, ContactNode};
 use super::grid::{
     Grid, GridGeom, Node, P2gNode, ScatterBuffer, BLOCK, CHUNKS, FX, FY, M, MC, P2G_LANES, PX, PY,
 };
@@ -33,6 +35,14 @@ struct BandSrc<'a> {
     touched: &'a [bool],
 }
 
+/// What every band of the grid update reads.
+struct BandCtx<'a> {
+    is_active: &'a [bool],
+    geom: &'a GridGeom,
+    dt: f64,
+    ext: &'a GridForces<'a>,
+}
+
 /// Pass 2 (see the module documentation). `flip`: also store each node's
 /// velocity change (the buffers then hold the impulse alone, see
 /// [`super::particle_to_grid::scatter`]). The scatter buffers are consumed:
@@ -48,18 +58,52 @@ pub fn grid_update(grid: &mut Grid, dt: f64, ext: &GridForces, flip: bool) {
             band.push(BandSrc { node, touched });
         }
     }
-    let is_active = &grid.is_active;
-    grid.node
+    let ctx = BandCtx {
+        is_active: &grid.is_active,
+        geom: &geom,
+        dt,
+        ext,
+    };
+    let ctx = &ctx;
+    let contacts: Vec<Vec<ContactNode>> = grid
+        .node
         .par_chunks_mut(band_len)
         .zip(bands)
         .enumerate()
-        .for_each(|(bi, (band, mut srcs))| {
+        .map(|(bi, (band, mut srcs))| {
+            let mut contacts = Vec::new();
             if flip {
-                grid_band::<true>(bi, band, &mut srcs, is_active, &geom, dt, ext)
+                grid_band::<true>(bi, band, &mut srcs, ctx, &mut contacts)
             } else {
-                grid_band::<false>(bi, band, &mut srcs, is_active, &geom, dt, ext)
+                grid_band::<false>(bi, band, &mut srcs, ctx, &mut contacts)
             }
-        });
+            contacts
+        })
+        .collect();
+    if contacts.iter().any(|c| !c.is_empty()) {
+        let nodes: Vec<ContactNode> = contacts.into_iter().flatten().collect();
+        let (walls, cells, n) = (ext.walls, ext.wall_cells, geom.n);
+        obstacle_friction(
+            ext.obstacles,
+            geom.dx,
+            &nodes,
+            &mut grid.node,
+            flip,
+            &mut |c, out| {
+                if walls != WallMode::None {
+                    let v = Vec2::new(out[0], out[1]);
+                    let w = wall_velocity(walls, cells, n, c.ij[0] as usize, c.ij[1] as usize, v);
+                    let d = w - v;
+                    out[0] = w.x;
+                    out[1] = w.y;
+                    if flip {
+                        out[2] += d.x;
+                        out[3] += d.y;
+                    }
+                }
+            },
+        );
+    }
 }
 
 multiversion! {
@@ -68,11 +112,11 @@ multiversion! {
         bi: usize,
         band: &mut [Node],
         buffers: &mut [BandSrc],
-        is_active: &[bool],
-        geom: &GridGeom,
-        dt: f64,
-        ext: &GridForces,
+        ctx: &BandCtx,
+        contacts: &mut Vec<ContactNode>,
     ) {
+        let BandCtx { is_active, geom, dt, ext } = *ctx;
+        let band_base = bi * geom.stride * BLOCK;
         let cells = ext.wall_cells;
         let dx = geom.dx;
         // contact reaches nodes up to the particles' stencil (1.5 cells) plus
@@ -133,8 +177,20 @@ multiversion! {
                         }
                         if near_obstacle {
                             let touching = acc[MC] * inv_m;
-                            for o in ext.obstacles {
-                                v = obstacle_velocity(o, xi, v, touching);
+                            for (oi, o) in ext.obstacles.iter().enumerate() {
+                                if let Some((share, normal, impulse)) =
+                                    obstacle_normal(o, xi, &mut v, acc[M], touching)
+                                {
+                                    contacts.push(ContactNode {
+                                        index: band_base + row + c,
+                                        ij: [i as u32, j as u32],
+                                        obstacle: oi as u32,
+                                        share,
+                                        mass: share * acc[M],
+                                        impulse,
+                                        normal,
+                                    });
+                                }
                             }
                         }
                     }
