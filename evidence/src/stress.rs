@@ -187,22 +187,14 @@ fn massspring_limits(
                 Integrator::SymplecticEuler => info.symplectic_euler,
                 _ => f64::INFINITY,
             };
-            let (floor, cap) = (1e-6, 0.1);
-            let (s, u, probes) = largest_stable(floor, cap, iterations, |h| {
-                massspring_stable(&sys, *integ, opt, h)
-            });
-            out.push(Limit {
-                scene: name.into(),
-                integrator: iname.to_string(),
-                parameter: format!("k x{f}"),
-                value: k0 * f,
-                stable_dt: s,
-                unstable_dt: u,
+            out.push(Limit::search(
+                [name.into(), iname.to_string(), format!("k x{f}")],
+                k0 * f,
                 bound,
-                floor,
-                cap,
-                probes,
-            });
+                (1e-6, 0.1),
+                iterations,
+                |h| massspring_stable(&sys, *integ, opt, h),
+            ));
         }
     }
 }
@@ -312,22 +304,14 @@ pub fn run(opts: &StressOptions) -> StressReport {
     massspring_limits("cloth", &cloth, factors, it, &mut limits);
     for (label, value, scene) in yarn_configs(opts.quick) {
         let bound = yarn_bound(&scene);
-        let (floor, cap) = (bound / 64.0, bound * 16.0);
-        let (s, u, probes) = largest_stable(floor, cap, if opts.quick { 5 } else { 7 }, |dt| {
-            yarn_stable(&scene, dt)
-        });
-        limits.push(Limit {
-            scene: "yarn-small".into(),
-            integrator: "mpm".into(),
-            parameter: label,
+        limits.push(Limit::search(
+            ["yarn-small".into(), "mpm".into(), label],
             value,
-            stable_dt: s,
-            unstable_dt: u,
             bound,
-            floor,
-            cap,
-            probes,
-        });
+            (bound / 64.0, bound * 16.0),
+            if opts.quick { 5 } else { 7 },
+            |dt| yarn_stable(&scene, dt),
+        ));
     }
     StressReport { limits }
 }
@@ -343,6 +327,32 @@ pub fn set_attractor(sim: &mut YarnSim, pos: [f64; 2], strength: f64) -> Result<
 }
 
 impl Limit {
+    /// The stability limit of `[scene, integrator, parameter]` at the
+    /// parameter's `value`: [`largest_stable`] between `floor` and `cap`
+    /// in `iterations` bisections of `stable`.
+    fn search(
+        [scene, integrator, parameter]: [String; 3],
+        value: f64,
+        bound: f64,
+        (floor, cap): (f64, f64),
+        iterations: usize,
+        stable: impl FnMut(f64) -> bool,
+    ) -> Limit {
+        let (stable_dt, unstable_dt, probes) = largest_stable(floor, cap, iterations, stable);
+        Limit {
+            scene,
+            integrator,
+            parameter,
+            value,
+            stable_dt,
+            unstable_dt,
+            bound,
+            floor,
+            cap,
+            probes,
+        }
+    }
+
     /// Largest stable step over the theoretical bound.
     pub fn ratio(&self) -> f64 {
         if self.bound.is_finite() && self.bound > 0.0 {

@@ -46,7 +46,8 @@ pub fn scene(text: &str) -> YarnScene {
 }
 
 /// The bare test scene of [`SceneBuilder::bare`] with its `[[yarns]]` given
-/// as TOML text, read by the scene loader.
+/// as TOML text, read by the scene loader (`yarns` holds `[[yarns]]` tables
+/// only: the scene's other tables are already in the text).
 pub fn bare_scene(yarns: &str) -> YarnScene {
     let text = SceneBuilder::bare()
         .yarn(straight([0.3, 0.5], [0.7, 0.5], 10))
