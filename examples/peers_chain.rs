@@ -28,7 +28,7 @@
 
 use std::time::Instant;
 
-use yarnsim::math::bessel_j0;
+use yarnsim::testing::bessel_j0;
 use yarnsim::scene::builtin::yarn_reference;
 use yarnsim::scene::YarnScene;
 use yarnsim::YarnSim;

@@ -64,7 +64,7 @@ fn observed_order(layout: &MassSpringScene, integ: Integrator, h: f64, t_end: f6
 /// (step `h`, to `t_end`) within `tolerance`; `label` names the scene.
 fn assert_orders(
     label: &str,
-    layout: &Layout,
+    layout: &MassSpringScene,
     (h, t_end): (f64, f64),
     cases: &[(Integrator, f64)],
     tolerance: f64,
