@@ -4,18 +4,12 @@
 use std::path::Path;
 
 use rerun::RecordingStream;
-use yarnsim::scene::Scene;
-use yarnsim::YarnSim;
 
-use super::massspring::record_massspring;
 use super::sink::{Server, Sink};
-use super::yarn::record_yarn;
 use crate::driver::{
     interrupt_flag, progress_bar, run_frames, FrameInfo, FrameRun, Outcome, Stepper,
 };
 use crate::error::CliError;
-use crate::massspring::{IntegratorArgs, MassSpringRun};
-use crate::run::no_integrator_for_yarn;
 use crate::schedule::Schedule;
 
 /// What to record: the sink and which frames.
@@ -54,25 +48,6 @@ pub struct RecordOutcome {
     /// The `--serve` server, still serving the recording after the run (not
     /// after an interruption: Ctrl-C during the run stops both).
     pub server: Option<Server>,
-}
-
-/// Records `scene` for `duration` seconds; `integrator` applies to
-/// mass-spring scenes only.
-pub fn record(
-    scene: &Scene,
-    duration: f64,
-    opts: &RecordOptions,
-    integrator: &IntegratorArgs,
-) -> Result<RecordOutcome, CliError> {
-    match scene {
-        Scene::Yarn(y) => {
-            no_integrator_for_yarn(integrator)?;
-            record_yarn(&mut YarnSim::new(y)?, duration, opts)
-        }
-        Scene::MassSpring(l) => {
-            record_massspring(&mut MassSpringRun::new(l, integrator)?, duration, opts)
-        }
-    }
 }
 
 /// Runs `schedule` on `sim`, logging the frames `opts` selects with `log`,

@@ -35,7 +35,7 @@ pub mod style;
 pub mod yarn;
 
 pub use blueprint::{massspring_blueprint, yarn_blueprint};
-pub use frames::{record, RecordOptions, RecordOutcome};
+pub use frames::{RecordOptions, RecordOutcome};
 pub use massspring::record_massspring;
 pub use sink::{
     parse_memory_limit, MemoryLimit, Serve, Server, Sink, DEFAULT_CONNECT_URL,
@@ -157,4 +157,30 @@ pub mod values {
     /// Plastic state (quadrature only): 0 elastic, 1 on the yield surface
     /// (sliding), 2 separated (`r22 = 1`, cross-section in tension).
     pub const PLASTIC: &str = "plastic";
+}
+
+use yarnsim::scene::Scene;
+use yarnsim::YarnSim;
+
+use crate::error::CliError;
+use crate::massspring::{IntegratorArgs, MassSpringRun};
+use crate::run::no_integrator_for_yarn;
+
+/// Records `scene` for `duration` seconds; `integrator` applies to
+/// mass-spring scenes only.
+pub fn record(
+    scene: &Scene,
+    duration: f64,
+    opts: &RecordOptions,
+    integrator: &IntegratorArgs,
+) -> Result<RecordOutcome, CliError> {
+    match scene {
+        Scene::Yarn(y) => {
+            no_integrator_for_yarn(integrator)?;
+            record_yarn(&mut YarnSim::new(y)?, duration, opts)
+        }
+        Scene::MassSpring(l) => {
+            record_massspring(&mut MassSpringRun::new(l, integrator)?, duration, opts)
+        }
+    }
 }
