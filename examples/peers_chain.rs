@@ -28,9 +28,9 @@
 
 use std::time::Instant;
 
-use yarnsim::testing::bessel_j0;
 use yarnsim::scene::builtin::yarn_reference;
 use yarnsim::scene::YarnScene;
+use yarnsim::testing::bessel_j0;
 use yarnsim::YarnSim;
 
 const J01: f64 = 2.404_825_557_695_773;

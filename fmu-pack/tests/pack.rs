@@ -108,7 +108,8 @@ fn crc32_known_value() {
 fn mass_spring_archive_layout() {
     let scene = Scene::MassSpring(wire());
     let (_, entries) = archive(&scene, "MassSpring");
-    let packed = YarnBundle::scene_from_toml_str(std::str::from_utf8(&entries[2].1).unwrap()).unwrap();
+    let packed =
+        YarnBundle::scene_from_toml_str(std::str::from_utf8(&entries[2].1).unwrap()).unwrap();
     assert_eq!(packed.guid(), scene.guid());
     let doc = String::from_utf8(entries[3].1.clone()).unwrap();
     assert!(doc.contains("particle[10].x") && doc.contains("mass-spring"));

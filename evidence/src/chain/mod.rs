@@ -47,8 +47,11 @@ use yarnsim::scene::{
 };
 use yarnsim::testing::bessel_j0;
 
-/// First zero of `J0`.
-pub const J01: f64 = 2.404_825_557_695_773;
+mod oracle;
+mod report;
+
+pub use oracle::{extensible_chain_omega, frequency_from_crossings, oracle_omega, J01};
+
 /// Gravity (m/s^2).
 pub const GRAVITY: f64 = 9.8;
 /// Rest length of the yarn (m).
@@ -71,69 +74,6 @@ pub const DT_LADDER_GRID: u32 = 32;
 pub const REPEAT_BELOW_S: f64 = 0.5;
 /// Relative error levels of the summary.
 pub const LEVELS: [f64; 3] = [1e-1, 1e-2, 1e-3];
-
-/// The oracle: first angular frequency (rad/s) of the uniform inextensible
-/// chain of length `l` hanging in gravity `g`.
-pub fn oracle_omega(g: f64, l: f64) -> f64 {
-    0.5 * J01 * (g / l).sqrt()
-}
-
-/// First angular frequency of a discrete *extensible* hanging chain: `n`
-/// equal segments of rest length `l / n`, line density `rho`, fiber
-/// stiffness `k` (tension `k` times strain), in gravity `g`, top node fixed,
-/// each segment stretched by its static tension (the weight below it).
-/// Small transverse oscillations `M u'' = -K u` with `K` from the tensions
-/// over the stretched lengths; the smallest eigenvalue of the symmetric
-/// tridiagonal `M^-1/2 K M^-1/2` by bisection on its Sturm count. With
-/// `k -> infinity` and large `n` it tends to [`oracle_omega`]; the
-/// difference at finite `k` is the model error that stretching adds.
-pub fn extensible_chain_omega(n: usize, l: f64, rho: f64, k: f64, g: f64) -> f64 {
-    let l0 = l / n as f64;
-    // node i = 1..=n (index i - 1); node 0 is the pin
-    let m: Vec<f64> = (1..=n)
-        .map(|i| if i < n { rho * l0 } else { 0.5 * rho * l0 })
-        .collect();
-    // tension and stretched length of segment j = 1..=n (index j - 1)
-    let mut below = 0.0;
-    let mut t = vec![0.0; n];
-    for j in (0..n).rev() {
-        below += m[j];
-        t[j] = g * below;
-    }
-    let s: Vec<f64> = t.iter().map(|tj| tj / (l0 * (1.0 + tj / k))).collect();
-    let a: Vec<f64> = (0..n)
-        .map(|i| (s[i] + if i + 1 < n { s[i + 1] } else { 0.0 }) / m[i])
-        .collect();
-    let b: Vec<f64> = (0..n - 1)
-        .map(|i| -s[i + 1] / (m[i] * m[i + 1]).sqrt())
-        .collect();
-    // eigenvalues below x
-    let count = |x: f64| {
-        let mut c = 0;
-        let mut q = 1.0;
-        for i in 0..n {
-            let off = if i > 0 { b[i - 1] * b[i - 1] / q } else { 0.0 };
-            q = a[i] - x - off;
-            if q == 0.0 {
-                q = -1e-300;
-            }
-            if q < 0.0 {
-                c += 1;
-            }
-        }
-        c
-    };
-    let (mut lo, mut hi) = (0.0, 4.0 * oracle_omega(g, l).powi(2));
-    for _ in 0..200 {
-        let mid = 0.5 * (lo + hi);
-        if count(mid) >= 1 {
-            hi = mid;
-        } else {
-            lo = mid;
-        }
-    }
-    (0.5 * (lo + hi)).sqrt()
-}
 
 /// Relative frequency shift that the yarn's stretching under its own weight
 /// causes in the study's set-up (negative: lower): the extensible chain
@@ -262,23 +202,6 @@ pub fn chain_scene(resolution: u32, dt: impl Into<StepSize>, transfer: TransferS
             angular_velocity: None,
         }],
     }
-}
-
-/// Angular frequency from the zero crossings of `(t, x)` samples: the
-/// crossing times by linear interpolation, `omega = pi (n - 1) / (t_n - t_1)`
-/// over the `n >= 3` crossings; `None` with fewer.
-pub fn frequency_from_crossings(samples: &[(f64, f64)]) -> Option<f64> {
-    let mut tc = Vec::new();
-    for w in samples.windows(2) {
-        let ((t0, x0), (t1, x1)) = (w[0], w[1]);
-        if (x0 > 0.0 && x1 <= 0.0) || (x0 < 0.0 && x1 >= 0.0) {
-            tc.push(t0 + (t1 - t0) * x0 / (x0 - x1));
-        }
-    }
-    // A sample exactly at zero would count twice; drop near-duplicates.
-    tc.dedup_by(|a, b| (*a - *b).abs() < 1e-12);
-    (tc.len() >= 3)
-        .then(|| std::f64::consts::PI * (tc.len() - 1) as f64 / (tc[tc.len() - 1] - tc[0]))
 }
 
 /// What one run measured.
@@ -458,179 +381,6 @@ pub fn run(quick: bool) -> ChainReport {
         periods,
         quick,
         elapsed: t0.elapsed().as_secs_f64(),
-    }
-}
-
-impl ChainReport {
-    fn ok(&self) -> impl Iterator<Item = &ChainRun> {
-        self.runs
-            .iter()
-            .filter(|r| r.status == "ok" && r.error.is_finite() && r.wall.is_finite())
-    }
-
-    /// The cheapest successful run (least wall time) with error <= `level`,
-    /// of `scheme` or of any scheme.
-    pub fn cheapest(&self, level: f64, scheme: Option<&str>) -> Option<&ChainRun> {
-        self.ok()
-            .filter(|r| r.error <= level && scheme.is_none_or(|s| r.scheme == s))
-            .min_by(|a, b| a.wall.total_cmp(&b.wall))
-    }
-
-    /// Every run (CSV).
-    pub fn runs_table(&self) -> Table {
-        let mut t = Table::new(&[
-            "scheme",
-            "ladder",
-            "resolution",
-            "vertices",
-            "dt_s",
-            "steps",
-            "wall_s",
-            "repeats",
-            "omega",
-            "omega_oracle",
-            "signed_error",
-            "rel_error",
-            "status",
-        ]);
-        for r in &self.runs {
-            t.push(vec![
-                r.scheme.clone(),
-                r.ladder.clone(),
-                r.resolution.to_string(),
-                r.vertices.to_string(),
-                num(r.dt),
-                r.steps.to_string(),
-                num(r.wall),
-                r.repeats.to_string(),
-                format!("{:.6}", r.omega),
-                format!("{:.6}", r.omega_oracle),
-                num(r.omega / r.omega_oracle - 1.0),
-                num(r.error),
-                r.status.clone(),
-            ]);
-        }
-        t
-    }
-
-    /// Cheapest setting per error level: any scheme first, then per scheme.
-    pub fn summary_table(&self) -> Table {
-        let mut t = Table::new(&[
-            "error_level",
-            "among",
-            "scheme",
-            "ladder",
-            "resolution",
-            "dt_s",
-            "wall_s",
-            "rel_error",
-        ]);
-        let mut among: Vec<Option<String>> = vec![None];
-        among.extend(schemes().into_iter().map(|s| Some(s.name)));
-        for &lvl in &LEVELS {
-            for a in &among {
-                let mut row = vec![
-                    format!("{lvl:.0e}"),
-                    a.clone().unwrap_or_else(|| "any scheme".into()),
-                ];
-                match self.cheapest(lvl, a.as_deref()) {
-                    Some(r) => row.extend([
-                        r.scheme.clone(),
-                        r.ladder.clone(),
-                        format!("{}^2", r.resolution),
-                        num(r.dt),
-                        num(r.wall),
-                        num(r.error),
-                    ]),
-                    None => row.extend(["not reached", "-", "-", "-", "-", "-"].map(String::from)),
-                }
-                t.push(row);
-            }
-        }
-        t
-    }
-
-    /// Error against wall time: a colour per scheme, a line per ladder
-    /// (dt ladder solid with circles, grid ladder dashed with squares).
-    pub fn plot(&self) -> LinePlot {
-        let mut series = Vec::new();
-        for (i, s) in schemes().iter().enumerate() {
-            for (ladder, label) in [
-                ("dt", format!("dt ladder, {}^2", dt_ladder_grid(self.quick))),
-                ("grid", format!("grid ladder, CFL {CFL}")),
-            ] {
-                series.push(Series {
-                    name: format!("{}: {label}", s.name),
-                    points: self
-                        .ok()
-                        .filter(|r| r.scheme == s.name && r.ladder == ladder)
-                        .map(|r| (r.wall, r.error))
-                        .collect(),
-                    color: Some(i),
-                    dashed: ladder == "grid",
-                    marker: if ladder == "grid" {
-                        Marker::Square
-                    } else {
-                        Marker::Circle
-                    },
-                    ..Series::default()
-                });
-            }
-        }
-        for (i, s) in schemes().iter().enumerate() {
-            series.push(Series {
-                name: format!(
-                    "{}: dt = \"auto\" (safety {DEFAULT_SAFETY}), {}^2",
-                    s.name,
-                    dt_ladder_grid(self.quick)
-                ),
-                points: self
-                    .ok()
-                    .filter(|r| r.scheme == s.name && r.ladder == "auto")
-                    .map(|r| (r.wall, r.error))
-                    .collect(),
-                color: Some(i),
-                markers_only: true,
-                ..Series::default()
-            });
-        }
-        LinePlot {
-            title: "yarn work-precision: hanging chain, first-mode frequency vs oracle".into(),
-            x_label: "wall time (s)".into(),
-            y_label: "|omega / omega_1 - 1|, omega_1 = 1.2024 sqrt(g/L)".into(),
-            log_x: true,
-            log_y: true,
-            series,
-        }
-    }
-
-    /// Set-up, one paragraph, and the model floor.
-    pub fn setup(&self) -> String {
-        let m = chain_material();
-        let floor = model_floor();
-        format!(
-            "hanging chain: L = {LENGTH} m pinned at ({}, {}), g = {GRAVITY}, rho = {DENSITY}, k = {:.0} (top strain {STRAIN_TOP:.0e}), gamma = {}, E = {}, no bending, no plasticity; amplitude {AMPLITUDE} L in the J0 mode shape; {} oracle periods per run; {VERTICES_PER_CELL} vertices per cell; dt ladder at {}^2 from CFL {CFL} (dt = {:.3e} s) halving; dt = \"auto\" (safety {DEFAULT_SAFETY}, dt_s its mean substep) at the same grid; grid ladder at CFL {CFL} (c = {:.1} m/s); wall time = stepping only, median of 3 for runs under {REPEAT_BELOW_S} s\nmodel floor: stretching under its own weight shifts the frequency by {floor:+.2e} (discrete extensible chain, 4000 segments, against the same chain with k -> infinity); the amplitude by about (A/L)^2 = 1e-4 or less\n",
-            TOP[0],
-            TOP[1],
-            m.k,
-            m.gamma,
-            m.youngs_modulus,
-            self.periods,
-            dt_ladder_grid(self.quick),
-            cfl_dt(dt_ladder_grid(self.quick)),
-            wave_speed(&m)
-        )
-    }
-
-    /// The printed part of the report.
-    pub fn to_text(&self) -> String {
-        format!(
-            "Yarn against a physical oracle (study took {:.1} s)\n\n{}\n{}\nCheapest setting per error level\n\n{}",
-            self.elapsed,
-            self.setup(),
-            self.runs_table().to_text(),
-            self.summary_table().to_text()
-        )
     }
 }
 
