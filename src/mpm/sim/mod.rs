@@ -11,12 +11,17 @@ use super::particles::Particles;
 use super::pins::{self, Pin};
 use super::spin;
 use super::transfer::Transfer;
-use super::vertex_forces;
 use crate::math::Vec2;
+
+mod diagnostics;
+mod stats;
+
 use crate::scene::{
     Obstacle, SceneError, StepSize, TransferScheme, TransferSpec, WallMode, YarnScene,
     DEFAULT_SAFETY,
 };
+pub use diagnostics::Diagnostics;
+pub use stats::{DtStats, PassTimes, Passes};
 
 /// Why a step failed.
 #[derive(Clone, Debug, PartialEq)]
@@ -53,63 +58,6 @@ pub struct Attractor {
     pub active: bool,
 }
 
-/// Which optional passes a scene needs; the stepper skips the others.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct Passes {
-    pub bending: bool,
-    pub plasticity: bool,
-    pub obstacles: bool,
-    pub attractor: bool,
-    pub walls: bool,
-}
-
-/// Wall-clock seconds spent in each pass since the last reset.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct PassTimes {
-    /// Stencils and stress recomputed from the frames after the state was
-    /// set from outside (new simulation, restore, edited particles); zero
-    /// in steady stepping, where [`PassTimes::gather_quads`] does this work.
-    pub forces: f64,
-    /// Particle-to-grid, with the vertex forces (fiber and bending).
-    pub scatter: f64,
-    /// Grid velocities, gravity, attractor, obstacles, walls.
-    pub grid: f64,
-    /// Grid-to-particle of the vertices, advection, obstacle projection.
-    pub gather_vertices: f64,
-    /// Grid-to-particle of the quadrature particles, return mapping, stress.
-    pub gather_quads: f64,
-    pub substeps: u64,
-}
-
-impl PassTimes {
-    pub fn total(&self) -> f64 {
-        self.forces + self.scatter + self.grid + self.gather_vertices + self.gather_quads
-    }
-
-    /// `(name, seconds)` of every pass, in execution order.
-    pub fn entries(&self) -> [(&'static str, f64); 5] {
-        [
-            (
-                "stress refresh (only after outside state changes)",
-                self.forces,
-            ),
-            ("P2G scatter + vertex forces (fiber, bending)", self.scatter),
-            (
-                "grid update (gravity, attractor, obstacles, walls)",
-                self.grid,
-            ),
-            (
-                "G2P vertices + advection + obstacle projection",
-                self.gather_vertices,
-            ),
-            (
-                "G2P quadrature + return mapping + stress",
-                self.gather_quads,
-            ),
-        ]
-    }
-}
-
 /// How the substep is chosen (`[time] dt`).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Stepping {
@@ -118,64 +66,6 @@ pub enum Stepping {
     /// `dt = "auto"`: each substep is `min(safety * stable_dt, dt_max)` of
     /// the state it starts from ([`super::timestep::stable_dt`]).
     Auto { safety: f64, dt_max: f64 },
-}
-
-/// The substeps taken since the last reset: count and sizes.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct DtStats {
-    pub substeps: u64,
-    pub min: f64,
-    pub max: f64,
-    /// Sum of the substeps (simulated time), s.
-    pub sum: f64,
-}
-
-impl Default for DtStats {
-    fn default() -> Self {
-        DtStats {
-            substeps: 0,
-            min: f64::INFINITY,
-            max: 0.0,
-            sum: 0.0,
-        }
-    }
-}
-
-impl DtStats {
-    fn record(&mut self, dt: f64) {
-        self.substeps += 1;
-        self.min = self.min.min(dt);
-        self.max = self.max.max(dt);
-        self.sum += dt;
-    }
-
-    /// Mean substep, s (0 before any).
-    pub fn mean(&self) -> f64 {
-        if self.substeps == 0 {
-            0.0
-        } else {
-            self.sum / self.substeps as f64
-        }
-    }
-}
-
-/// Summary quantities of the current state.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Diagnostics {
-    pub time: f64,
-    pub steps: u64,
-    pub kinetic_energy: f64,
-    pub elastic_energy: f64,
-    /// Gravitational potential energy `-sum m g.x`.
-    pub potential_energy: f64,
-    pub momentum: Vec2,
-    /// Angular momentum about the origin, including the APIC affine part.
-    pub angular_momentum: f64,
-    pub min_stretch: f64,
-    pub max_stretch: f64,
-    pub mean_stretch: f64,
-    pub center_of_mass: Vec2,
-    pub total_mass: f64,
 }
 
 /// A running yarn-bundle simulation.
@@ -711,82 +601,5 @@ impl YarnSim {
             return Err(e);
         }
         Ok(())
-    }
-
-    /// Left and right end of yarn `y`.
-    pub fn yarn_endpoints(&self, y: usize) -> (Vec2, Vec2) {
-        let r = &self.particles.yarn_vertices;
-        (
-            self.particles.vert.x[r[y]],
-            self.particles.vert.x[r[y + 1] - 1],
-        )
-    }
-
-    /// Stretch `|x_r - x_l| / l0` of every segment.
-    pub fn stretches(&self) -> Vec<f64> {
-        let p = &self.particles;
-        p.quad
-            .left
-            .iter()
-            .zip(&p.quad.l0)
-            .map(|(&l, &l0)| (p.vert.x[l as usize + 1] - p.vert.x[l as usize]).norm() / l0)
-            .collect()
-    }
-
-    /// Total elastic energy: the yarn energy of every quadrature particle
-    /// plus the bending energy.
-    pub fn elastic_energy(&self) -> f64 {
-        let p = &self.particles;
-        let mut e = 0.0;
-        for q in 0..p.quad.x.len() {
-            e += p.quad.vol[q] * self.energy.psi(&(p.quad.d[q] / p.quad.l0[q]));
-        }
-        e + vertex_forces::bending_energy(&p.vert, self.scene.material.bending)
-    }
-
-    /// Energies, momenta, stretch and centre of mass.
-    pub fn diagnostics(&self) -> Diagnostics {
-        let p = &self.particles;
-        let dx = self.grid.geom.dx;
-        let mut ke = 0.0;
-        let mut pe = 0.0;
-        let mut mom = Vec2::zeros();
-        let mut ang = 0.0;
-        let mut mass = 0.0;
-        let mut com = Vec2::zeros();
-        let mut add = |x: &[Vec2], v: &[Vec2], c: &[nalgebra::Matrix2<f64>], m: &[f64]| {
-            for k in 0..x.len() {
-                ke += 0.5 * m[k] * v[k].norm_squared();
-                pe -= m[k] * self.gravity.dot(&x[k]);
-                mom += v[k] * m[k];
-                ang += m[k] * crate::math::cross(x[k], v[k])
-                    + m[k] * dx * dx * 0.25 * (c[k][(1, 0)] - c[k][(0, 1)]);
-                mass += m[k];
-                com += x[k] * m[k];
-            }
-        };
-        add(&p.vert.x, &p.vert.v, &p.vert.c, &p.vert.m);
-        add(&p.quad.x, &p.quad.v, &p.quad.c, &p.quad.m);
-        let s = self.stretches();
-        let (mut lo, mut hi, mut sum) = (f64::INFINITY, f64::NEG_INFINITY, 0.0);
-        for &x in &s {
-            lo = lo.min(x);
-            hi = hi.max(x);
-            sum += x;
-        }
-        Diagnostics {
-            time: self.time,
-            steps: self.steps,
-            kinetic_energy: ke,
-            elastic_energy: self.elastic_energy(),
-            potential_energy: pe,
-            momentum: mom,
-            angular_momentum: ang,
-            min_stretch: lo,
-            max_stretch: hi,
-            mean_stretch: sum / s.len().max(1) as f64,
-            center_of_mass: com / mass,
-            total_mass: mass,
-        }
     }
 }
