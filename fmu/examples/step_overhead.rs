@@ -33,6 +33,7 @@ use YarnBundle::ffi::*;
 use YarnBundle::fmu_model::FmuModel;
 use YarnBundle::massspring::{self as ms, MsModel};
 use YarnBundle::model::*;
+use YarnBundle::yarn::variables::*;
 
 mod common;
 

@@ -16,6 +16,9 @@ use crate::fmu_model::{
 use crate::model::*;
 use crate::state_bytes::{Reader, Writer};
 
+pub mod variables;
+use variables::*;
+
 /// The inputs of one `motion = "input"` pin.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PinInput {
@@ -145,7 +148,7 @@ impl Default for Config {
 
 /// Index of the Real parameter `vr` in [`yarn_real_parameters`] and its
 /// scene field.
-fn real_param(vr: u32) -> Option<(usize, SceneField)> {
+fn real_param(vr: u32) -> Option<(usize, SceneField<YarnScene>)> {
     yarn_real_parameters()
         .enumerate()
         .find(|(_, (p, _))| *p == vr)
