@@ -76,16 +76,19 @@ impl Inputs {
         Ok(())
     }
 
-    /// Checks the inputs the way the library does, then hands them to `sim`.
+    /// The attractor inputs as the library's [`Attractor`].
+    fn attractor(&self) -> Attractor {
+        Attractor {
+            position: Vec2::from(self.attractor),
+            strength: self.strength,
+            active: self.active,
+        }
+    }
+
+    /// Hands the inputs to `sim`, which checks them as [`Self::check`] does.
     fn apply(&self, sim: &mut YarnSim) -> ModelResult {
         sim.set_gravity(Vec2::from(self.gravity))
-            .and_then(|_| {
-                sim.set_attractor(Attractor {
-                    position: Vec2::from(self.attractor),
-                    strength: self.strength,
-                    active: self.active,
-                })
-            })
+            .and_then(|_| sim.set_attractor(self.attractor()))
             .or_else(|e| refuse(e.to_string()))
     }
 
@@ -98,18 +101,10 @@ impl Inputs {
                 g.x, g.y
             ));
         }
-        if !(0.0..=1e6).contains(&self.strength) {
-            return refuse(format!(
-                "attractor strength {} must be in [0, 1e6] m/s2",
-                self.strength
-            ));
-        }
-        if self.attractor.iter().any(|c| c.abs() > 1e6) {
-            return refuse(format!(
-                "attractor position ({}, {}) is absurd (beyond 1e6 m)",
-                self.attractor[0], self.attractor[1]
-            ));
-        }
+        // The attractor's limits are the library's, checked in one place.
+        self.attractor()
+            .check()
+            .or_else(|e| refuse(e.to_string()))?;
         for p in &self.pins {
             let x = Vec2::from(p.position);
             let v = Vec2::from(p.velocity);
