@@ -393,6 +393,18 @@ fn bad_inputs_are_rejected() {
             ..a
         })
         .is_err());
+    // The bound the FMU needs, in the library: |x| <= 1e6 m per coordinate.
+    let far = sim
+        .set_attractor(yarnsim::mpm::Attractor {
+            position: Vec2::new(0.5, 2e6),
+            ..a
+        })
+        .unwrap_err()
+        .to_string();
+    assert!(
+        far.contains("attractor position") && far.contains("1e6"),
+        "{far}"
+    );
     assert!(sim.step_dt(-1.0).is_err());
     assert_eq!(sim.attractor(), a);
 }

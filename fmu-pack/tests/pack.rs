@@ -7,7 +7,7 @@ use std::path::PathBuf;
 use yarnsim::massspring::scenes::wire;
 use yarnsim::scene::{Scene, YarnScene};
 use yarnsim_fmu_pack::*;
-use YarnBundle::model::*;
+use YarnBundle::yarn::variables::*;
 use YarnBundle::SceneFmu;
 
 /// The FMU library cargo built as this crate's dependency:

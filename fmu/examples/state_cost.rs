@@ -23,7 +23,7 @@ use std::time::Instant;
 
 use yarnsim::scene::{Scene, DEFAULT_SCENE};
 use YarnBundle::ffi::*;
-use YarnBundle::model::*;
+use YarnBundle::yarn::variables::*;
 
 mod common;
 

@@ -33,6 +33,7 @@ use YarnBundle::ffi::*;
 use YarnBundle::fmu_model::FmuModel;
 use YarnBundle::massspring::{self as ms, MsModel};
 use YarnBundle::model::*;
+use YarnBundle::yarn::variables::*;
 
 mod common;
 
@@ -180,8 +181,8 @@ fn main() {
         let (check_s, clone_s) = match scene {
             Scene::Yarn(s) => {
                 let mut m = YarnBundle::yarn::YarnModel::new(s.clone()).unwrap();
-                for _ in 0..20 {
-                    m.substep().unwrap();
+                for k in 0..20 {
+                    m.substep(k).unwrap();
                 }
                 let t0 = Instant::now();
                 for _ in 0..reps {
@@ -203,7 +204,7 @@ fn main() {
                 }
                 let t0 = Instant::now();
                 for _ in 0..reps {
-                    assert!(black_box(&m).outputs_finite());
+                    assert!(black_box(&mut m).outputs_finite());
                 }
                 let check = t0.elapsed().as_secs_f64() / reps as f64;
                 let t0 = Instant::now();

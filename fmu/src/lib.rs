@@ -4,24 +4,32 @@
 //! or as `binaries/linux64/MassSpring.so` in a mass-spring FMU) exports the 34
 //! `fmi2*` functions of FMI 2.0 Co-Simulation ([`ffi`]). The scene it runs
 //! travels in the FMU's `resources/scene.toml`: a yarn scene makes it the MPM
-//! yarn bundle (`YarnBundle`), a mass-spring layout (`wire`, `cloth`, ...) the
+//! yarn bundle (`YarnBundle`), a mass-spring scene (`wire`, `cloth`, ...) the
 //! mass-spring system (`MassSpring`). The scene fixes the outputs (yarns or
 //! particles), so `modelDescription.xml` is generated from it
-//! ([`SceneFmu::model_description`] on [`yarnsim::scene::Scene`]) by the `build-fmu` packager (crate
-//! `yarnsim-fmu-pack` in `fmu-pack/`, so this library does not carry the zip
-//! writer and the ELF reader).
+//! ([`SceneFmu::model_description`] on [`yarnsim::scene::Scene`]) by the
+//! `build-fmu` packager (crate `yarnsim-fmu-pack` in `fmu-pack/`, so this
+//! library does not carry the zip writer and the ELF reader).
 //!
-//! * [`model`]: the YarnBundle variables and value references, GUIDs, the
-//!   `modelDescription.xml` writer shared by both FMUs.
+//! Model-neutral (they import no model):
+//! * [`model`]: the variable types and static-table mechanics, the variables
+//!   every model has, the `modelDescription.xml` writer and the GUID hash.
 //! * [`fmu_model`]: the [`fmu_model::FmuModel`] trait between the FMI front
 //!   end and the models, with typed errors.
-//! * [`yarn`], [`massspring`]: each model's inputs, parameters, outputs and
-//!   its part of a serialized FMU state (they implement `FmuModel`).
-//! * [`instance`]: an instance around either model: clock, stepping, values.
+//! * [`state_bytes`]: the framing of a serialized FMU state (magics, version,
+//!   writer and reader); [`clock`]: the wrapper's time keeping.
+//! * [`snapshot`]: FMU state snapshots and their serialization.
 //! * [`state_machine`]: statuses, states and the table of the states each
 //!   function is allowed in.
-//! * [`state_bytes`]: FMU state snapshots and their serialization.
 //! * [`resources`], [`logging`]: the resource location and the logger.
+//!
+//! One module per model, each with its variable table and its `FmuModel`:
+//! * [`yarn`] (table in [`yarn::variables`]), [`massspring`].
+//!
+//! Above them:
+//! * [`models`]: the bundled scene's model, identifier, GUID and description
+//!   (the one module that knows both models).
+//! * [`instance`]: an instance around either model: stepping, values.
 //! * [`ffi`]: the C ABI.
 //!
 //! See the README, section "YarnBundle: the FMI 2.0 Co-Simulation FMU", for
@@ -48,5 +56,5 @@ pub mod state_bytes;
 pub mod state_machine;
 pub mod yarn;
 
-pub use model::{guid, model_description, MODEL_IDENTIFIER};
 pub use models::{new_model, scene_from_toml_str, SceneFmu};
+pub use yarn::variables::{guid, model_description, MODEL_IDENTIFIER};

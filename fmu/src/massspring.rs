@@ -192,161 +192,6 @@ impl MsModel {
         })
     }
 
-    /// Rebuilds the simulation from the layout and the parameters.
-    pub fn rebuild(&mut self, particles: usize) -> ModelResult {
-        let mut sim = build(&self.base, self.integrator, self.dt)?;
-        if sim.positions().len() != particles {
-            return refuse(format!(
-                "the scene has {} particles, but this FMU has outputs for {particles}",
-                sim.positions().len()
-            ));
-        }
-        sim.set_gravity(V3::from(self.gravity))
-            .or_else(|e| refuse(e.to_string()))?;
-        self.sim = sim;
-        Ok(())
-    }
-
-    pub fn count(&self) -> usize {
-        self.sim.positions().len()
-    }
-
-    pub fn dt(&self) -> f64 {
-        self.sim.dt()
-    }
-
-    /// Substep number `k` (0-based since initialization): the clock is set
-    /// to `k dt` first, so the driven particles follow the substep grid.
-    pub fn substep(&mut self, k: u64) -> Result<(), StepFailure> {
-        let dt = self.sim.dt();
-        self.sim.state_mut().t = k as f64 * dt;
-        self.sim.step(dt).map(|_| ()).map_err(|e| StepFailure {
-            terminal: true,
-            msg: e.to_string(),
-        })
-    }
-
-    /// Every Real output this model serves is finite: the positions, the
-    /// four energies and the largest strain (energies overflow to inf long
-    /// before the positions do).
-    pub fn outputs_finite(&self) -> bool {
-        let e = self.sim.energies();
-        e.kinetic.is_finite()
-            && e.elastic.is_finite()
-            && e.gravity.is_finite()
-            && e.total().is_finite()
-            && self.sim.max_strain().is_finite()
-            && self
-                .sim
-                .positions()
-                .iter()
-                .all(|p| p.iter().all(|c| c.is_finite()))
-    }
-
-    /// Whether the Real variable `vr` depends on the simulated state.
-    pub fn is_state_output(&self, vr: u32) -> bool {
-        (VR_KINETIC_ENERGY..=VR_MAX_STRAIN).contains(&vr)
-            || (vr >= VR_PARTICLE_BASE && ((vr - VR_PARTICLE_BASE) / 3) < self.count() as u32)
-    }
-
-    /// The value of the Real variable `vr`, `None` if there is none.
-    pub fn get_real(&self, vr: u32) -> Option<f64> {
-        Some(match vr {
-            VR_GRAVITY_X..=VR_GRAVITY_Z => self.gravity[(vr - VR_GRAVITY_X) as usize],
-            VR_DT => self.dt.unwrap_or(0.0),
-            VR_KINETIC_ENERGY => self.sim.energies().kinetic,
-            VR_ELASTIC_ENERGY => self.sim.energies().elastic,
-            VR_GRAVITY_ENERGY => self.sim.energies().gravity,
-            VR_TOTAL_ENERGY => self.sim.energies().total(),
-            VR_MAX_STRAIN => self.sim.max_strain(),
-            _ if self.is_state_output(vr) => {
-                let i = (vr - VR_PARTICLE_BASE) as usize;
-                self.sim.positions()[i / 3][i % 3]
-            }
-            _ => return None,
-        })
-    }
-
-    pub fn get_boolean(&self, _vr: u32) -> Option<bool> {
-        None
-    }
-
-    pub fn get_string(&self, vr: u32) -> Option<&str> {
-        (vr == VR_INTEGRATOR).then_some(self.integrator.name())
-    }
-
-    /// Sets the gravity inputs and the `dt` parameter; true when the
-    /// parameter changed. A rejected call changes nothing.
-    pub fn set_real(
-        &mut self,
-        vrs: &[u32],
-        vals: &[f64],
-        param_ok: ParamCheck,
-    ) -> ModelResult<bool> {
-        let mut gravity = self.gravity;
-        let mut dt = self.dt;
-        for (&vr, &v) in vrs.iter().zip(vals) {
-            match vr {
-                VR_GRAVITY_X..=VR_GRAVITY_Z => gravity[(vr - VR_GRAVITY_X) as usize] = v,
-                VR_DT => {
-                    param_ok(vr)?;
-                    if !(0.0..=1e3).contains(&v) {
-                        return refuse(format!(
-                            "dt = {v} s is out of range (0 = automatic, else up to 1e3 s)"
-                        ));
-                    }
-                    dt = (v > 0.0).then_some(v);
-                }
-                _ => {
-                    return refuse(format!(
-                        "value reference {vr} is not a Real input or parameter"
-                    ))
-                }
-            }
-        }
-        if gravity != self.gravity {
-            self.sim
-                .set_gravity(V3::from(gravity))
-                .or_else(|e| refuse(format!("{e}")))?;
-            self.gravity = gravity;
-        }
-        let changed = dt != self.dt;
-        self.dt = dt;
-        Ok(changed)
-    }
-
-    pub fn set_boolean(&mut self, vrs: &[u32], _vals: &[bool], _: ParamCheck) -> ModelResult<bool> {
-        match vrs.first() {
-            None => Ok(false),
-            Some(vr) => refuse(format!(
-                "value reference {vr} is not a Boolean input or parameter"
-            )),
-        }
-    }
-
-    /// Sets the `integrator` parameter; true when it changed.
-    pub fn set_string(
-        &mut self,
-        vrs: &[u32],
-        vals: &[Option<String>],
-        param_ok: ParamCheck,
-    ) -> ModelResult<bool> {
-        let mut integrator = self.integrator;
-        for (&vr, v) in vrs.iter().zip(vals) {
-            if vr != VR_INTEGRATOR {
-                return refuse(format!("value reference {vr} is not a String parameter"));
-            }
-            param_ok(vr)?;
-            let Some(v) = v else {
-                return refuse("the integrator name is a null pointer");
-            };
-            integrator = v.parse::<Integrator>().or_else(|e| refuse(e.to_string()))?;
-        }
-        let changed = integrator != self.integrator;
-        self.integrator = integrator;
-        Ok(changed)
-    }
-
     /// This model's part of a serialized FMU state: gravity, parameters, the
     /// layout text, then time, positions and velocities (the state's header
     /// checksums the whole body).
@@ -432,26 +277,150 @@ impl MsModel {
 }
 
 impl FmuModel for MsModel {
+    /// Rebuilds the simulation from the layout and the parameters.
+    fn rebuild(&mut self, particles: usize) -> ModelResult {
+        let mut sim = build(&self.base, self.integrator, self.dt)?;
+        if sim.positions().len() != particles {
+            return refuse(format!(
+                "the scene has {} particles, but this FMU has outputs for {particles}",
+                sim.positions().len()
+            ));
+        }
+        sim.set_gravity(V3::from(self.gravity))
+            .or_else(|e| refuse(e.to_string()))?;
+        self.sim = sim;
+        Ok(())
+    }
+    fn count(&self) -> usize {
+        self.sim.positions().len()
+    }
+    fn dt(&self) -> f64 {
+        self.sim.dt()
+    }
+    /// Substep number `k` (0-based since initialization): the clock is set
+    /// to `k dt` first, so the driven particles follow the substep grid.
+    fn substep(&mut self, k: u64) -> Result<(), StepFailure> {
+        let dt = self.sim.dt();
+        self.sim.state_mut().t = k as f64 * dt;
+        self.sim.step(dt).map(|_| ()).map_err(|e| StepFailure {
+            terminal: true,
+            msg: e.to_string(),
+        })
+    }
+    /// Every Real output this model serves is finite: the positions, the
+    /// four energies and the largest strain (energies overflow to inf long
+    /// before the positions do).
+    fn outputs_finite(&mut self) -> bool {
+        let e = self.sim.energies();
+        e.kinetic.is_finite()
+            && e.elastic.is_finite()
+            && e.gravity.is_finite()
+            && e.total().is_finite()
+            && self.sim.max_strain().is_finite()
+            && self
+                .sim
+                .positions()
+                .iter()
+                .all(|p| p.iter().all(|c| c.is_finite()))
+    }
+    /// Whether the Real variable `vr` depends on the simulated state.
+    fn is_state_output(&self, vr: u32) -> bool {
+        (VR_KINETIC_ENERGY..=VR_MAX_STRAIN).contains(&vr)
+            || (vr >= VR_PARTICLE_BASE && ((vr - VR_PARTICLE_BASE) / 3) < self.count() as u32)
+    }
+    /// The value of the Real variable `vr`, `None` if there is none.
+    fn get_real(&mut self, vr: u32) -> Option<f64> {
+        Some(match vr {
+            VR_GRAVITY_X..=VR_GRAVITY_Z => self.gravity[(vr - VR_GRAVITY_X) as usize],
+            VR_DT => self.dt.unwrap_or(0.0),
+            VR_KINETIC_ENERGY => self.sim.energies().kinetic,
+            VR_ELASTIC_ENERGY => self.sim.energies().elastic,
+            VR_GRAVITY_ENERGY => self.sim.energies().gravity,
+            VR_TOTAL_ENERGY => self.sim.energies().total(),
+            VR_MAX_STRAIN => self.sim.max_strain(),
+            _ if self.is_state_output(vr) => {
+                let i = (vr - VR_PARTICLE_BASE) as usize;
+                self.sim.positions()[i / 3][i % 3]
+            }
+            _ => return None,
+        })
+    }
+    fn get_boolean(&self, _vr: u32) -> Option<bool> {
+        None
+    }
+    fn get_string(&self, vr: u32) -> Option<&str> {
+        (vr == VR_INTEGRATOR).then_some(self.integrator.name())
+    }
+    /// Sets the gravity inputs and the `dt` parameter; true when the
+    /// parameter changed. A rejected call changes nothing.
+    fn set_real(&mut self, vrs: &[u32], vals: &[f64], param_ok: ParamCheck) -> ModelResult<bool> {
+        let mut gravity = self.gravity;
+        let mut dt = self.dt;
+        for (&vr, &v) in vrs.iter().zip(vals) {
+            match vr {
+                VR_GRAVITY_X..=VR_GRAVITY_Z => gravity[(vr - VR_GRAVITY_X) as usize] = v,
+                VR_DT => {
+                    param_ok(vr)?;
+                    if !(0.0..=1e3).contains(&v) {
+                        return refuse(format!(
+                            "dt = {v} s is out of range (0 = automatic, else up to 1e3 s)"
+                        ));
+                    }
+                    dt = (v > 0.0).then_some(v);
+                }
+                _ => {
+                    return refuse(format!(
+                        "value reference {vr} is not a Real input or parameter"
+                    ))
+                }
+            }
+        }
+        if gravity != self.gravity {
+            self.sim
+                .set_gravity(V3::from(gravity))
+                .or_else(|e| refuse(format!("{e}")))?;
+            self.gravity = gravity;
+        }
+        let changed = dt != self.dt;
+        self.dt = dt;
+        Ok(changed)
+    }
+    fn set_boolean(&mut self, vrs: &[u32], _vals: &[bool], _: ParamCheck) -> ModelResult<bool> {
+        match vrs.first() {
+            None => Ok(false),
+            Some(vr) => refuse(format!(
+                "value reference {vr} is not a Boolean input or parameter"
+            )),
+        }
+    }
+    /// Sets the `integrator` parameter; true when it changed.
+    fn set_string(
+        &mut self,
+        vrs: &[u32],
+        vals: &[Option<String>],
+        param_ok: ParamCheck,
+        _ctx: &SetContext,
+    ) -> ModelResult<bool> {
+        let mut integrator = self.integrator;
+        for (&vr, v) in vrs.iter().zip(vals) {
+            if vr != VR_INTEGRATOR {
+                return refuse(format!("value reference {vr} is not a String parameter"));
+            }
+            param_ok(vr)?;
+            let Some(v) = v else {
+                return refuse("the integrator name is a null pointer");
+            };
+            integrator = v.parse::<Integrator>().or_else(|e| refuse(e.to_string()))?;
+        }
+        let changed = integrator != self.integrator;
+        self.integrator = integrator;
+        Ok(changed)
+    }
     fn state_magic(&self) -> &'static [u8; 8] {
         crate::state_bytes::MASS_SPRING_STATE_MAGIC
     }
-    fn count(&self) -> usize {
-        MsModel::count(self)
-    }
-    fn dt(&self) -> f64 {
-        MsModel::dt(self)
-    }
     fn stable_dt(&self) -> Option<f64> {
         self.sim.stable_dt()
-    }
-    fn rebuild(&mut self, count: usize) -> ModelResult {
-        MsModel::rebuild(self, count)
-    }
-    fn substep(&mut self, k: u64) -> Result<(), StepFailure> {
-        MsModel::substep(self, k)
-    }
-    fn outputs_finite(&mut self) -> bool {
-        MsModel::outputs_finite(self)
     }
     /// A clone of the model (cheaper than its serialization).
     fn checkpoint(&self) -> Checkpoint {
@@ -461,33 +430,6 @@ impl FmuModel for MsModel {
         *self = *c
             .downcast::<MsModel>()
             .expect("a checkpoint of a mass-spring model");
-    }
-    fn is_state_output(&self, vr: u32) -> bool {
-        MsModel::is_state_output(self, vr)
-    }
-    fn get_real(&mut self, vr: u32) -> Option<f64> {
-        MsModel::get_real(self, vr)
-    }
-    fn get_boolean(&self, vr: u32) -> Option<bool> {
-        MsModel::get_boolean(self, vr)
-    }
-    fn get_string(&self, vr: u32) -> Option<&str> {
-        MsModel::get_string(self, vr)
-    }
-    fn set_real(&mut self, vrs: &[u32], vals: &[f64], check: ParamCheck) -> ModelResult<bool> {
-        MsModel::set_real(self, vrs, vals, check)
-    }
-    fn set_boolean(&mut self, vrs: &[u32], vals: &[bool], check: ParamCheck) -> ModelResult<bool> {
-        MsModel::set_boolean(self, vrs, vals, check)
-    }
-    fn set_string(
-        &mut self,
-        vrs: &[u32],
-        vals: &[Option<String>],
-        check: ParamCheck,
-        _ctx: &SetContext,
-    ) -> ModelResult<bool> {
-        MsModel::set_string(self, vrs, vals, check)
     }
     /// A clone of the model: the mass-spring simulation has no scratch
     /// worth leaving out.

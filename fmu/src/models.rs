@@ -9,9 +9,9 @@ use yarnsim::scene::Scene;
 
 use crate::fmu_model::{FmuModel, ModelResult};
 use crate::massspring::MsModel;
-use crate::model::{
-    check_value_references, description, guid, num_yarns, write_model_description, Description,
-    MODEL_IDENTIFIER,
+use crate::model::{write_model_description, Description};
+use crate::yarn::variables::{
+    check_value_references, description, guid, num_yarns, MODEL_IDENTIFIER,
 };
 use crate::yarn::YarnModel;
 

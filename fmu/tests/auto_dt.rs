@@ -12,6 +12,7 @@ use yarnsim::mpm::YarnSim;
 use yarnsim::scene::{StepSize, YarnScene};
 use YarnBundle::ffi::*;
 use YarnBundle::model::*;
+use YarnBundle::yarn::variables::*;
 
 const H: f64 = 0.01;
 

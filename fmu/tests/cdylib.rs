@@ -8,7 +8,7 @@ use std::ffi::{c_char, c_int, c_void, CString};
 
 use common::*;
 use YarnBundle::ffi::*;
-use YarnBundle::model::*;
+use YarnBundle::yarn::variables::*;
 
 type Instantiate = unsafe extern "C" fn(
     fmi2String,

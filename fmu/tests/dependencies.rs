@@ -10,7 +10,8 @@ use std::ffi::{c_int, CString};
 use common::*;
 use yarnsim::massspring::scenes::wire;
 use YarnBundle::ffi::*;
-use YarnBundle::model::{self, Dependency, VarType, Variable, VR_SCENE, VR_SUBSTEPS};
+use YarnBundle::model::{self as neutral, Dependency, VarType, Variable, VR_SUBSTEPS};
+use YarnBundle::yarn::variables::{self as model, VR_SCENE};
 
 /// How a variable is changed in the test.
 #[derive(Clone, Debug)]
@@ -85,7 +86,7 @@ fn declared(deps: &[Dependency], output: u32, initial: bool) -> Vec<u32> {
 
 /// Sets each input between steps (from a saved state) and compares every
 /// output before and after, without stepping.
-fn check_outputs(new: &dyn Fn() -> Fmu, d: &model::Description, h: f64) -> usize {
+fn check_outputs(new: &dyn Fn() -> Fmu, d: &neutral::Description, h: f64) -> usize {
     let outs = real_outputs(&d.variables);
     let f = new();
     f.init();
@@ -122,13 +123,13 @@ fn check_outputs(new: &dyn Fn() -> Fmu, d: &model::Description, h: f64) -> usize
 /// Sets each input and parameter in initialization mode and compares the
 /// outputs read there with those of an untouched instance: an output that
 /// changes must declare the variable among its initial dependencies.
-fn check_initial(new: &dyn Fn() -> Fmu, d: &model::Description, alt_scene: &str) -> usize {
+fn check_initial(new: &dyn Fn() -> Fmu, d: &neutral::Description, alt_scene: &str) -> usize {
     check_initial_with(new, d, alt_scene, &alt_scene_text())
 }
 
 fn check_initial_with(
     new: &dyn Fn() -> Fmu,
-    d: &model::Description,
+    d: &neutral::Description,
     alt_scene: &str,
     alt_text: &str,
 ) -> usize {
@@ -246,7 +247,7 @@ fn mass_spring_energies_declare_gravity_and_nothing_else_does() {
     let seen = check_initial(&new, &d, "unused.toml");
     assert!(seen >= 2, "{seen}");
     let xml = YarnBundle::massspring::description(&layout)
-        .map(|d| model::write_model_description(&d))
+        .map(|d| neutral::write_model_description(&d))
         .unwrap();
     let index = |name: &str| 1 + d.variables.iter().position(|v| v.name == name).unwrap();
     let g = format!(
@@ -263,12 +264,18 @@ fn mass_spring_energies_declare_gravity_and_nothing_else_does() {
 
 #[test]
 fn generation_date_is_reproducible() {
-    assert_eq!(model::utc_date_time(0), "1970-01-01T00:00:00Z");
-    assert_eq!(model::utc_date_time(1_764_547_200), "2025-12-01T00:00:00Z");
-    assert_eq!(model::utc_date_time(951_782_400), "2000-02-29T00:00:00Z");
-    assert_eq!(model::utc_date_time(4_102_444_799), "2099-12-31T23:59:59Z");
+    assert_eq!(neutral::utc_date_time(0), "1970-01-01T00:00:00Z");
+    assert_eq!(
+        neutral::utc_date_time(1_764_547_200),
+        "2025-12-01T00:00:00Z"
+    );
+    assert_eq!(neutral::utc_date_time(951_782_400), "2000-02-29T00:00:00Z");
+    assert_eq!(
+        neutral::utc_date_time(4_102_444_799),
+        "2099-12-31T23:59:59Z"
+    );
     let xml = model::model_description(&small_scene());
-    let expected = model::generation_date_and_time();
+    let expected = neutral::generation_date_and_time();
     assert!(xml.contains(&format!("generationDateAndTime=\"{expected}\"")));
     assert_eq!(xml, model::model_description(&small_scene()));
 }

@@ -9,6 +9,7 @@ use common::*;
 use yarnsim::scene::YarnScene;
 use YarnBundle::ffi::*;
 use YarnBundle::model::*;
+use YarnBundle::yarn::variables::*;
 
 const H: f64 = 0.01;
 

@@ -6,7 +6,7 @@ mod common;
 
 use yarnsim::scene::builtin::yarn_reference;
 use yarnsim::scene::YarnScene;
-use YarnBundle::model::*;
+use YarnBundle::yarn::variables::*;
 
 #[test]
 fn checked_in_model_description_is_current() {

@@ -13,7 +13,7 @@ use yarnsim::math::Vec2;
 use yarnsim::mpm::YarnSim;
 use yarnsim::scene::{TransferScheme, YarnScene};
 use YarnBundle::ffi::*;
-use YarnBundle::model::*;
+use YarnBundle::yarn::variables::*;
 
 const H: f64 = 0.01;
 

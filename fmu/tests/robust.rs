@@ -11,6 +11,7 @@ use common::*;
 use yarnsim::massspring::scenes::wire;
 use YarnBundle::ffi::*;
 use YarnBundle::model::*;
+use YarnBundle::yarn::variables::*;
 
 const H: f64 = 0.01;
 

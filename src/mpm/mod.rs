@@ -22,6 +22,7 @@
 //! * [`state`]: byte serialization of the dynamic state.
 //! * [`timestep`]: the stable substep bound (CFL / elastic waves).
 
+pub mod attractor;
 pub mod bending;
 pub mod constitutive;
 pub mod contact;

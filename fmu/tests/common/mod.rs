@@ -11,6 +11,7 @@ use yarnsim::scene::YarnScene;
 use YarnBundle::ffi::*;
 use YarnBundle::instance::Logger;
 use YarnBundle::model::*;
+use YarnBundle::yarn::variables::*;
 
 pub const SMALL_SCENE: &str = include_str!("../../scenes/small.toml");
 

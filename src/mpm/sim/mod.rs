@@ -50,13 +50,7 @@ impl std::fmt::Display for SimError {
 
 impl std::error::Error for SimError {}
 
-/// The attractor as the simulation sees it (settable at run time).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Attractor {
-    pub position: Vec2,
-    pub strength: f64,
-    pub active: bool,
-}
+pub use super::attractor::Attractor;
 
 /// How the substep is chosen (`[time] dt`).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -336,20 +330,9 @@ impl YarnSim {
         Ok(())
     }
 
-    /// Sets the attractor; rejects non-finite positions and strengths outside [0, 1e6].
+    /// Sets the attractor; refuses one that fails [`Attractor::check`].
     pub fn set_attractor(&mut self, a: Attractor) -> Result<(), SimError> {
-        if !(a.position.x.is_finite() && a.position.y.is_finite()) {
-            return Err(SimError::BadInput(format!(
-                "attractor position ({}, {}) must be finite",
-                a.position.x, a.position.y
-            )));
-        }
-        if !(a.strength.is_finite() && (0.0..=1e6).contains(&a.strength)) {
-            return Err(SimError::BadInput(format!(
-                "attractor strength {} must be in [0, 1e6]",
-                a.strength
-            )));
-        }
+        a.check()?;
         self.attractor = a;
         Ok(())
     }

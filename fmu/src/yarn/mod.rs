@@ -1,12 +1,13 @@
 //! The yarn-bundle physics behind the `YarnBundle` FMU: inputs, parameter
 //! overrides, the [`YarnSim`] they build, the values of its variables
-//! ([`crate::model`] lists them) and its part of a serialized FMU state.
+//! ([`variables`] lists them; [`inputs`] holds the inputs) and its part of
+//! a serialized FMU state.
 
 use std::path::Path;
 
 use yarnsim::math::Vec2;
 use yarnsim::mpm::state::DynamicState;
-use yarnsim::mpm::{Attractor, Diagnostics, SimError, YarnSim};
+use yarnsim::mpm::{Diagnostics, SimError, YarnSim};
 use yarnsim::scene::{TransferScheme, YarnScene};
 
 use crate::fmu_model::{
@@ -16,110 +17,11 @@ use crate::fmu_model::{
 use crate::model::*;
 use crate::state_bytes::{Reader, Writer};
 
-/// The inputs of one `motion = "input"` pin.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct PinInput {
-    /// Index in `[[pins]]`.
-    pub pin: usize,
-    /// `pin[i].x`, `.y`: position of the pin's first vertex, m.
-    pub position: [f64; 2],
-    /// `pin[i].vx`, `.vy`: velocity of its vertices, m/s.
-    pub velocity: [f64; 2],
-}
+mod inputs;
+pub mod variables;
 
-/// Values of the inputs.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Inputs {
-    pub attractor: [f64; 2],
-    pub strength: f64,
-    pub active: bool,
-    pub gravity: [f64; 2],
-    /// The driven pins, in `[[pins]]` order.
-    pub pins: Vec<PinInput>,
-}
-
-impl Inputs {
-    fn from_scene(s: &YarnScene) -> Self {
-        Inputs {
-            attractor: s.attractor.position,
-            strength: s.attractor.strength,
-            active: s.attractor.active,
-            gravity: s.gravity,
-            pins: fmu_pins(s)
-                .iter()
-                .enumerate()
-                .filter(|(_, p)| p.input)
-                .map(|(pin, p)| PinInput {
-                    pin,
-                    position: p.start,
-                    velocity: [0.0; 2],
-                })
-                .collect(),
-        }
-    }
-
-    /// The driven pin `pin`'s inputs.
-    fn pin_mut(&mut self, pin: usize) -> Option<&mut PinInput> {
-        self.pins.iter_mut().find(|p| p.pin == pin)
-    }
-
-    /// Hands the pin targets to `sim`, for the communication step that
-    /// starts at `since` on the simulation's clock.
-    fn latch_pins(&self, sim: &mut YarnSim, since: f64) -> ModelResult {
-        for p in &self.pins {
-            sim.set_pin_target_at(p.pin, Vec2::from(p.position), Vec2::from(p.velocity), since)
-                .or_else(|e| refuse(e.to_string()))?;
-        }
-        Ok(())
-    }
-
-    /// Checks the inputs the way the library does, then hands them to `sim`.
-    fn apply(&self, sim: &mut YarnSim) -> ModelResult {
-        sim.set_gravity(Vec2::from(self.gravity))
-            .and_then(|_| {
-                sim.set_attractor(Attractor {
-                    position: Vec2::from(self.attractor),
-                    strength: self.strength,
-                    active: self.active,
-                })
-            })
-            .or_else(|e| refuse(e.to_string()))
-    }
-
-    /// The library's input limits, without a simulation at hand.
-    fn check(&self) -> ModelResult {
-        let g = Vec2::from(self.gravity);
-        if g.norm() > 1e6 {
-            return refuse(format!(
-                "gravity ({}, {}) is absurd (|g| above 1e6 m/s2)",
-                g.x, g.y
-            ));
-        }
-        if !(0.0..=1e6).contains(&self.strength) {
-            return refuse(format!(
-                "attractor strength {} must be in [0, 1e6] m/s2",
-                self.strength
-            ));
-        }
-        if self.attractor.iter().any(|c| c.abs() > 1e6) {
-            return refuse(format!(
-                "attractor position ({}, {}) is absurd (beyond 1e6 m)",
-                self.attractor[0], self.attractor[1]
-            ));
-        }
-        for p in &self.pins {
-            let x = Vec2::from(p.position);
-            let v = Vec2::from(p.velocity);
-            if x.norm() > 1e6 || v.norm() > 1e6 {
-                return refuse(format!(
-                    "pin[{}] position ({}, {}) m or velocity ({}, {}) m/s is absurd (beyond 1e6)",
-                    p.pin, x.x, x.y, v.x, v.y
-                ));
-            }
-        }
-        Ok(())
-    }
-}
+pub use inputs::{Inputs, PinInput};
+use variables::*;
 
 /// The parameters as set by the environment (`None`: the scene's value).
 #[derive(Clone, Debug, PartialEq)]
@@ -145,7 +47,7 @@ impl Default for Config {
 
 /// Index of the Real parameter `vr` in [`yarn_real_parameters`] and its
 /// scene field.
-fn real_param(vr: u32) -> Option<(usize, SceneField)> {
+fn real_param(vr: u32) -> Option<(usize, SceneField<YarnScene>)> {
     yarn_real_parameters()
         .enumerate()
         .find(|(_, (p, _))| *p == vr)
@@ -255,62 +157,6 @@ impl YarnModel {
         })
     }
 
-    /// Rebuilds the simulation from the scene and the parameters.
-    pub fn rebuild(&mut self, yarns: usize) -> ModelResult {
-        let scene = effective_scene(&self.base, &self.config);
-        let mut sim = YarnSim::new(&scene).or_else(|e| refuse(format!("parameters: {e}")))?;
-        if sim.num_yarns() != yarns {
-            return refuse(format!(
-                "scene {:?} creates {} yarns, but this FMU has outputs for {yarns}",
-                self.config.scene_path,
-                sim.num_yarns()
-            ));
-        }
-        self.inputs.apply(&mut sim)?;
-        self.sim = sim;
-        self.diag = None;
-        self.forces = PinForces::new(self.base.pins.len());
-        Ok(())
-    }
-
-    pub fn count(&self) -> usize {
-        self.sim.num_yarns()
-    }
-
-    pub fn dt(&self) -> f64 {
-        self.sim.dt()
-    }
-
-    /// A communication step from `since` (on the simulation's clock)
-    /// begins: the pin inputs become the targets of the driven pins and
-    /// the force sums restart.
-    pub fn begin_step(&mut self, since: f64) -> Result<(), StepFailure> {
-        self.inputs
-            .latch_pins(&mut self.sim, since)
-            .map_err(|e| StepFailure {
-                terminal: false,
-                msg: e.0,
-            })?;
-        self.forces = PinForces::new(self.forces.sum.len());
-        Ok(())
-    }
-
-    pub fn substep(&mut self) -> Result<(), StepFailure> {
-        self.diag = None;
-        let step = self.sim.step();
-        self.after_substep(step, 1.0)
-    }
-
-    /// One adaptive substep toward `until` on the simulation's clock
-    /// (`dt = "auto"`), the last one landing on it.
-    pub fn substep_toward(&mut self, until: f64) -> Result<(), StepFailure> {
-        self.diag = None;
-        let before = self.sim.time();
-        let step = self.sim.step_toward(until).map(|_| ());
-        let dt = self.sim.time() - before;
-        self.after_substep(step, dt)
-    }
-
     /// Adds the substep's pin forces with `weight` (1, or the substep's
     /// length under `dt = "auto"`).
     fn after_substep(
@@ -331,25 +177,6 @@ impl YarnModel {
         Ok(())
     }
 
-    /// Every Real output is finite: the yarn ends, the energies and the
-    /// largest stretch (the library reports divergence itself; this makes
-    /// sure no step ends OK with a non-finite output). The diagnostics it
-    /// computes are cached for the `fmi2GetReal` calls that follow.
-    pub fn outputs_finite(&mut self) -> bool {
-        let d = self.diagnostics();
-        d.kinetic_energy.is_finite()
-            && d.elastic_energy.is_finite()
-            && d.max_stretch.is_finite()
-            && (0..self.count()).all(|y| {
-                let (l, r) = self.sim.yarn_endpoints(y);
-                l.x.is_finite() && l.y.is_finite() && r.x.is_finite() && r.y.is_finite()
-            })
-            && (0..self.forces.sum.len()).all(|i| {
-                let f = self.forces.mean(i);
-                f.x.is_finite() && f.y.is_finite()
-            })
-    }
-
     /// Pin `i` and offset `k` of a pin value reference.
     fn pin_vr(&self, vr: u32) -> Option<(usize, u32)> {
         let i = (vr.checked_sub(VR_PIN_BASE)? / 8) as usize;
@@ -358,165 +185,6 @@ impl YarnModel {
 
     fn diagnostics(&mut self) -> Diagnostics {
         *self.diag.get_or_insert_with(|| self.sim.diagnostics())
-    }
-
-    /// Whether the Real variable `vr` depends on the simulated state.
-    pub fn is_state_output(&self, vr: u32) -> bool {
-        matches!(vr, VR_KINETIC_ENERGY | VR_ELASTIC_ENERGY | VR_MAX_STRETCH)
-            || ((VR_YARN_BASE..VR_PIN_BASE).contains(&vr)
-                && ((vr - VR_YARN_BASE) / 4) < self.count() as u32)
-            || matches!(self.pin_vr(vr), Some((_, k)) if k == PIN_FORCE || k == PIN_FORCE + 1)
-    }
-
-    /// The value of the Real variable `vr`, `None` if there is none.
-    pub fn get_real(&mut self, vr: u32) -> Option<f64> {
-        Some(match vr {
-            VR_ATTRACTOR_X => self.inputs.attractor[0],
-            VR_ATTRACTOR_Y => self.inputs.attractor[1],
-            VR_ATTRACTOR_STRENGTH => self.inputs.strength,
-            VR_GRAVITY_X => self.inputs.gravity[0],
-            VR_GRAVITY_Y => self.inputs.gravity[1],
-            _ if real_param(vr).is_some() => {
-                let (i, field) = real_param(vr).unwrap();
-                self.config.reals[i].unwrap_or_else(|| (field.get)(&self.base))
-            }
-            VR_KINETIC_ENERGY => self.diagnostics().kinetic_energy,
-            VR_ELASTIC_ENERGY => self.diagnostics().elastic_energy,
-            VR_MAX_STRETCH => self.diagnostics().max_stretch,
-            _ if self.pin_vr(vr).is_some() => {
-                let (i, k) = self.pin_vr(vr).unwrap();
-                match k {
-                    0..=3 => {
-                        let p = self.inputs.pins.iter().find(|p| p.pin == i)?;
-                        [p.position[0], p.position[1], p.velocity[0], p.velocity[1]][k as usize]
-                    }
-                    PIN_FORCE => self.forces.mean(i).x,
-                    5 => self.forces.mean(i).y,
-                    _ => return None,
-                }
-            }
-            _ if self.is_state_output(vr) => {
-                let i = (vr - VR_YARN_BASE) as usize;
-                let (l, r) = self.sim.yarn_endpoints(i / 4);
-                [l.x, l.y, r.x, r.y][i % 4]
-            }
-            _ => return None,
-        })
-    }
-
-    pub fn get_boolean(&self, vr: u32) -> Option<bool> {
-        match vr {
-            VR_ATTRACTOR_ACTIVE => Some(self.inputs.active),
-            VR_PLASTICITY => Some(
-                self.config
-                    .plasticity
-                    .unwrap_or(self.base.material.plasticity),
-            ),
-            _ => None,
-        }
-    }
-
-    pub fn get_string(&self, vr: u32) -> Option<&str> {
-        match vr {
-            VR_SCENE => Some(self.config.scene_path.as_str()),
-            VR_TRANSFER_SCHEME => Some(scheme_name(
-                self.config.scheme.unwrap_or(self.base.transfer.scheme),
-            )),
-            _ => None,
-        }
-    }
-
-    /// Sets Real inputs and parameters; true when a parameter changed (the
-    /// simulation must be rebuilt). A rejected call changes nothing.
-    pub fn set_real(
-        &mut self,
-        vrs: &[u32],
-        vals: &[f64],
-        param_ok: ParamCheck,
-    ) -> ModelResult<bool> {
-        let mut inputs = self.inputs.clone();
-        let mut reals = self.config.reals;
-        for (&vr, &v) in vrs.iter().zip(vals) {
-            match vr {
-                _ if matches!(self.pin_vr(vr), Some((_, 0..=3))) => {
-                    let (i, k) = self.pin_vr(vr).unwrap();
-                    let Some(p) = inputs.pin_mut(i) else {
-                        return refuse(format!(
-                            "value reference {vr} (pin {i}) is not an input: pin {i} is not a motion = \"input\" pin"
-                        ));
-                    };
-                    match k {
-                        0 => p.position[0] = v,
-                        1 => p.position[1] = v,
-                        2 => p.velocity[0] = v,
-                        _ => p.velocity[1] = v,
-                    }
-                }
-                VR_ATTRACTOR_X => inputs.attractor[0] = v,
-                VR_ATTRACTOR_Y => inputs.attractor[1] = v,
-                VR_ATTRACTOR_STRENGTH => inputs.strength = v,
-                VR_GRAVITY_X => inputs.gravity[0] = v,
-                VR_GRAVITY_Y => inputs.gravity[1] = v,
-                _ if real_param(vr).is_some() => {
-                    param_ok(vr)?;
-                    let (i, field) = real_param(vr).unwrap();
-                    let ok = if field.positive { v > 0.0 } else { v >= 0.0 } && v <= field.max;
-                    if !ok {
-                        let range = if field.positive { "> 0" } else { ">= 0" };
-                        return refuse(format!(
-                            "parameter value reference {vr} = {v} is out of range (must be {range} and at most {})",
-                            field.max
-                        ));
-                    }
-                    reals[i] = Some(v);
-                }
-                _ => {
-                    return refuse(format!(
-                        "value reference {vr} is not a Real input or parameter"
-                    ))
-                }
-            }
-        }
-        inputs.check()?;
-        if inputs != self.inputs {
-            inputs.apply(&mut self.sim)?;
-            self.inputs = inputs;
-        }
-        let changed = reals != self.config.reals;
-        self.config.reals = reals;
-        Ok(changed)
-    }
-
-    /// Sets Boolean inputs and parameters; true when a parameter changed.
-    pub fn set_boolean(
-        &mut self,
-        vrs: &[u32],
-        vals: &[bool],
-        param_ok: ParamCheck,
-    ) -> ModelResult<bool> {
-        let mut active = self.inputs.active;
-        let mut plasticity = self.config.plasticity;
-        for (&vr, &v) in vrs.iter().zip(vals) {
-            match vr {
-                VR_ATTRACTOR_ACTIVE => active = v,
-                VR_PLASTICITY => {
-                    param_ok(vr)?;
-                    plasticity = Some(v);
-                }
-                _ => {
-                    return refuse(format!(
-                        "value reference {vr} is not a Boolean input or parameter"
-                    ))
-                }
-            }
-        }
-        if active != self.inputs.active {
-            self.inputs.active = active;
-            self.inputs.apply(&mut self.sim)?;
-        }
-        let changed = plasticity != self.config.plasticity;
-        self.config.plasticity = plasticity;
-        Ok(changed)
     }
 
     /// Sets the `scene` parameter: a scene file in `resources` (or the
@@ -755,38 +423,233 @@ impl YarnModel {
 }
 
 impl FmuModel for YarnModel {
+    fn count(&self) -> usize {
+        self.sim.num_yarns()
+    }
+    fn dt(&self) -> f64 {
+        self.sim.dt()
+    }
+    /// Rebuilds the simulation from the scene and the parameters.
+    fn rebuild(&mut self, yarns: usize) -> ModelResult {
+        let scene = effective_scene(&self.base, &self.config);
+        let mut sim = YarnSim::new(&scene).or_else(|e| refuse(format!("parameters: {e}")))?;
+        if sim.num_yarns() != yarns {
+            return refuse(format!(
+                "scene {:?} creates {} yarns, but this FMU has outputs for {yarns}",
+                self.config.scene_path,
+                sim.num_yarns()
+            ));
+        }
+        self.inputs.apply(&mut sim)?;
+        self.sim = sim;
+        self.diag = None;
+        self.forces = PinForces::new(self.base.pins.len());
+        Ok(())
+    }
+    /// A communication step from `since` (on the simulation's clock)
+    /// begins: the pin inputs become the targets of the driven pins and
+    /// the force sums restart.
+    fn begin_step(&mut self, since: f64) -> Result<(), StepFailure> {
+        self.inputs
+            .latch_pins(&mut self.sim, since)
+            .map_err(|e| StepFailure {
+                terminal: false,
+                msg: e.0,
+            })?;
+        self.forces = PinForces::new(self.forces.sum.len());
+        Ok(())
+    }
+    /// One adaptive substep toward `until` on the simulation's clock
+    /// (`dt = "auto"`), the last one landing on it.
+    fn substep_toward(&mut self, until: f64) -> Result<(), StepFailure> {
+        self.diag = None;
+        let before = self.sim.time();
+        let step = self.sim.step_toward(until).map(|_| ());
+        let dt = self.sim.time() - before;
+        self.after_substep(step, dt)
+    }
+    fn substep(&mut self, _k: u64) -> Result<(), StepFailure> {
+        self.diag = None;
+        let step = self.sim.step();
+        self.after_substep(step, 1.0)
+    }
+    /// Every Real output is finite: the yarn ends, the energies and the
+    /// largest stretch (the library reports divergence itself; this makes
+    /// sure no step ends OK with a non-finite output). The diagnostics it
+    /// computes are cached for the `fmi2GetReal` calls that follow.
+    fn outputs_finite(&mut self) -> bool {
+        let d = self.diagnostics();
+        d.kinetic_energy.is_finite()
+            && d.elastic_energy.is_finite()
+            && d.max_stretch.is_finite()
+            && (0..self.count()).all(|y| {
+                let (l, r) = self.sim.yarn_endpoints(y);
+                l.x.is_finite() && l.y.is_finite() && r.x.is_finite() && r.y.is_finite()
+            })
+            && (0..self.forces.sum.len()).all(|i| {
+                let f = self.forces.mean(i);
+                f.x.is_finite() && f.y.is_finite()
+            })
+    }
+    /// Whether the Real variable `vr` depends on the simulated state.
+    fn is_state_output(&self, vr: u32) -> bool {
+        matches!(vr, VR_KINETIC_ENERGY | VR_ELASTIC_ENERGY | VR_MAX_STRETCH)
+            || ((VR_YARN_BASE..VR_PIN_BASE).contains(&vr)
+                && ((vr - VR_YARN_BASE) / 4) < self.count() as u32)
+            || matches!(self.pin_vr(vr), Some((_, k)) if k == PIN_FORCE || k == PIN_FORCE + 1)
+    }
+    /// The value of the Real variable `vr`, `None` if there is none.
+    fn get_real(&mut self, vr: u32) -> Option<f64> {
+        Some(match vr {
+            VR_ATTRACTOR_X => self.inputs.attractor[0],
+            VR_ATTRACTOR_Y => self.inputs.attractor[1],
+            VR_ATTRACTOR_STRENGTH => self.inputs.strength,
+            VR_GRAVITY_X => self.inputs.gravity[0],
+            VR_GRAVITY_Y => self.inputs.gravity[1],
+            _ if real_param(vr).is_some() => {
+                let (i, field) = real_param(vr).unwrap();
+                self.config.reals[i].unwrap_or_else(|| (field.get)(&self.base))
+            }
+            VR_KINETIC_ENERGY => self.diagnostics().kinetic_energy,
+            VR_ELASTIC_ENERGY => self.diagnostics().elastic_energy,
+            VR_MAX_STRETCH => self.diagnostics().max_stretch,
+            _ if self.pin_vr(vr).is_some() => {
+                let (i, k) = self.pin_vr(vr).unwrap();
+                match k {
+                    0..=3 => {
+                        let p = self.inputs.pins.iter().find(|p| p.pin == i)?;
+                        [p.position[0], p.position[1], p.velocity[0], p.velocity[1]][k as usize]
+                    }
+                    PIN_FORCE => self.forces.mean(i).x,
+                    5 => self.forces.mean(i).y,
+                    _ => return None,
+                }
+            }
+            _ if self.is_state_output(vr) => {
+                let i = (vr - VR_YARN_BASE) as usize;
+                let (l, r) = self.sim.yarn_endpoints(i / 4);
+                [l.x, l.y, r.x, r.y][i % 4]
+            }
+            _ => return None,
+        })
+    }
+    fn get_boolean(&self, vr: u32) -> Option<bool> {
+        match vr {
+            VR_ATTRACTOR_ACTIVE => Some(self.inputs.active),
+            VR_PLASTICITY => Some(
+                self.config
+                    .plasticity
+                    .unwrap_or(self.base.material.plasticity),
+            ),
+            _ => None,
+        }
+    }
+    fn get_string(&self, vr: u32) -> Option<&str> {
+        match vr {
+            VR_SCENE => Some(self.config.scene_path.as_str()),
+            VR_TRANSFER_SCHEME => Some(scheme_name(
+                self.config.scheme.unwrap_or(self.base.transfer.scheme),
+            )),
+            _ => None,
+        }
+    }
+    /// Sets Real inputs and parameters; true when a parameter changed (the
+    /// simulation must be rebuilt). A rejected call changes nothing.
+    fn set_real(&mut self, vrs: &[u32], vals: &[f64], param_ok: ParamCheck) -> ModelResult<bool> {
+        let mut inputs = self.inputs.clone();
+        let mut reals = self.config.reals;
+        for (&vr, &v) in vrs.iter().zip(vals) {
+            match vr {
+                _ if matches!(self.pin_vr(vr), Some((_, 0..=3))) => {
+                    let (i, k) = self.pin_vr(vr).unwrap();
+                    let Some(p) = inputs.pin_mut(i) else {
+                        return refuse(format!(
+                            "value reference {vr} (pin {i}) is not an input: pin {i} is not a motion = \"input\" pin"
+                        ));
+                    };
+                    match k {
+                        0 => p.position[0] = v,
+                        1 => p.position[1] = v,
+                        2 => p.velocity[0] = v,
+                        _ => p.velocity[1] = v,
+                    }
+                }
+                VR_ATTRACTOR_X => inputs.attractor[0] = v,
+                VR_ATTRACTOR_Y => inputs.attractor[1] = v,
+                VR_ATTRACTOR_STRENGTH => inputs.strength = v,
+                VR_GRAVITY_X => inputs.gravity[0] = v,
+                VR_GRAVITY_Y => inputs.gravity[1] = v,
+                _ if real_param(vr).is_some() => {
+                    param_ok(vr)?;
+                    let (i, field) = real_param(vr).unwrap();
+                    let ok = if field.positive { v > 0.0 } else { v >= 0.0 } && v <= field.max;
+                    if !ok {
+                        let range = if field.positive { "> 0" } else { ">= 0" };
+                        return refuse(format!(
+                            "parameter value reference {vr} = {v} is out of range (must be {range} and at most {})",
+                            field.max
+                        ));
+                    }
+                    reals[i] = Some(v);
+                }
+                _ => {
+                    return refuse(format!(
+                        "value reference {vr} is not a Real input or parameter"
+                    ))
+                }
+            }
+        }
+        inputs.check()?;
+        if inputs != self.inputs {
+            inputs.apply(&mut self.sim)?;
+            self.inputs = inputs;
+        }
+        let changed = reals != self.config.reals;
+        self.config.reals = reals;
+        Ok(changed)
+    }
+    /// Sets Boolean inputs and parameters; true when a parameter changed.
+    fn set_boolean(
+        &mut self,
+        vrs: &[u32],
+        vals: &[bool],
+        param_ok: ParamCheck,
+    ) -> ModelResult<bool> {
+        let mut active = self.inputs.active;
+        let mut plasticity = self.config.plasticity;
+        for (&vr, &v) in vrs.iter().zip(vals) {
+            match vr {
+                VR_ATTRACTOR_ACTIVE => active = v,
+                VR_PLASTICITY => {
+                    param_ok(vr)?;
+                    plasticity = Some(v);
+                }
+                _ => {
+                    return refuse(format!(
+                        "value reference {vr} is not a Boolean input or parameter"
+                    ))
+                }
+            }
+        }
+        if active != self.inputs.active {
+            self.inputs.active = active;
+            self.inputs.apply(&mut self.sim)?;
+        }
+        let changed = plasticity != self.config.plasticity;
+        self.config.plasticity = plasticity;
+        Ok(changed)
+    }
     fn state_magic(&self) -> &'static [u8; 8] {
         crate::state_bytes::YARN_STATE_MAGIC
     }
-    fn count(&self) -> usize {
-        YarnModel::count(self)
-    }
-    fn dt(&self) -> f64 {
-        YarnModel::dt(self)
-    }
     fn stable_dt(&self) -> Option<f64> {
         Some(self.sim.stable_dt())
-    }
-    fn rebuild(&mut self, count: usize) -> ModelResult {
-        YarnModel::rebuild(self, count)
-    }
-    fn begin_step(&mut self, since_start: f64) -> Result<(), StepFailure> {
-        YarnModel::begin_step(self, since_start)
     }
     fn adaptive(&self) -> bool {
         self.sim.is_auto()
     }
     fn substeps_to(&self, until: f64) -> u64 {
         self.sim.substeps_to(until)
-    }
-    fn substep_toward(&mut self, until: f64) -> Result<(), StepFailure> {
-        YarnModel::substep_toward(self, until)
-    }
-    fn substep(&mut self, _k: u64) -> Result<(), StepFailure> {
-        YarnModel::substep(self)
-    }
-    fn outputs_finite(&mut self) -> bool {
-        YarnModel::outputs_finite(self)
     }
     /// The library's dynamic state (`YarnSim::dynamic_state`: particles,
     /// clock, inputs; not the grid) and the pin force sums.
@@ -802,24 +665,6 @@ impl FmuModel for YarnModel {
             .expect("the simulation's own dynamic state fits it");
         self.forces = forces;
         self.diag = None;
-    }
-    fn is_state_output(&self, vr: u32) -> bool {
-        YarnModel::is_state_output(self, vr)
-    }
-    fn get_real(&mut self, vr: u32) -> Option<f64> {
-        YarnModel::get_real(self, vr)
-    }
-    fn get_boolean(&self, vr: u32) -> Option<bool> {
-        YarnModel::get_boolean(self, vr)
-    }
-    fn get_string(&self, vr: u32) -> Option<&str> {
-        YarnModel::get_string(self, vr)
-    }
-    fn set_real(&mut self, vrs: &[u32], vals: &[f64], check: ParamCheck) -> ModelResult<bool> {
-        YarnModel::set_real(self, vrs, vals, check)
-    }
-    fn set_boolean(&mut self, vrs: &[u32], vals: &[bool], check: ParamCheck) -> ModelResult<bool> {
-        YarnModel::set_boolean(self, vrs, vals, check)
     }
     fn set_string(
         &mut self,

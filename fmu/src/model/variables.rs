@@ -1,0 +1,187 @@
+//! The variable types of `modelDescription.xml` and the static-table
+//! mechanics: a [`VarSpec`] row (name, value reference, type, causality,
+//! variability, unit, start, description) over a model's scene type `S`,
+//! and for the Real parameters the scene field ([`SceneField`]) that the
+//! getter and setter use.
+
+/// The FMI base type of a variable.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum VarType {
+    Real,
+    Integer,
+    Boolean,
+    String,
+}
+
+/// A variable of the FMU as it appears in `modelDescription.xml`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Variable {
+    pub name: String,
+    pub vr: u32,
+    pub ty: VarType,
+    /// `"parameter"`, `"input"` or `"output"`.
+    pub causality: &'static str,
+    /// `"fixed"`, `"discrete"` or `"continuous"`.
+    pub variability: &'static str,
+    pub unit: Option<&'static str>,
+    /// Start value as written in the XML (inputs and parameters only).
+    pub start: Option<String>,
+    pub description: String,
+}
+
+/// Formats an `f64` so that it reads back to the same bits (shortest round trip).
+pub fn real(v: f64) -> String {
+    format!("{v:?}")
+}
+
+fn boolean(b: bool) -> String {
+    if b { "true" } else { "false" }.to_string()
+}
+
+/// A Real parameter that lives in the scene (of type `S`): how to read and
+/// override it.
+pub struct SceneField<S> {
+    pub get: fn(&S) -> f64,
+    pub set: fn(&mut S, f64),
+    /// Must be > 0 (else >= 0).
+    pub positive: bool,
+    /// Largest accepted value.
+    pub max: f64,
+}
+
+impl<S> Clone for SceneField<S> {
+    fn clone(&self) -> Self {
+        *self
+    }
+}
+impl<S> Copy for SceneField<S> {}
+
+/// Where a variable's start value comes from (a scene of type `S`).
+pub enum Start<S> {
+    /// Outputs have none.
+    None,
+    /// A Real parameter in the scene (also its getter and setter).
+    Scene(SceneField<S>),
+    /// A Real read from the scene.
+    Real(fn(&S) -> f64),
+    /// A Boolean read from the scene.
+    Bool(fn(&S) -> bool),
+    /// A fixed text.
+    Text(&'static str),
+    /// A name read from the scene.
+    Name(fn(&S) -> &'static str),
+}
+
+impl<S> Clone for Start<S> {
+    fn clone(&self) -> Self {
+        *self
+    }
+}
+impl<S> Copy for Start<S> {}
+
+/// One row of a model's variable table; `S` is the scene type its start
+/// values are read from (the yarn scene, or the mass-spring layout).
+pub struct VarSpec<S> {
+    pub name: &'static str,
+    pub vr: u32,
+    pub ty: VarType,
+    pub causality: &'static str,
+    pub variability: &'static str,
+    pub unit: Option<&'static str>,
+    pub start: Start<S>,
+    pub description: &'static str,
+}
+
+impl<S> Clone for VarSpec<S> {
+    fn clone(&self) -> Self {
+        *self
+    }
+}
+impl<S> Copy for VarSpec<S> {}
+
+impl<S> VarSpec<S> {
+    /// The variable as written in `modelDescription.xml`, for this scene.
+    pub fn variable(&self, scene: &S) -> Variable {
+        Variable {
+            name: self.name.to_string(),
+            vr: self.vr,
+            ty: self.ty,
+            causality: self.causality,
+            variability: self.variability,
+            unit: self.unit,
+            start: match self.start {
+                Start::None => None,
+                Start::Scene(f) => Some(real((f.get)(scene))),
+                Start::Real(f) => Some(real(f(scene))),
+                Start::Bool(f) => Some(boolean(f(scene))),
+                Start::Text(t) => Some(t.to_string()),
+                Start::Name(f) => Some(f(scene).to_string()),
+            },
+            description: self.description.to_string(),
+        }
+    }
+}
+
+/// An input row (Real inputs continuous, others discrete).
+pub const fn input<S>(
+    name: &'static str,
+    vr: u32,
+    ty: VarType,
+    unit: Option<&'static str>,
+    start: Start<S>,
+    description: &'static str,
+) -> VarSpec<S> {
+    VarSpec {
+        name,
+        vr,
+        ty,
+        causality: "input",
+        variability: match ty {
+            VarType::Real => "continuous",
+            _ => "discrete",
+        },
+        unit,
+        start,
+        description,
+    }
+}
+
+/// A fixed parameter row.
+pub const fn parameter<S>(
+    name: &'static str,
+    vr: u32,
+    ty: VarType,
+    unit: Option<&'static str>,
+    start: Start<S>,
+    description: &'static str,
+) -> VarSpec<S> {
+    VarSpec {
+        name,
+        vr,
+        ty,
+        causality: "parameter",
+        variability: "fixed",
+        unit,
+        start,
+        description,
+    }
+}
+
+/// A continuous Real output row.
+pub const fn output<S>(
+    name: &'static str,
+    vr: u32,
+    unit: Option<&'static str>,
+    description: &'static str,
+) -> VarSpec<S> {
+    VarSpec {
+        name,
+        vr,
+        ty: VarType::Real,
+        causality: "output",
+        variability: "continuous",
+        unit,
+        start: Start::None,
+        description,
+    }
+}

@@ -1,0 +1,238 @@
+//! `modelDescription.xml`: what it is written from ([`Description`]), the
+//! writer, the GUID hash and the generation date; model-neutral.
+
+use std::fmt::Write as _;
+
+use yarnsim::mpm::state::fnv1a;
+
+use super::{real, VarType, Variable, LOG_CATEGORIES};
+
+/// A GUID-formatted 128-bit hash of `text`.
+pub fn guid_of(text: &str) -> String {
+    let a = fnv1a(text.as_bytes());
+    let b = fnv1a(format!("{text}\u{1}").as_bytes());
+    format!(
+        "{{{:08x}-{:04x}-{:04x}-{:04x}-{:012x}}}",
+        a >> 32,
+        (a >> 16) & 0xffff,
+        a & 0xffff,
+        b >> 48,
+        b & 0xffff_ffff_ffff
+    )
+}
+
+/// Escapes text for an XML attribute.
+pub fn xml_escape(s: &str) -> String {
+    let mut out = String::with_capacity(s.len());
+    for c in s.chars() {
+        match c {
+            '&' => out.push_str("&amp;"),
+            '<' => out.push_str("&lt;"),
+            '>' => out.push_str("&gt;"),
+            '"' => out.push_str("&quot;"),
+            '\'' => out.push_str("&apos;"),
+            c if (c as u32) < 0x20 => out.push(' '),
+            c => out.push(c),
+        }
+    }
+    out
+}
+
+/// Units used by the variables with their SI base-unit exponents.
+const UNITS: [(&str, &str); 8] = [
+    ("J", r#"kg="1" m="2" s="-2""#),
+    ("N/m", r#"kg="1" s="-2""#),
+    ("m/s", r#"m="1" s="-1""#),
+    ("Pa", r#"kg="1" m="-1" s="-2""#),
+    ("kg/m", r#"kg="1" m="-1""#),
+    ("m", r#"m="1""#),
+    ("m/s2", r#"m="1" s="-2""#),
+    ("s", r#"s="1""#),
+];
+
+/// What `modelDescription.xml` is written from.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Description {
+    pub identifier: &'static str,
+    pub guid: String,
+    pub description: String,
+    pub variables: Vec<Variable>,
+    /// `DefaultExperiment` stop time and step size in s.
+    pub stop_time: f64,
+    pub step_size: f64,
+    /// What each output depends on ([`Dependency`]); an output without an
+    /// entry depends on nothing (`dependencies=""`).
+    pub dependencies: Vec<Dependency>,
+}
+
+/// The `ModelStructure` dependencies of one output, by value reference.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Dependency {
+    pub output: u32,
+    /// Inputs that change the output at the same instant, without a step
+    /// (`<Outputs>`).
+    pub step: Vec<u32>,
+    /// Inputs and parameters its value after initialization depends on
+    /// (`<InitialUnknowns>`).
+    pub initial: Vec<u32>,
+}
+
+/// `generationDateAndTime` when `SOURCE_DATE_EPOCH` is not set: the date of
+/// the interface version (fixed, so the same sources give the same XML).
+pub const GENERATION_DATE_AND_TIME: &str = "2026-12-01T00:00:00Z";
+
+/// `generationDateAndTime`: `SOURCE_DATE_EPOCH` (seconds since 1970, the
+/// reproducible-builds convention) when set to an integer, else
+/// [`GENERATION_DATE_AND_TIME`].
+pub fn generation_date_and_time() -> String {
+    std::env::var("SOURCE_DATE_EPOCH")
+        .ok()
+        .and_then(|v| v.trim().parse::<i64>().ok())
+        .map(utc_date_time)
+        .unwrap_or_else(|| GENERATION_DATE_AND_TIME.to_string())
+}
+
+/// ISO 8601 UTC of a Unix time (proleptic Gregorian calendar).
+pub fn utc_date_time(secs: i64) -> String {
+    let days = secs.div_euclid(86_400);
+    let sod = secs.rem_euclid(86_400);
+    // Days to civil date (H. Hinnant's algorithm).
+    let z = days + 719_468;
+    let era = z.div_euclid(146_097);
+    let doe = z.rem_euclid(146_097);
+    let yoe = (doe - doe / 1460 + doe / 36_524 - doe / 146_096) / 365;
+    let doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
+    let mp = (5 * doy + 2) / 153;
+    let d = doy - (153 * mp + 2) / 5 + 1;
+    let m = if mp < 10 { mp + 3 } else { mp - 9 };
+    let y = yoe + era * 400 + i64::from(m <= 2);
+    format!(
+        "{y:04}-{m:02}-{d:02}T{:02}:{:02}:{:02}Z",
+        sod / 3600,
+        sod / 60 % 60,
+        sod % 60
+    )
+}
+
+/// Writes `modelDescription.xml`; only the units the variables use are defined.
+pub fn write_model_description(d: &Description) -> String {
+    let vars = &d.variables;
+    let ident = d.identifier;
+    let mut x = String::new();
+    x.push_str("<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n");
+    let _ = writeln!(
+        x,
+        "<fmiModelDescription fmiVersion=\"2.0\" modelName=\"{ident}\" guid=\"{}\" description=\"{}\" generationTool=\"yarnsim-fmu {}\" generationDateAndTime=\"{}\" variableNamingConvention=\"structured\" numberOfEventIndicators=\"0\">",
+        d.guid,
+        xml_escape(&d.description),
+        env!("CARGO_PKG_VERSION"),
+        generation_date_and_time(),
+    );
+    let _ = writeln!(
+        x,
+        "  <CoSimulation modelIdentifier=\"{ident}\" canHandleVariableCommunicationStepSize=\"true\" canInterpolateInputs=\"false\" maxOutputDerivativeOrder=\"0\" canRunAsynchronuously=\"false\" canBeInstantiatedOnlyOncePerProcess=\"false\" canNotUseMemoryManagementFunctions=\"true\" canGetAndSetFMUstate=\"true\" canSerializeFMUstate=\"true\" providesDirectionalDerivative=\"false\"/>"
+    );
+    x.push_str("  <UnitDefinitions>\n");
+    for (name, base) in UNITS
+        .iter()
+        .filter(|(u, _)| vars.iter().any(|v| v.unit == Some(*u)))
+    {
+        let _ = writeln!(
+            x,
+            "    <Unit name=\"{}\"><BaseUnit {base}/></Unit>",
+            xml_escape(name)
+        );
+    }
+    x.push_str("  </UnitDefinitions>\n  <LogCategories>\n");
+    for (name, what) in LOG_CATEGORIES {
+        let _ = writeln!(
+            x,
+            "    <Category name=\"{name}\" description=\"{}\"/>",
+            xml_escape(what)
+        );
+    }
+    x.push_str("  </LogCategories>\n");
+    let _ = writeln!(
+        x,
+        "  <DefaultExperiment startTime=\"0.0\" stopTime=\"{}\" stepSize=\"{}\"/>",
+        real(d.stop_time),
+        real(d.step_size)
+    );
+    x.push_str("  <ModelVariables>\n");
+    for (i, v) in vars.iter().enumerate() {
+        let _ = writeln!(x, "    <!-- index {} -->", i + 1);
+        let _ = write!(
+            x,
+            "    <ScalarVariable name=\"{}\" valueReference=\"{}\" description=\"{}\" causality=\"{}\" variability=\"{}\"",
+            xml_escape(&v.name),
+            v.vr,
+            xml_escape(&v.description),
+            v.causality,
+            v.variability
+        );
+        // Parameters are initial="exact" by default, inputs take no initial,
+        // outputs default to initial="calculated".
+        x.push_str(">\n      <");
+        x.push_str(match v.ty {
+            VarType::Real => "Real",
+            VarType::Integer => "Integer",
+            VarType::Boolean => "Boolean",
+            VarType::String => "String",
+        });
+        if let Some(u) = v.unit {
+            let _ = write!(x, " unit=\"{}\"", xml_escape(u));
+        }
+        if let Some(s) = &v.start {
+            let _ = write!(x, " start=\"{}\"", xml_escape(s));
+        }
+        x.push_str("/>\n    </ScalarVariable>\n");
+    }
+    x.push_str("  </ModelVariables>\n  <ModelStructure>\n    <Outputs>\n");
+    let outputs: Vec<usize> = vars
+        .iter()
+        .enumerate()
+        .filter(|(_, v)| v.causality == "output")
+        .map(|(i, _)| i + 1)
+        .collect();
+    // 1-based indices of value references, ascending.
+    let indices = |vrs: &[u32]| -> String {
+        let mut ix: Vec<usize> = vrs
+            .iter()
+            .map(|vr| {
+                1 + vars
+                    .iter()
+                    .position(|v| v.vr == *vr)
+                    .unwrap_or_else(|| panic!("dependency on unknown value reference {vr}"))
+            })
+            .collect();
+        ix.sort_unstable();
+        ix.iter()
+            .map(|i| i.to_string())
+            .collect::<Vec<_>>()
+            .join(" ")
+    };
+    let deps_of = |i: usize, initial: bool| -> String {
+        d.dependencies
+            .iter()
+            .find(|dep| dep.output == vars[i - 1].vr)
+            .map(|dep| indices(if initial { &dep.initial } else { &dep.step }))
+            .unwrap_or_default()
+    };
+    for &i in &outputs {
+        let _ = writeln!(
+            x,
+            "      <Unknown index=\"{i}\" dependencies=\"{}\"/>",
+            deps_of(i, false)
+        );
+    }
+    x.push_str("    </Outputs>\n    <InitialUnknowns>\n");
+    for &i in &outputs {
+        let _ = writeln!(
+            x,
+            "      <Unknown index=\"{i}\" dependencies=\"{}\"/>",
+            deps_of(i, true)
+        );
+    }
+    x.push_str("    </InitialUnknowns>\n  </ModelStructure>\n</fmiModelDescription>\n");
+    x
+}
