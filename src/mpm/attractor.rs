@@ -1,7 +1,7 @@
 //! The attractor: a point that pulls the yarn with a settable strength
 //! (the FMU's and the CLI's run-time input), and its one input check.
 
-use super::sim::SimError;
+use super::error::SimError;
 use crate::math::Vec2;
 
 /// The attractor as the simulation sees it (settable at run time).

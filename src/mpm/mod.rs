@@ -26,6 +26,7 @@ pub mod attractor;
 pub mod bending;
 pub mod constitutive;
 pub mod contact;
+pub mod error;
 pub mod frames;
 pub mod grid;
 pub mod grid_to_particle;

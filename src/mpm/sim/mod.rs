@@ -3,6 +3,7 @@
 use std::time::Instant;
 
 use super::constitutive::YarnEnergy;
+pub use super::error::SimError;
 use super::grid::{Grid, GridGeom};
 use super::grid_to_particle::{self, VertexGather};
 use super::grid_update::{self, GridForces};
@@ -22,33 +23,6 @@ use crate::scene::{
 };
 pub use diagnostics::Diagnostics;
 pub use stats::{DtStats, PassTimes, Passes};
-
-/// Why a step failed.
-#[derive(Clone, Debug, PartialEq)]
-pub enum SimError {
-    /// A particle's state became NaN or infinite, or a particle moved more
-    /// than one grid cell in one substep, during this step; the simulation
-    /// refuses further steps until its state is restored.
-    NonFinite { step: u64, time: f64, what: String },
-    /// An input given to the simulation is unusable.
-    BadInput(String),
-}
-
-impl std::fmt::Display for SimError {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        match self {
-            SimError::NonFinite { step, time, what } => {
-                write!(
-                    f,
-                    "simulation diverged at step {step} (t = {time:.6} s): {what}"
-                )
-            }
-            SimError::BadInput(m) => write!(f, "bad input: {m}"),
-        }
-    }
-}
-
-impl std::error::Error for SimError {}
 
 pub use super::attractor::Attractor;
 

@@ -1,0 +1,28 @@
+//! The error a simulation step returns.
+
+/// Why a step failed.
+#[derive(Clone, Debug, PartialEq)]
+pub enum SimError {
+    /// A particle's state became NaN or infinite, or a particle moved more
+    /// than one grid cell in one substep, during this step; the simulation
+    /// refuses further steps until its state is restored.
+    NonFinite { step: u64, time: f64, what: String },
+    /// An input given to the simulation is unusable.
+    BadInput(String),
+}
+
+impl std::fmt::Display for SimError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            SimError::NonFinite { step, time, what } => {
+                write!(
+                    f,
+                    "simulation diverged at step {step} (t = {time:.6} s): {what}"
+                )
+            }
+            SimError::BadInput(m) => write!(f, "bad input: {m}"),
+        }
+    }
+}
+
+impl std::error::Error for SimError {}
