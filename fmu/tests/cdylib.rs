@@ -27,12 +27,21 @@ type GetReal = unsafe extern "C" fn(fmi2Component, *const u32, usize, *mut f64) 
 type DoStep = unsafe extern "C" fn(fmi2Component, f64, f64, c_int) -> fmi2Status;
 type Version = unsafe extern "C" fn() -> *const c_char;
 
+/// The symbol `name` of `lib` as a `T`.
+///
+/// # Safety
+/// `lib` is a handle from `dlopen`, and `T` is the function-pointer type of
+/// that symbol's C signature.
 unsafe fn sym<T: Copy>(lib: *mut c_void, name: &str) -> T {
     let n = CString::new(name).unwrap();
-    let p = libc::dlsym(lib, n.as_ptr());
+    // SAFETY: `lib` is a live handle (the caller's contract) and `n` a
+    // NUL-terminated name.
+    let p = unsafe { libc::dlsym(lib, n.as_ptr()) };
     assert!(!p.is_null(), "{name} does not resolve");
     assert_eq!(std::mem::size_of::<T>(), std::mem::size_of::<*mut c_void>());
-    std::mem::transmute_copy(&p)
+    // SAFETY: `T` is a function pointer of the symbol's signature (the
+    // caller's contract), of the size of `p` (checked above).
+    unsafe { std::mem::transmute_copy(&p) }
 }
 
 #[test]
