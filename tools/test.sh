@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The whole test suite: the documentation's links, every Rust test of the
+# The whole test suite: the documentation's links, the module graph, every Rust test of the
 # workspace in release mode (heavy physics tests run only there), then the FMU
 # checks through fmpy.
 set -euo pipefail
@@ -8,6 +8,9 @@ cd "$(dirname "$0")/.."
 # link checker's own tests
 python3 tools/check_links.py --self-test
 python3 tools/check_links.py
+# no import circle between the modules of any folder of any crate
+python3 tools/check_modules.py --self-test
+python3 tools/check_modules.py
 cargo test --workspace --release
 if [ -f tools/fmu_check.sh ]; then
     bash tools/fmu_check.sh

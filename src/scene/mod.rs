@@ -9,7 +9,6 @@
 pub mod builtin;
 pub mod error;
 pub mod massspring;
-pub mod overlap;
 pub mod overrides;
 pub(crate) mod readers;
 pub mod yarn;
@@ -122,5 +121,20 @@ fn toml_kind(text: &str) -> Result<Option<String>, SceneError> {
                 .map(|i| i + 1),
             message: "kind must be a string".into(),
         }),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn builtin_scenes_start_apart() {
+        for (name, _) in builtin_names() {
+            match Scene::resolve(name).unwrap() {
+                Scene::Yarn(y) => y.validate().unwrap(),
+                Scene::MassSpring(l) => l.validate().unwrap(),
+            }
+        }
     }
 }

@@ -1,0 +1,217 @@
+//! Checks of a yarn scene beyond its field types: grid and time step,
+//! pins against their yarns, and start-up overlap with the obstacles; each
+//! error names its field and, given the file, its line.
+
+use super::*;
+
+impl YarnScene {
+    /// Checks cross-field constraints (geometry, time step against grid).
+    pub fn validate(&self) -> Result<(), SceneError> {
+        self.validate_with_source(None)
+    }
+
+    pub(super) fn validate_with_source(&self, text: Option<&str>) -> Result<(), SceneError> {
+        let yarn_line = |i: usize| table_line(text, "[[yarns]]", i);
+        let obstacle_line = |i: usize| table_line(text, "[[obstacles]]", i);
+        if self.yarns.is_empty() {
+            return Err(SceneError::Invalid {
+                field: "yarns".into(),
+                line: None,
+                message: "a yarn scene needs at least one [[yarns]] entry".into(),
+            });
+        }
+        let size = self.grid.size;
+        let margin = self.dx() * 1.5;
+        for (i, y) in self.yarns.iter().enumerate() {
+            let curves = y.curves().map_err(|message| SceneError::Invalid {
+                field: format!("yarns[{i}]"),
+                line: yarn_line(i),
+                message,
+            })?;
+            for c in &curves {
+                for p in c {
+                    if p.x < margin || p.y < margin || p.x > size - margin || p.y > size - margin {
+                        return Err(SceneError::Invalid {
+                            field: format!("yarns[{i}]"),
+                            line: yarn_line(i),
+                            message: format!(
+                                "vertex ({:.4}, {:.4}) lies outside the grid interior [{margin:.4}, {:.4}]^2",
+                                p.x,
+                                p.y,
+                                size - margin
+                            ),
+                        });
+                    }
+                }
+            }
+        }
+        for (i, o) in self.obstacles.iter().enumerate() {
+            if o.radius > 10.0 * size {
+                return Err(SceneError::Invalid {
+                    field: format!("obstacles[{i}].radius"),
+                    line: obstacle_line(i),
+                    message: "radius is absurdly large for the domain".into(),
+                });
+            }
+        }
+        let total: u64 = self
+            .yarns
+            .iter()
+            .map(|y| y.vertices as u64 * y.count as u64)
+            .sum();
+        if total > 20_000_000 {
+            return Err(SceneError::Invalid {
+                field: "yarns".into(),
+                line: None,
+                message: format!("{total} vertices in all is more than the 20 million supported"),
+            });
+        }
+        self.validate_pins(text)?;
+        self.validate_time(text)?;
+        overlap::check_yarns_clear_of_obstacles(self, text)?;
+        Ok(())
+    }
+
+    fn validate_time(&self, text: Option<&str>) -> Result<(), SceneError> {
+        let t = &self.time;
+        let invalid = |field: &str, message: String| SceneError::Invalid {
+            field: format!("time.{field}"),
+            line: text.and_then(|text| key_line(text, "[time]", field)),
+            message,
+        };
+        match t.dt {
+            StepSize::Fixed(dt) => {
+                if !(dt.is_finite() && dt > 0.0) {
+                    return Err(invalid("dt", format!("must be > 0, got {dt}")));
+                }
+                if t.frame_dt < dt {
+                    return Err(invalid(
+                        "frame_dt",
+                        format!(
+                            "frame_dt {} is shorter than the substep dt {dt}",
+                            t.frame_dt
+                        ),
+                    ));
+                }
+                for (field, set) in [
+                    ("safety", t.safety.is_some()),
+                    ("dt_max", t.dt_max.is_some()),
+                ] {
+                    if set {
+                        return Err(invalid(
+                            field,
+                            format!("applies only to dt = \"auto\", but dt is {dt}"),
+                        ));
+                    }
+                }
+            }
+            StepSize::Auto => {
+                if let Some(s) = t.safety.filter(|s| !(*s > 0.0 && *s <= 2.0)) {
+                    return Err(invalid("safety", format!("must be in (0, 2], got {s}")));
+                }
+                if let Some(m) = t.dt_max.filter(|m| !(m.is_finite() && *m > 0.0)) {
+                    return Err(invalid("dt_max", format!("must be > 0, got {m}")));
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// The vertex ranges (within its yarn) of every pin, checked: the yarn
+    /// exists, the range lies inside it, the motion has its fields, and no
+    /// vertex is pinned twice.
+    pub fn pin_ranges(&self) -> Result<Vec<(usize, std::ops::Range<usize>)>, SceneError> {
+        self.validate_pins(None)?;
+        Ok(self
+            .pins
+            .iter()
+            .map(|p| self.pin_range(p).expect("validated"))
+            .collect())
+    }
+
+    fn pin_range(&self, p: &PinSpec) -> Result<(usize, std::ops::Range<usize>), String> {
+        let counts: Vec<usize> = self
+            .yarns
+            .iter()
+            .flat_map(|y| std::iter::repeat_n(y.vertices as usize, y.count as usize))
+            .collect();
+        let y = p.yarn as usize;
+        let Some(&n) = counts.get(y) else {
+            return Err(format!(
+                "yarn {y} does not exist: the scene has {} yarns (0 to {})",
+                counts.len(),
+                counts.len().saturating_sub(1)
+            ));
+        };
+        let c = p.count as usize;
+        let start = match (p.end, p.vertex) {
+            (Some(YarnEnd::Start), None) => 0,
+            (Some(YarnEnd::End), None) => n.saturating_sub(c),
+            (None, Some(v)) => v as usize,
+            _ => {
+                return Err("give exactly one of `end` (\"start\" or \"end\") and `vertex`".into())
+            }
+        };
+        if c > n || start + c > n {
+            return Err(format!(
+                "vertices {start}..{} are outside yarn {y}, which has {n} vertices",
+                start + c
+            ));
+        }
+        match p.motion {
+            PinMotionKind::Fixed => {}
+            PinMotionKind::Line if p.velocity.is_none() => {
+                return Err("motion \"line\" needs `velocity`".into())
+            }
+            PinMotionKind::Circle if p.center.is_none() || p.angular_velocity.is_none() => {
+                return Err("motion \"circle\" needs `center` and `angular_velocity`".into())
+            }
+            _ => {}
+        }
+        Ok((y, start..start + c))
+    }
+
+    fn validate_pins(&self, text: Option<&str>) -> Result<(), SceneError> {
+        let pin_line = |i: usize| table_line(text, "[[pins]]", i);
+        let mut seen: Vec<(usize, std::ops::Range<usize>)> = Vec::new();
+        for (i, p) in self.pins.iter().enumerate() {
+            let (y, r) = self.pin_range(p).map_err(|message| SceneError::Invalid {
+                field: format!("pins[{i}]"),
+                line: pin_line(i),
+                message,
+            })?;
+            if let Some(k) = seen
+                .iter()
+                .position(|(y2, r2)| *y2 == y && r.start < r2.end && r2.start < r.end)
+            {
+                return Err(SceneError::Invalid {
+                    field: format!("pins[{i}]"),
+                    line: pin_line(i),
+                    message: format!("its vertices overlap those of pins[{k}] on yarn {y}"),
+                });
+            }
+            seen.push((y, r));
+        }
+        Ok(())
+    }
+}
+
+/// Line of `key = ...` inside the table `header` (e.g. `[time]`), else of
+/// the header, when the text has it.
+fn key_line(text: &str, header: &str, key: &str) -> Option<usize> {
+    let start = text.find(header)?;
+    let body = &text[start + header.len()..];
+    let end = body.find("\n[").map_or(body.len(), |i| i + 1);
+    let mut pos = start + header.len();
+    for line in body[..end].split_inclusive('\n') {
+        if line
+            .trim_start()
+            .strip_prefix(key)
+            .is_some_and(|r| r.trim_start().starts_with('='))
+        {
+            return Some(line_of(text, pos));
+        }
+        pos += line.len();
+    }
+    Some(line_of(text, start))
+}
