@@ -9,7 +9,7 @@
 
 use rayon::prelude::*;
 
-use super::contact::{obstacle_friction, obstacle_normal, wall_velocity, ContactNode};
+use super::contact::{obstacle_friction, obstacle_normal, wall_velocity, ContactNode, WedgeTable};
 use super::grid::{
     Grid, GridGeom, Node, P2gNode, ScatterBuffer, BLOCK, CHUNKS, FX, FY, M, MC, P2G_LANES, PX, PY,
 };
@@ -41,6 +41,7 @@ struct BandCtx<'a> {
     geom: &'a GridGeom,
     dt: f64,
     ext: &'a GridForces<'a>,
+    wedges: &'a WedgeTable,
 }
 
 /// Pass 2 (see the module documentation). `flip`: also store each node's
@@ -58,11 +59,13 @@ pub fn grid_update(grid: &mut Grid, dt: f64, ext: &GridForces, flip: bool) {
             band.push(BandSrc { node, touched });
         }
     }
+    let wedges = WedgeTable::new(ext.obstacles, geom.dx);
     let ctx = BandCtx {
         is_active: &grid.is_active,
         geom: &geom,
         dt,
         ext,
+        wedges: &wedges,
     };
     let ctx = &ctx;
     let contacts: Vec<Vec<ContactNode>> = grid
@@ -81,12 +84,11 @@ pub fn grid_update(grid: &mut Grid, dt: f64, ext: &GridForces, flip: bool) {
         })
         .collect();
     if contacts.iter().any(|c| !c.is_empty()) {
-        let nodes: Vec<ContactNode> = contacts.into_iter().flatten().collect();
         let (walls, cells, n) = (ext.walls, ext.wall_cells, geom.n);
         obstacle_friction(
             ext.obstacles,
-            geom.dx,
-            &nodes,
+            &wedges,
+            &contacts,
             &mut grid.node,
             flip,
             &mut |c, out| {
@@ -115,7 +117,7 @@ multiversion! {
         ctx: &BandCtx,
         contacts: &mut Vec<ContactNode>,
     ) {
-        let BandCtx { is_active, geom, dt, ext } = *ctx;
+        let BandCtx { is_active, geom, dt, ext, wedges } = *ctx;
         let band_base = bi * geom.stride * BLOCK;
         let cells = ext.wall_cells;
         let dx = geom.dx;
@@ -184,7 +186,7 @@ multiversion! {
                                     contacts.push(ContactNode {
                                         index: band_base + row + c,
                                         ij: [i as u32, j as u32],
-                                        obstacle: oi as u32,
+                                        wedge: wedges.wedge(oi, normal),
                                         share,
                                         mass: share * acc[M],
                                         impulse,

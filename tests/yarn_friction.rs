@@ -1,0 +1,178 @@
+//! Fibre-fibre friction oracle, release-only: a yarn lying on a pinned
+//! straight yarn (a bed) under gravity tilted by `theta`.
+//!
+//! What `material.friction` (`c_f`) means: the return mapping
+//! (`constitutive.rs`) caps the fibre-frame shear stress `|A01| = gamma
+//! |r12| r22` at `c_f` times the normal pressure `-A11 = -(2 mu + lambda)
+//! ln r22`. The Kirchhoff stress is `tau = P G^T = Q A Q^T`, so `A01` and
+//! `A11` are the shear and normal tractions on the plane along the fibre
+//! (normal `q2`): the yield condition is Coulomb's `|tau_t| <= c_f
+//! |tau_n|` on that plane, and a yarn whose weight is carried through its
+//! cross-section onto a bed along its fibres should hold for `tan theta <
+//! c_f` and slide for `tan theta > c_f` with acceleration `g (sin theta -
+//! c_f cos theta)` (the incline law, `/docs/obstacle-contact.md`).
+
+mod common;
+
+use common::scene;
+use yarnsim::scene::TransferScheme;
+use yarnsim::YarnSim;
+
+/// Gravity of the incline scenes.
+const G: f64 = 9.8;
+/// Time the top yarn settles on the bed before its slip is measured.
+const SETTLE: f64 = 0.1;
+
+/// Bed yarn (0.8 m, all vertices pinned) along x at y = 0.4 on 128^2, a
+/// second yarn of 0.3 m one cell above it, the built-in material with
+/// fibre friction `c_f` and no bending, gravity g tilted by `theta`
+/// (downhill along +x), dt 1e-4.
+fn incline(theta: f64, c_f: f64, scheme: TransferScheme) -> YarnSim {
+    let res = 128;
+    let dx = 1.0 / res as f64;
+    let bed_n = (0.8 / (0.5 * dx)).round() as u32 + 1;
+    let top_n = (0.3 / (0.5 * dx)).round() as u32 + 1;
+    let scheme = match scheme {
+        TransferScheme::Flip => "flip",
+        TransferScheme::Apic => "apic",
+    };
+    let s = scene(&format!(
+        r#"
+gravity = [{}, {}]
+[grid]
+resolution = {res}
+[time]
+dt = 1e-4
+[transfer]
+scheme = "{scheme}"
+[material]
+k = 1000.0
+gamma = 500.0
+youngs_modulus = 1000.0
+friction = {c_f}
+bending = 0.0
+plasticity = true
+[walls]
+mode = "none"
+[[yarns]]
+start = [0.1, 0.4]
+end = [0.9, 0.4]
+vertices = {bed_n}
+[[yarns]]
+start = [0.3, {y}]
+end = [0.6, {y}]
+vertices = {top_n}
+[[pins]]
+yarn = 0
+end = "start"
+count = {bed_n}
+"#,
+        G * theta.sin(),
+        -G * theta.cos(),
+        y = 0.4 + dx
+    ));
+    YarnSim::new(&s).unwrap()
+}
+
+/// Downhill displacement of the top yarn's centre over `t` after settling.
+fn slip(theta: f64, c_f: f64, scheme: TransferScheme, t: f64) -> f64 {
+    let mut sim = incline(theta, c_f, scheme);
+    sim.advance(SETTLE).unwrap();
+    let centre = |sim: &YarnSim| {
+        let (a, b) = sim.yarn_endpoints(1);
+        0.5 * (a.x + b.x)
+    };
+    let x0 = centre(&sim);
+    sim.advance(t).unwrap();
+    centre(&sim) - x0
+}
+
+/// Slid: the top yarn moved downhill more than 5 mm (0.64 cells) in 0.5 s
+/// (a Coulomb slide at tan theta = 1.1 c_f, c_f = 0.2, covers 27 mm).
+fn slides(theta: f64, c_f: f64, scheme: TransferScheme) -> bool {
+    slip(theta, c_f, scheme, 0.5) > 5e-3
+}
+
+/// Threshold of `tan theta` at `c_f` = 0.2 by three bisection steps between
+/// 0.5 c_f and 2 c_f (bracket 0.19 c_f, the midpoint within 9.4 % of the
+/// crossing); returns (held at 0.5 c_f, slid at 2 c_f, threshold, bracket).
+fn threshold(c_f: f64, scheme: TransferScheme) -> (bool, bool, f64, f64, f64) {
+    let held = !slides((0.5 * c_f).atan(), c_f, scheme);
+    let slid = slides((2.0 * c_f).atan(), c_f, scheme);
+    let (mut lo, mut hi) = (0.5 * c_f, 2.0 * c_f);
+    for _ in 0..3 {
+        let mid = 0.5 * (lo + hi);
+        if slides(mid.atan(), c_f, scheme) {
+            hi = mid;
+        } else {
+            lo = mid;
+        }
+    }
+    (held, slid, 0.5 * (lo + hi), lo, hi)
+}
+
+/// Mean downhill acceleration `2 x(T) / T^2` over T = 0.3 s at tan theta =
+/// 2 c_f, and the incline law's `g (sin theta - c_f cos theta)`.
+fn acceleration(c_f: f64, scheme: TransferScheme) -> (f64, f64) {
+    let theta = (2.0 * c_f).atan();
+    let t = 0.3;
+    let a = 2.0 * slip(theta, c_f, scheme, t) / (t * t);
+    (a, G * (theta.sin() - c_f * theta.cos()))
+}
+
+/// FLIP (the default transfer): the top yarn holds for tan theta below
+/// `c_f` and slides above it, threshold within 15 % of `c_f` = 0.2.
+#[test]
+#[cfg_attr(debug_assertions, ignore = "release-mode test (cargo test --release)")]
+fn yarn_on_an_inclined_bed_holds_below_and_slides_above_its_friction_flip() {
+    let c_f = 0.2;
+    let (held, slid, c, lo, hi) = threshold(c_f, TransferScheme::Flip);
+    let err = (c - c_f) / c_f;
+    eprintln!(
+        "incline Flip c_f {c_f}: tan 0.5 c_f held {held}, tan 2 c_f slid {slid}, threshold tan \
+         {c:.3} in [{lo:.3}, {hi:.3}] ({:+.1} %)",
+        100.0 * err
+    );
+    // tolerances: holds at 0.5 c_f, slides at 2 c_f, threshold within 15 %
+    assert!(held && slid, "held {held}, slid {slid}");
+    assert!(err.abs() <= 0.15, "threshold error {err:+.3}");
+}
+
+/// The parts of the incline oracle the model does not meet (measured in
+/// docs/obstacle-contact.md): the sliding acceleration under FLIP within
+/// 10 % of `g (sin theta - c_f cos theta)`, and the threshold and
+/// acceleration under APIC.
+#[test]
+#[ignore = "known gap, measured in docs/obstacle-contact.md: the slide is \
+            slower than Coulomb (FLIP) and APIC holds far above c_f"]
+fn yarn_on_an_inclined_bed_slides_at_the_coulomb_rate_and_apic_matches() {
+    let c_f = 0.2;
+    let mut failures = Vec::new();
+    for scheme in [TransferScheme::Flip, TransferScheme::Apic] {
+        let (a, a_coulomb) = acceleration(c_f, scheme);
+        let aerr = (a - a_coulomb) / a_coulomb;
+        eprintln!(
+            "incline {scheme:?} c_f {c_f}: acceleration at tan 2 c_f {a:.3} m/s^2 against \
+             g (sin - c_f cos) {a_coulomb:.3} ({:+.1} %)",
+            100.0 * aerr
+        );
+        // tolerance 10 % on the acceleration
+        if aerr.abs() > 0.10 {
+            failures.push(format!("{scheme:?}: acceleration {aerr:+.3}"));
+        }
+        if scheme == TransferScheme::Apic {
+            let (held, slid, c, lo, hi) = threshold(c_f, scheme);
+            let err = (c - c_f) / c_f;
+            eprintln!(
+                "incline Apic c_f {c_f}: tan 0.5 c_f held {held}, tan 2 c_f slid {slid}, \
+                 threshold tan {c:.3} in [{lo:.3}, {hi:.3}] ({:+.1} %)",
+                100.0 * err
+            );
+            // tolerance: threshold within 15 %
+            if !held || !slid || err.abs() > 0.15 {
+                failures.push(format!("Apic: threshold {err:+.3}"));
+            }
+        }
+    }
+    assert!(failures.is_empty(), "{failures:?}");
+}
