@@ -565,11 +565,16 @@ impl Isa {
         match self {
             #[cfg(target_arch = "x86_64")]
             Isa::Portable => (madd_sse2(iters, m, a), 2 * CHAINS),
-            // SAFETY: `available` listed this instruction set only where the CPU has it.
             #[cfg(target_arch = "x86_64")]
-            Isa::Avx2Fma => (unsafe { madd_avx2(iters, m, a) }, 4 * CHAINS),
+            Isa::Avx2Fma => {
+                // SAFETY: `available` listed this instruction set only where the CPU has it.
+                (unsafe { madd_avx2(iters, m, a) }, 4 * CHAINS)
+            }
             #[cfg(target_arch = "x86_64")]
-            Isa::Avx512 => (unsafe { madd_avx512(iters, m, a) }, 8 * CHAINS),
+            Isa::Avx512 => {
+                // SAFETY: as for AVX2 above.
+                (unsafe { madd_avx512(iters, m, a) }, 8 * CHAINS)
+            }
             #[cfg(not(target_arch = "x86_64"))]
             _ => (madd_generic(iters, m, a), CHAINS),
         }
@@ -577,10 +582,11 @@ impl Isa {
     fn triad(self, a: &mut [f64], b: &[f64], c: &[f64], s: f64) {
         match self {
             Isa::Portable => triad_portable(a, b, c, s),
-            // SAFETY: as in `madd`.
             #[cfg(target_arch = "x86_64")]
+            // SAFETY: as in `madd`.
             Isa::Avx2Fma => unsafe { triad_avx2(a, b, c, s) },
             #[cfg(target_arch = "x86_64")]
+            // SAFETY: as in `madd`.
             Isa::Avx512 => unsafe { triad_avx512(a, b, c, s) },
             #[cfg(not(target_arch = "x86_64"))]
             _ => triad_portable(a, b, c, s),

@@ -97,6 +97,8 @@ fn main() {
         }
     };
     let ports = in_vr.len();
+    // SAFETY: `c` is the fixture's initialized instance, alive for the whole block; every
+    // value-reference and value array passed below has the length given with it.
     unsafe {
         let c = fx.instance();
 

@@ -17,6 +17,8 @@ use YarnBundle::yarn::variables::*;
 const H: f64 = 0.01;
 
 fn set_int(f: &Fmu, vr: u32, v: c_int) -> fmi2Status {
+    // SAFETY: `f.c` came from `fmi2Instantiate` and lives until its `Fmu` drops; every pointer
+    // argument is a local that outlives the call.
     unsafe { fmi2SetInteger(f.c, &vr, 1, &v) }
 }
 

@@ -43,6 +43,9 @@ fn shared_library_loads_and_runs_like_the_rlib() {
     let dir = resources(&scene);
     let h = 0.01;
     let inputs = |k: usize| [0.3 * k as f64, -9.8 + 0.5 * k as f64];
+    // SAFETY: `dlopen` and `dlsym` get NUL-terminated names; each symbol is cast to the FMI 2.0
+    // signature its name has in fmi2Functions.h; the instance is used only between its
+    // fmi2Instantiate and fmi2FreeInstance.
     unsafe {
         let lib = libc::dlopen(cpath.as_ptr(), libc::RTLD_NOW | libc::RTLD_LOCAL);
         assert!(!lib.is_null(), "dlopen {} failed", path.display());

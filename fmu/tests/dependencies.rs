@@ -26,10 +26,14 @@ fn apply(f: &Fmu, vr: u32, c: &Change) -> fmi2Status {
     match c {
         Change::Real(v) => f.set_real(&[vr], &[*v]),
         Change::Bool(b) => f.set_bool(vr, *b),
+        // SAFETY: `f.c` came from `fmi2Instantiate` and lives until its `Fmu` drops; every
+        // pointer argument is a local that outlives the call.
         Change::Int(v) => unsafe { fmi2SetInteger(f.c, &vr, 1, v) },
         Change::Str(s) => {
             let s = CString::new(s.as_str()).unwrap();
             let p = s.as_ptr();
+            // SAFETY: `f.c` came from `fmi2Instantiate` and lives until its `Fmu` drops; every
+            // pointer argument is a local that outlives the call.
             unsafe { fmi2SetString(f.c, &vr, 1, &p) }
         }
     }
@@ -108,6 +112,8 @@ fn check_outputs(new: &dyn Fn() -> Fmu, d: &neutral::Description, h: f64) -> usi
             );
             checked += 1;
         }
+        // SAFETY: `f.c` came from `fmi2Instantiate` and lives until its `Fmu` drops; every
+        // pointer argument is a local that outlives the call.
         assert_eq!(unsafe { fmi2SetFMUstate(f.c, state) }, fmi2OK);
         assert_eq!(f.get_real(&outs).unwrap(), base);
     }
@@ -130,6 +136,8 @@ fn check_initial_with(
     let outs = real_outputs(&d.variables);
     let enter = |f: &Fmu| {
         assert_eq!(f.setup(0.0, None), fmi2OK);
+        // SAFETY: `f.c` came from `fmi2Instantiate` and lives until its `Fmu` drops; every
+        // pointer argument is a local that outlives the call.
         assert_eq!(unsafe { fmi2EnterInitializationMode(f.c) }, fmi2OK);
     };
     let f = new();
@@ -161,6 +169,8 @@ fn check_initial_with(
         }
         let mut n = -1;
         assert_eq!(
+            // SAFETY: `g.c` came from `fmi2Instantiate` and lives until its `Fmu` drops; every
+            // pointer argument is a local that outlives the call.
             unsafe { fmi2GetInteger(g.c, &VR_SUBSTEPS, 1, &mut n) },
             fmi2OK
         );

@@ -166,10 +166,14 @@ fn state_round_trip_gives_identical_bits() {
 
     // Restore the in-memory state (twice: a state survives being set).
     for _ in 0..2 {
+        // SAFETY: `fmu.c` came from `fmi2Instantiate` and lives until its `Fmu` drops; every
+        // pointer argument is a local that outlives the call.
         assert_eq!(unsafe { fmi2SetFMUstate(fmu.c, s) }, fmi2OK);
         assert_eq!(run_on(&fmu, 0.05, 6), first);
     }
     // A state taken right after a restore serializes to the same bytes.
+    // SAFETY: `fmu.c` came from `fmi2Instantiate` and lives until its `Fmu` drops; every pointer
+    // argument is a local that outlives the call.
     assert_eq!(unsafe { fmi2SetFMUstate(fmu.c, s) }, fmi2OK);
     let s2 = fmu.get_state();
     assert_eq!(fmu.serialize(s2), bytes);
@@ -179,6 +183,8 @@ fn state_round_trip_gives_identical_bits() {
     // Restore the deserialized bytes, in this instance and in a new one.
     let (st, d) = fmu.deserialize(&bytes);
     assert_eq!(st, fmi2OK, "{:?}", fmu.lines());
+    // SAFETY: `fmu.c` came from `fmi2Instantiate` and lives until its `Fmu` drops; every pointer
+    // argument is a local that outlives the call.
     assert_eq!(unsafe { fmi2SetFMUstate(fmu.c, d) }, fmi2OK);
     assert_eq!(fmu.substeps(), 250);
     assert_eq!(run_on(&fmu, 0.05, 6), first);
@@ -187,6 +193,8 @@ fn state_round_trip_gives_identical_bits() {
     let other = Fmu::new(&scene);
     let (st, d) = other.deserialize(&bytes);
     assert_eq!(st, fmi2OK, "{:?}", other.lines());
+    // SAFETY: `other.c` came from `fmi2Instantiate` and lives until its `Fmu` drops; every
+    // pointer argument is a local that outlives the call.
     assert_eq!(unsafe { fmi2SetFMUstate(other.c, d) }, fmi2OK);
     let restored = other.get_state();
     assert_eq!(other.serialize(restored), bytes);
@@ -211,9 +219,13 @@ fn get_fmu_state_reuses_an_existing_state() {
     let mut s = fmu.get_state();
     run_on(&fmu, 0.0, 3);
     let before = s;
+    // SAFETY: `fmu.c` came from `fmi2Instantiate` and lives until its `Fmu` drops; every pointer
+    // argument is a local that outlives the call.
     assert_eq!(unsafe { fmi2GetFMUstate(fmu.c, &mut s) }, fmi2OK);
     assert_eq!(s, before);
     let later = run_on(&fmu, 0.03, 2);
+    // SAFETY: `fmu.c` came from `fmi2Instantiate` and lives until its `Fmu` drops; every pointer
+    // argument is a local that outlives the call.
     assert_eq!(unsafe { fmi2SetFMUstate(fmu.c, s) }, fmi2OK);
     assert_eq!(fmu.substeps(), 150);
     assert_eq!(run_on(&fmu, 0.03, 2), later);
@@ -261,6 +273,8 @@ fn corrupt_or_truncated_state_is_rejected() {
     assert_eq!(st, fmi2Error);
     // A null FMUstate is not a state.
     assert_eq!(
+        // SAFETY: `fmu.c` is a live instance; the FMU checks the state for null before using it,
+        // which is what is checked.
         unsafe { fmi2SetFMUstate(fmu.c, std::ptr::null_mut()) },
         fmi2Error
     );
@@ -279,12 +293,16 @@ fn illegal_call_order_is_an_error_with_a_log_line() {
     );
     // The instance is now in the error state: only reset / set state / free.
     assert_eq!(fmu.setup(0.0, None), fmi2Error);
+    // SAFETY: `fmu.c` came from `fmi2Instantiate` and lives until its `Fmu` drops; every pointer
+    // argument is a local that outlives the call.
     assert_eq!(unsafe { fmi2Reset(fmu.c) }, fmi2OK);
     fmu.init();
     assert_eq!(fmu.do_step(0.0, H), fmi2OK);
 
     // Exit initialization without entering it; setup after initialization.
     let f = Fmu::new(&scene);
+    // SAFETY: `f.c` came from `fmi2Instantiate` and lives until its `Fmu` drops; every pointer
+    // argument is a local that outlives the call.
     assert_eq!(unsafe { fmi2ExitInitializationMode(f.c) }, fmi2Error);
     let f = Fmu::new(&scene);
     f.init();
@@ -304,6 +322,8 @@ fn illegal_call_order_is_an_error_with_a_log_line() {
     // Terminate, then no more steps.
     let f = Fmu::new(&scene);
     f.init();
+    // SAFETY: `f.c` came from `fmi2Instantiate` and lives until its `Fmu` drops; every pointer
+    // argument is a local that outlives the call.
     assert_eq!(unsafe { fmi2Terminate(f.c) }, fmi2OK);
     assert_eq!(f.do_step(0.0, H), fmi2Error);
 
@@ -313,6 +333,8 @@ fn illegal_call_order_is_an_error_with_a_log_line() {
     let mut v = 0.0;
     let order = 1;
     assert_eq!(
+        // SAFETY: `f.c` came from `fmi2Instantiate` and lives until its `Fmu` drops; every
+        // pointer argument is a local that outlives the call.
         unsafe { fmi2GetRealOutputDerivatives(f.c, &VR_YARN_BASE, 1, &order, &mut v) },
         fmi2Error
     );
@@ -365,6 +387,8 @@ fn do_step_checks_time_step_and_stop_time() {
     assert_eq!(f.substeps(), 50);
     let mut lst = 0.0;
     assert_eq!(
+        // SAFETY: `f.c` came from `fmi2Instantiate` and lives until its `Fmu` drops; every
+        // pointer argument is a local that outlives the call.
         unsafe { fmi2GetRealStatus(f.c, fmi2LastSuccessfulTime, &mut lst) },
         fmi2OK
     );
@@ -383,6 +407,8 @@ fn reset_returns_to_the_instantiated_state() {
     f.init_mode();
     assert_eq!(f.set_real(&[VR_GRAVITY_Y], &[3.0]), fmi2OK);
     assert_eq!(f.do_step(1.0, 0.05), fmi2OK);
+    // SAFETY: `f.c` came from `fmi2Instantiate` and lives until its `Fmu` drops; every pointer
+    // argument is a local that outlives the call.
     assert_eq!(unsafe { fmi2Reset(f.c) }, fmi2OK);
     // Instantiated again: the inputs are back to their start values, the
     // time to 0 and no stop time.
@@ -410,6 +436,8 @@ fn guid_mismatch_and_bad_arguments_fail_instantiation() {
     let err = Fmu::try_new(&scene, &guid(&scene), "").err().unwrap();
     assert!(err.iter().any(|l| l.2.contains("instance name")), "{err:?}");
     // Model exchange is not offered; null callbacks give null.
+    // SAFETY: the strings are live `CString`s and `cb` outlives every call; the FMU refuses Model
+    // Exchange and null callbacks before it uses them, which is what is checked.
     unsafe {
         let dir = resources(&scene);
         let uri = CString::new(format!("file://{}", dir.display())).unwrap();
@@ -483,6 +511,8 @@ fn null_pointers_and_bad_value_references_are_errors() {
     let scene = small_scene();
     let f = Fmu::new(&scene);
     f.init();
+    // SAFETY: null arrays with a non-zero count: the FMU checks every pointer for null before
+    // reading it, which is what is checked.
     unsafe {
         assert_eq!(
             fmi2GetReal(f.c, std::ptr::null(), 2, std::ptr::null_mut()),
@@ -497,6 +527,8 @@ fn null_pointers_and_bad_value_references_are_errors() {
         Err(fmi2Error)
     );
     // Null components.
+    // SAFETY: null components: the FMU checks the component for null before using it, which is
+    // what is checked.
     unsafe {
         assert_eq!(fmi2DoStep(std::ptr::null_mut(), 0.0, H, 0), fmi2Error);
         assert_eq!(fmi2Reset(std::ptr::null_mut()), fmi2Error);
@@ -509,6 +541,7 @@ fn null_pointers_and_bad_value_references_are_errors() {
     // Zero-length calls with null arrays are fine.
     let f = Fmu::new(&scene);
     f.init();
+    // SAFETY: a zero-length call reads and writes nothing through its null arrays.
     unsafe {
         assert_eq!(
             fmi2GetReal(f.c, std::ptr::null(), 0, std::ptr::null_mut()),
@@ -533,6 +566,8 @@ fn non_finite_and_absurd_inputs_are_rejected_with_a_log_line() {
         assert!(f.last_error().contains("fmi2SetReal"), "{:?}", f.lines());
         // The instance is unusable until reset, then runs normally.
         assert_eq!(f.do_step(0.0, H), fmi2Error);
+        // SAFETY: `f.c` came from `fmi2Instantiate` and lives until its `Fmu` drops; every
+        // pointer argument is a local that outlives the call.
         assert_eq!(unsafe { fmi2Reset(f.c) }, fmi2OK);
         f.init();
         assert_eq!(f.do_step(0.0, H), fmi2OK);
@@ -547,6 +582,8 @@ fn log_messages_escape_percent_and_hash() {
     let f = Fmu::new(&scene);
     let name = CString::new("no%such#scene.toml").unwrap();
     let p = name.as_ptr();
+    // SAFETY: `f.c` came from `fmi2Instantiate` and lives until its `Fmu` drops; every pointer
+    // argument is a local that outlives the call.
     assert_eq!(unsafe { fmi2SetString(f.c, &VR_SCENE, 1, &p) }, fmi2Error);
     let lines = f.lines();
     let err = lines
@@ -563,6 +600,8 @@ fn log_messages_escape_percent_and_hash() {
     ];
     let ptrs: Vec<*const c_char> = cats.iter().map(|c| c.as_ptr()).collect();
     assert_eq!(
+        // SAFETY: `f.c` came from `fmi2Instantiate` and lives until its `Fmu` drops; every
+        // pointer argument is a local that outlives the call.
         unsafe { fmi2SetDebugLogging(f.c, 1, 2, ptrs.as_ptr()) },
         fmi2OK
     );
@@ -583,6 +622,8 @@ fn log_messages_escape_percent_and_hash() {
     );
     let bad = CString::new("logNothing").unwrap();
     let p = bad.as_ptr();
+    // SAFETY: `f.c` came from `fmi2Instantiate` and lives until its `Fmu` drops; every pointer
+    // argument is a local that outlives the call.
     assert_eq!(unsafe { fmi2SetDebugLogging(f.c, 1, 1, &p) }, fmi2Error);
 }
 
@@ -597,6 +638,8 @@ fn diverging_run_is_discarded_never_ok_with_nan() {
     // A huge substep: the CFL guard or the stress update fails.
     assert_eq!(f.set_real(&[VR_DT], &[5e-3]), fmi2OK);
     assert_eq!(f.setup(0.0, None), fmi2OK);
+    // SAFETY: `f.c` came from `fmi2Instantiate` and lives until its `Fmu` drops; every pointer
+    // argument is a local that outlives the call.
     unsafe {
         assert_eq!(fmi2EnterInitializationMode(f.c), fmi2OK);
         // Beyond the stability bound: a warning at initialization.
@@ -624,12 +667,16 @@ fn diverging_run_is_discarded_never_ok_with_nan() {
         .any(|l| l.0 == fmi2Discard && l.1 == "logStatusDiscard"));
     let mut term = 0;
     assert_eq!(
+        // SAFETY: `f.c` came from `fmi2Instantiate` and lives until its `Fmu` drops; every
+        // pointer argument is a local that outlives the call.
         unsafe { fmi2GetBooleanStatus(f.c, fmi2Terminated, &mut term) },
         fmi2OK
     );
     assert_eq!(term, fmi2True);
     let mut lst = -1.0;
     assert_eq!(
+        // SAFETY: `f.c` came from `fmi2Instantiate` and lives until its `Fmu` drops; every
+        // pointer argument is a local that outlives the call.
         unsafe { fmi2GetRealStatus(f.c, fmi2LastSuccessfulTime, &mut lst) },
         fmi2OK
     );
@@ -697,8 +744,12 @@ fn parameters_and_scene_parameter() {
     let f = Fmu::new(&scene);
     assert_eq!(f.set_real(&[VR_DT], &[1e-4]), fmi2OK);
     assert_eq!(f.setup(0.0, None), fmi2OK);
+    // SAFETY: `f.c` came from `fmi2Instantiate` and lives until its `Fmu` drops; every pointer
+    // argument is a local that outlives the call.
     unsafe { assert_eq!(fmi2EnterInitializationMode(f.c), fmi2OK) };
     assert_eq!(f.get_real(&[VR_DT]), Ok(vec![1e-4]));
+    // SAFETY: `f.c` came from `fmi2Instantiate` and lives until its `Fmu` drops; every pointer
+    // argument is a local that outlives the call.
     unsafe { assert_eq!(fmi2ExitInitializationMode(f.c), fmi2OK) };
     let mut bits = Vec::new();
     for k in 0..6 {
@@ -716,6 +767,8 @@ fn parameters_and_scene_parameter() {
     let name = CString::new("stiff.toml").unwrap();
     let p = name.as_ptr();
     assert_eq!(
+        // SAFETY: `g.c` came from `fmi2Instantiate` and lives until its `Fmu` drops; every
+        // pointer argument is a local that outlives the call.
         unsafe { fmi2SetString(g.c, &VR_SCENE, 1, &p) },
         fmi2OK,
         "{:?}",

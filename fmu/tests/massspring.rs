@@ -23,12 +23,18 @@ const H: f64 = 0.05;
 fn set_string(f: &Fmu, vr: u32, v: &str) -> fmi2Status {
     let v = CString::new(v).unwrap();
     let p = v.as_ptr();
+    // SAFETY: `f.c` came from `fmi2Instantiate` and lives until its `Fmu` drops; every pointer
+    // argument is a local that outlives the call.
     unsafe { fmi2SetString(f.c, &vr, 1, &p) }
 }
 
 fn get_string(f: &Fmu, vr: u32) -> String {
     let mut p: *const c_char = std::ptr::null();
+    // SAFETY: `f.c` came from `fmi2Instantiate` and lives until its `Fmu` drops; every pointer
+    // argument is a local that outlives the call.
     assert_eq!(unsafe { fmi2GetString(f.c, &vr, 1, &mut p) }, fmi2OK);
+    // SAFETY: `fmi2GetString` returned OK, so `p` is a NUL-terminated string the instance keeps
+    // until its next call.
     unsafe { std::ffi::CStr::from_ptr(p) }
         .to_string_lossy()
         .into_owned()
@@ -161,6 +167,8 @@ fn forward_euler_on_the_undamped_cloth_is_refused_at_initialization() {
     let f = Fmu::mass_spring(&cloth());
     assert_eq!(set_string(&f, VR_INTEGRATOR, "forward-euler"), fmi2OK);
     assert_eq!(f.setup(0.0, None), fmi2OK);
+    // SAFETY: `f.c` came from `fmi2Instantiate` and lives until its `Fmu` drops; every pointer
+    // argument is a local that outlives the call.
     unsafe {
         assert_eq!(fmi2EnterInitializationMode(f.c), fmi2OK);
         assert_eq!(fmi2ExitInitializationMode(f.c), fmi2Error);
@@ -222,10 +230,14 @@ fn gravity_inputs_act_and_bad_values_are_refused() {
 fn diverging_wire_is_discarded_never_ok_with_inf_outputs() {
     let f = Fmu::mass_spring(&wire());
     assert_eq!(f.setup(0.0, None), fmi2OK);
+    // SAFETY: `f.c` came from `fmi2Instantiate` and lives until its `Fmu` drops; every pointer
+    // argument is a local that outlives the call.
     assert_eq!(unsafe { fmi2EnterInitializationMode(f.c) }, fmi2OK);
     assert_eq!(set_string(&f, VR_INTEGRATOR, "symplectic-euler"), fmi2OK);
     assert_eq!(f.set_real(&[VR_DT], &[0.5]), fmi2OK);
     // dt is beyond the stability bound: a warning, not an error.
+    // SAFETY: `f.c` came from `fmi2Instantiate` and lives until its `Fmu` drops; every pointer
+    // argument is a local that outlives the call.
     assert!(unsafe { fmi2ExitInitializationMode(f.c) } <= fmi2Warning);
     assert_eq!(f.set_real(&[VR_GRAVITY_X], &[1e5]), fmi2OK);
     let h = 0.5;
@@ -253,12 +265,16 @@ fn diverging_wire_is_discarded_never_ok_with_inf_outputs() {
         .any(|l| l.0 == fmi2Discard && l.1 == "logStatusDiscard"));
     let mut term = 0;
     assert_eq!(
+        // SAFETY: `f.c` came from `fmi2Instantiate` and lives until its `Fmu` drops; every
+        // pointer argument is a local that outlives the call.
         unsafe { fmi2GetBooleanStatus(f.c, fmi2Terminated, &mut term) },
         fmi2OK
     );
     assert_eq!(term, fmi2True);
     let mut lst = -1.0;
     assert_eq!(
+        // SAFETY: `f.c` came from `fmi2Instantiate` and lives until its `Fmu` drops; every
+        // pointer argument is a local that outlives the call.
         unsafe { fmi2GetRealStatus(f.c, fmi2LastSuccessfulTime, &mut lst) },
         fmi2OK
     );
@@ -272,9 +288,13 @@ fn diverging_wire_is_discarded_never_ok_with_inf_outputs() {
 fn dt_parameter_sets_the_substep() {
     let f = Fmu::mass_spring(&wire());
     assert_eq!(f.setup(0.0, None), fmi2OK);
+    // SAFETY: `f.c` came from `fmi2Instantiate` and lives until its `Fmu` drops; every pointer
+    // argument is a local that outlives the call.
     assert_eq!(unsafe { fmi2EnterInitializationMode(f.c) }, fmi2OK);
     assert_eq!(f.get_real(&[VR_DT]).unwrap(), [0.0]);
     assert_eq!(f.set_real(&[VR_DT], &[0.01]), fmi2OK);
+    // SAFETY: `f.c` came from `fmi2Instantiate` and lives until its `Fmu` drops; every pointer
+    // argument is a local that outlives the call.
     assert_eq!(unsafe { fmi2ExitInitializationMode(f.c) }, fmi2OK);
     assert_eq!(f.get_real(&[VR_DT]).unwrap(), [0.01]);
     assert_eq!(f.do_step(0.0, H), fmi2OK);
@@ -308,6 +328,8 @@ fn fmu_state_round_trip_gives_identical_bits() {
     let first = run_on(&f);
     let (st, restored) = f.deserialize(&bytes);
     assert_eq!(st, fmi2OK, "{:?}", f.lines());
+    // SAFETY: `f.c` came from `fmi2Instantiate` and lives until its `Fmu` drops; every pointer
+    // argument is a local that outlives the call.
     assert_eq!(unsafe { fmi2SetFMUstate(f.c, restored) }, fmi2OK);
     // 5 frames of 10 substeps (the scene's time_step 0.005 s).
     assert_eq!(f.substeps(), 50);
@@ -319,6 +341,8 @@ fn fmu_state_round_trip_gives_identical_bits() {
     g.init();
     let (st, s2) = g.deserialize(&bytes);
     assert_eq!(st, fmi2OK, "{:?}", g.lines());
+    // SAFETY: `g.c` came from `fmi2Instantiate` and lives until its `Fmu` drops; every pointer
+    // argument is a local that outlives the call.
     assert_eq!(unsafe { fmi2SetFMUstate(g.c, s2) }, fmi2OK);
     assert_eq!(run_on(&g), first);
     g.free_state(s2);

@@ -20,12 +20,18 @@ const H: f64 = 0.01;
 fn set_string(f: &Fmu, vr: u32, v: &str) -> fmi2Status {
     let s = CString::new(v).unwrap();
     let p = s.as_ptr();
+    // SAFETY: `f.c` came from `fmi2Instantiate` and lives until its `Fmu` drops; every pointer
+    // argument is a local that outlives the call.
     unsafe { fmi2SetString(f.c, &vr, 1, &p) }
 }
 
 fn get_string(f: &Fmu, vr: u32) -> String {
     let mut p: fmi2String = std::ptr::null();
+    // SAFETY: `f.c` came from `fmi2Instantiate` and lives until its `Fmu` drops; every pointer
+    // argument is a local that outlives the call.
     assert_eq!(unsafe { fmi2GetString(f.c, &vr, 1, &mut p) }, fmi2OK);
+    // SAFETY: `fmi2GetString` returned OK, so `p` is a NUL-terminated string the instance keeps
+    // until its next call.
     unsafe { std::ffi::CStr::from_ptr(p) }
         .to_string_lossy()
         .into_owned()
@@ -106,14 +112,20 @@ fn bad_transfer_values_are_refused_with_a_log_line() {
             e.contains("transfer.scheme") && e.contains("\"flip\" or \"apic\""),
             "{e}"
         );
+        // SAFETY: `f.c` came from `fmi2Instantiate` and lives until its `Fmu` drops; every
+        // pointer argument is a local that outlives the call.
         unsafe { assert_eq!(fmi2Reset(f.c), fmi2OK) };
     }
     for bad in [1.5, -0.1, 1.0 + 1e-12] {
         assert_eq!(f.set_real(&[VR_FLIP_RATIO], &[bad]), fmi2Error, "{bad}");
         assert!(f.last_error().contains("at most 1"), "{}", f.last_error());
+        // SAFETY: `f.c` came from `fmi2Instantiate` and lives until its `Fmu` drops; every
+        // pointer argument is a local that outlives the call.
         unsafe { assert_eq!(fmi2Reset(f.c), fmi2OK) };
     }
     assert_eq!(f.set_real(&[VR_FLIP_RATIO], &[f64::NAN]), fmi2Error);
+    // SAFETY: `f.c` came from `fmi2Instantiate` and lives until its `Fmu` drops; every pointer
+    // argument is a local that outlives the call.
     unsafe { assert_eq!(fmi2Reset(f.c), fmi2OK) };
     // The bounds themselves are accepted.
     for ok in [0.0, 1.0] {
@@ -147,6 +159,8 @@ fn transfer_parameters_travel_in_the_fmu_state() {
     g.init();
     let (st, d) = g.deserialize(&bytes);
     assert_eq!(st, fmi2OK, "{:?}", g.lines());
+    // SAFETY: `g.c` came from `fmi2Instantiate` and lives until its `Fmu` drops; every pointer
+    // argument is a local that outlives the call.
     assert_eq!(unsafe { fmi2SetFMUstate(g.c, d) }, fmi2OK);
     g.free_state(d);
     assert_eq!(get_string(&g, VR_TRANSFER_SCHEME), "apic");
@@ -231,6 +245,8 @@ fn pin_variables_follow_the_scene() {
     let f = Fmu::new(&s);
     let enter = |f: &Fmu| {
         assert_eq!(f.setup(0.0, None), fmi2OK);
+        // SAFETY: `f.c` came from `fmi2Instantiate` and lives until its `Fmu` drops; every
+        // pointer argument is a local that outlives the call.
         assert_eq!(unsafe { fmi2EnterInitializationMode(f.c) }, fmi2OK);
     };
     enter(&f);
@@ -248,6 +264,8 @@ fn pin_variables_follow_the_scene() {
     ] {
         assert_eq!(f.set_real(&pin_vrs(0), &vals), fmi2Error);
         assert!(f.last_error().contains(what), "{}", f.last_error());
+        // SAFETY: `f.c` came from `fmi2Instantiate` and lives until its `Fmu` drops; every
+        // pointer argument is a local that outlives the call.
         unsafe { assert_eq!(fmi2Reset(f.c), fmi2OK) };
         enter(&f);
     }
@@ -265,6 +283,8 @@ fn pin_variables_follow_the_scene() {
         "{}",
         g.last_error()
     );
+    // SAFETY: `g.c` came from `fmi2Instantiate` and lives until its `Fmu` drops; every pointer
+    // argument is a local that outlives the call.
     unsafe { assert_eq!(fmi2Reset(g.c), fmi2OK) };
     enter(&g);
     assert_eq!(g.get_real(&force_vrs(0)), Ok(vec![0.0, 0.0]));
@@ -343,6 +363,8 @@ fn driven_pin_state_round_trip_gives_identical_bits() {
     let st = f.get_state();
     let bytes = f.serialize(st);
     let first = drive(&f, 4, 6);
+    // SAFETY: `f.c` came from `fmi2Instantiate` and lives until its `Fmu` drops; every pointer
+    // argument is a local that outlives the call.
     assert_eq!(unsafe { fmi2SetFMUstate(f.c, st) }, fmi2OK);
     assert_eq!(drive(&f, 4, 6), first);
     f.free_state(st);
@@ -351,6 +373,8 @@ fn driven_pin_state_round_trip_gives_identical_bits() {
     g.init();
     let (status, d) = g.deserialize(&bytes);
     assert_eq!(status, fmi2OK, "{:?}", g.lines());
+    // SAFETY: `g.c` came from `fmi2Instantiate` and lives until its `Fmu` drops; every pointer
+    // argument is a local that outlives the call.
     assert_eq!(unsafe { fmi2SetFMUstate(g.c, d) }, fmi2OK);
     g.free_state(d);
     assert_eq!(get_string(&g, VR_TRANSFER_SCHEME), "flip");
@@ -494,6 +518,8 @@ fn scene_parameter_must_keep_the_pins() {
     std::fs::write(f.dir.join("fixed.toml"), fixed.to_toml_string()).unwrap();
     assert_eq!(set_string(&f, VR_SCENE, "fixed.toml"), fmi2Error);
     assert!(f.last_error().contains("other pins"), "{}", f.last_error());
+    // SAFETY: `f.c` came from `fmi2Instantiate` and lives until its `Fmu` drops; every pointer
+    // argument is a local that outlives the call.
     unsafe { assert_eq!(fmi2Reset(f.c), fmi2OK) };
     let mut moved = s.clone();
     moved.gravity = [0.0, -5.0];

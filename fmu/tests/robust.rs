@@ -16,11 +16,15 @@ use YarnBundle::yarn::variables::*;
 const H: f64 = 0.01;
 
 fn set_int(f: &Fmu, vr: u32, v: c_int) -> fmi2Status {
+    // SAFETY: `f.c` came from `fmi2Instantiate` and lives until its `Fmu` drops; every pointer
+    // argument is a local that outlives the call.
     unsafe { fmi2SetInteger(f.c, &vr, 1, &v) }
 }
 
 fn get_int(f: &Fmu, vr: u32) -> c_int {
     let mut v = -1;
+    // SAFETY: `f.c` came from `fmi2Instantiate` and lives until its `Fmu` drops; every pointer
+    // argument is a local that outlives the call.
     assert_eq!(unsafe { fmi2GetInteger(f.c, &vr, 1, &mut v) }, fmi2OK);
     v
 }
@@ -28,12 +32,18 @@ fn get_int(f: &Fmu, vr: u32) -> c_int {
 fn set_scene(f: &Fmu, path: &str) -> fmi2Status {
     let v = CString::new(path).unwrap();
     let p = v.as_ptr();
+    // SAFETY: `f.c` came from `fmi2Instantiate` and lives until its `Fmu` drops; every pointer
+    // argument is a local that outlives the call.
     unsafe { fmi2SetString(f.c, &VR_SCENE, 1, &p) }
 }
 
 fn exit_init(f: &Fmu) -> fmi2Status {
     assert_eq!(f.setup(0.0, None), fmi2OK);
+    // SAFETY: `f.c` came from `fmi2Instantiate` and lives until its `Fmu` drops; every pointer
+    // argument is a local that outlives the call.
     assert_eq!(unsafe { fmi2EnterInitializationMode(f.c) }, fmi2OK);
+    // SAFETY: `f.c` came from `fmi2Instantiate` and lives until its `Fmu` drops; every pointer
+    // argument is a local that outlives the call.
     unsafe { fmi2ExitInitializationMode(f.c) }
 }
 
@@ -148,10 +158,14 @@ fn a_substep_beyond_the_stability_bound_gives_a_warning() {
     let integrator = CString::new("symplectic-euler").unwrap();
     let p = integrator.as_ptr();
     let m = Fmu::mass_spring(&layout);
+    // SAFETY: `m.c` came from `fmi2Instantiate` and lives until its `Fmu` drops; every pointer
+    // argument is a local that outlives the call.
     assert_eq!(unsafe { fmi2SetString(m.c, &VR_INTEGRATOR, 1, &p) }, fmi2OK);
     // Its default step (cfl_number times the bound) is inside.
     assert_eq!(exit_init(&m), fmi2OK, "{:?}", m.lines());
     let m = Fmu::mass_spring(&layout);
+    // SAFETY: `m.c` came from `fmi2Instantiate` and lives until its `Fmu` drops; every pointer
+    // argument is a local that outlives the call.
     assert_eq!(unsafe { fmi2SetString(m.c, &VR_INTEGRATOR, 1, &p) }, fmi2OK);
     assert_eq!(m.set_real(&[MS_DT], &[1.5 * ms_bound]), fmi2OK);
     assert_eq!(exit_init(&m), fmi2Warning);

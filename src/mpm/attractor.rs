@@ -1,7 +1,6 @@
 //! The attractor: a point that pulls the yarn with a settable strength
 //! (the FMU's and the CLI's run-time input), and its one input check.
 
-use super::sim::SimError;
 use crate::math::Vec2;
 
 /// The attractor as the simulation sees it (settable at run time).
@@ -23,25 +22,25 @@ impl Attractor {
     /// simulation, the FMU) applies: a finite position within
     /// [`Self::MAX_POSITION`] m of the origin in each coordinate, a strength
     /// in `[0, MAX_STRENGTH]` m/s^2. The error names the input.
-    pub fn check(&self) -> Result<(), SimError> {
+    pub fn check(&self) -> Result<(), String> {
         let p = self.position;
         if !(p.x.is_finite() && p.y.is_finite()) {
-            return Err(SimError::BadInput(format!(
+            return Err(format!(
                 "attractor position ({}, {}) must be finite",
                 p.x, p.y
-            )));
+            ));
         }
         if p.x.abs() > Self::MAX_POSITION || p.y.abs() > Self::MAX_POSITION {
-            return Err(SimError::BadInput(format!(
+            return Err(format!(
                 "attractor position ({}, {}) is absurd (beyond 1e6 m)",
                 p.x, p.y
-            )));
+            ));
         }
         if !(self.strength.is_finite() && (0.0..=Self::MAX_STRENGTH).contains(&self.strength)) {
-            return Err(SimError::BadInput(format!(
+            return Err(format!(
                 "attractor strength {} must be in [0, 1e6] m/s2",
                 self.strength
-            )));
+            ));
         }
         Ok(())
     }

@@ -23,6 +23,7 @@
 //! * [`timestep`]: the stable substep bound (CFL / elastic waves).
 
 pub mod attractor;
+pub mod bending;
 pub mod constitutive;
 pub mod contact;
 pub mod frames;

@@ -8,7 +8,7 @@
 //! (APIC), so linear momentum is conserved exactly; quadrature particle
 //! positions are re-interpolated from the vertices each step.
 
-use super::vertex_forces::{rest_of_curve, BendRest};
+use super::bending::{rest_of_curve, BendRest};
 use crate::math::bspline::Stencil;
 use crate::math::qr::{qr, Qr2};
 use crate::math::{perp, Mat2, Vec2};

@@ -442,7 +442,7 @@ impl YarnSim {
 
     /// Sets the attractor; refuses one that fails [`Attractor::check`].
     pub fn set_attractor(&mut self, a: Attractor) -> Result<(), SimError> {
-        a.check()?;
+        a.check().map_err(SimError::BadInput)?;
         self.attractor = a;
         Ok(())
     }

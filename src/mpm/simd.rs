@@ -94,13 +94,13 @@ macro_rules! multiversion {
                     imp$(::<$($cn),*>)?($($a),*)
                 }
                 match $crate::mpm::simd::kernels() {
-                    // SAFETY: `kernels()` reports AVX-512 F + VL, AVX2 and FMA.
                     $crate::mpm::simd::Kernels::Avx512 => {
-                        return unsafe { avx512$(::<$($cn),*>)?($($a),*) }
+                        // SAFETY: `kernels()` reports AVX-512 F + VL, AVX2 and FMA.
+                        return unsafe { avx512$(::<$($cn),*>)?($($a),*) };
                     }
-                    // SAFETY: `kernels()` reports AVX2 and FMA.
                     $crate::mpm::simd::Kernels::Avx2 => {
-                        return unsafe { wide$(::<$($cn),*>)?($($a),*) }
+                        // SAFETY: `kernels()` reports AVX2 and FMA.
+                        return unsafe { wide$(::<$($cn),*>)?($($a),*) };
                     }
                     $crate::mpm::simd::Kernels::Portable => {}
                 }

@@ -20,38 +20,9 @@
 //! stress), callable without a grid: the scatter calls it per chunk, and an
 //! implicit solver or a test can call it directly.
 
+pub use super::bending::{curvature, rest_of_curve, BendRest};
 use super::particles::{Vertices, NONE};
-use crate::math::{cross, Vec2};
-
-/// Rest data of the bending energy at one vertex.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct BendRest {
-    /// Rest curvature `kappa0 = 2 tan(theta0 / 2)`.
-    pub kappa0: f64,
-    /// `1 / l` with `l` the rest Voronoi length; 0 at yarn ends (no bending).
-    pub inv_len: f64,
-}
-
-impl BendRest {
-    /// Rest data at a vertex between edges `e1` (incoming) and `e2` (outgoing).
-    pub fn new(e1: Vec2, e2: Vec2) -> Self {
-        BendRest {
-            kappa0: curvature(e1, e2),
-            inv_len: 2.0 / (e1.norm() + e2.norm()),
-        }
-    }
-}
-
-/// `2 tan(theta / 2)` of the turning angle from edge `e1` to edge `e2`.
-#[inline(always)]
-pub fn curvature(e1: Vec2, e2: Vec2) -> f64 {
-    let d = e1.norm() * e2.norm() + e1.dot(&e2);
-    if d > 0.0 {
-        2.0 * cross(e1, e2) / d
-    } else {
-        0.0
-    }
-}
+use crate::math::Vec2;
 
 /// `(B (kappa - kappa0) / l) dkappa/de1` and `... dkappa/de2` at every
 /// vertex `j` of `lo..hi` (`[g1.x, g1.y, g2.x, g2.y]`, entry `j - lo`),
@@ -154,21 +125,6 @@ pub fn bending_energy(v: &Vertices, bending: f64) -> f64 {
         e += 0.5 * bending * dk * dk * rest.inv_len;
     }
     e
-}
-
-/// Rest bending data of a yarn's vertices `curve`: interior vertices get
-/// their rest curvature and Voronoi length, the two ends none.
-pub fn rest_of_curve(curve: &[Vec2]) -> Vec<BendRest> {
-    let n = curve.len();
-    (0..n)
-        .map(|i| {
-            if i == 0 || i + 1 == n {
-                BendRest::default()
-            } else {
-                BendRest::new(curve[i] - curve[i - 1], curve[i + 1] - curve[i])
-            }
-        })
-        .collect()
 }
 
 #[cfg(test)]

@@ -91,9 +91,7 @@ impl Inputs {
             ));
         }
         // The attractor's limits are the library's, checked in one place.
-        self.attractor()
-            .check()
-            .or_else(|e| refuse(e.to_string()))?;
+        self.attractor().check().or_else(refuse)?;
         for p in &self.pins {
             let x = Vec2::from(p.position);
             let v = Vec2::from(p.velocity);

@@ -97,7 +97,8 @@ pub struct Fmu {
     pub dir: PathBuf,
 }
 
-// The component is only used from the thread that owns the `Fmu`.
+// SAFETY: the component is only used from the thread that owns the `Fmu`, and the FMU keeps no
+// thread-local state.
 unsafe impl Send for Fmu {}
 
 impl Fmu {
@@ -132,6 +133,8 @@ impl Fmu {
         let uri = CString::new(format!("file://{}", dir.display())).unwrap();
         let name = CString::new(name).unwrap();
         let guid = CString::new(guid).unwrap();
+        // SAFETY: the strings are live `CString`s and `cb` outlives the call; `log`, the logger's
+        // environment, is boxed and lives as long as the instance (both are owned by the `Fmu`).
         let c = unsafe {
             fmi2Instantiate(
                 name.as_ptr(),
@@ -169,6 +172,8 @@ impl Fmu {
     }
 
     pub fn setup(&self, start: f64, stop: Option<f64>) -> fmi2Status {
+        // SAFETY: `self.c` came from `fmi2Instantiate` and lives until its `Fmu` drops; every
+        // pointer argument is a local that outlives the call.
         unsafe {
             fmi2SetupExperiment(
                 self.c,
@@ -188,6 +193,8 @@ impl Fmu {
     }
 
     pub fn init_mode(&self) {
+        // SAFETY: `self.c` came from `fmi2Instantiate` and lives until its `Fmu` drops; every
+        // pointer argument is a local that outlives the call.
         unsafe {
             assert_eq!(fmi2EnterInitializationMode(self.c), fmi2OK);
             assert_eq!(
@@ -201,16 +208,22 @@ impl Fmu {
 
     pub fn set_real(&self, vr: &[u32], v: &[f64]) -> fmi2Status {
         assert_eq!(vr.len(), v.len());
+        // SAFETY: `self.c` came from `fmi2Instantiate` and lives until its `Fmu` drops; every
+        // pointer argument is a local that outlives the call.
         unsafe { fmi2SetReal(self.c, vr.as_ptr(), vr.len(), v.as_ptr()) }
     }
 
     pub fn set_bool(&self, vr: u32, v: bool) -> fmi2Status {
         let v = v as fmi2Boolean;
+        // SAFETY: `self.c` came from `fmi2Instantiate` and lives until its `Fmu` drops; every
+        // pointer argument is a local that outlives the call.
         unsafe { fmi2SetBoolean(self.c, &vr, 1, &v) }
     }
 
     pub fn get_real(&self, vr: &[u32]) -> Result<Vec<f64>, fmi2Status> {
         let mut out = vec![f64::NAN; vr.len()];
+        // SAFETY: `self.c` came from `fmi2Instantiate` and lives until its `Fmu` drops; every
+        // pointer argument is a local that outlives the call.
         match unsafe { fmi2GetReal(self.c, vr.as_ptr(), vr.len(), out.as_mut_ptr()) } {
             s if s == fmi2OK => Ok(out),
             s => Err(s),
@@ -220,6 +233,8 @@ impl Fmu {
     pub fn substeps(&self) -> i32 {
         let mut v = -1;
         assert_eq!(
+            // SAFETY: `self.c` came from `fmi2Instantiate` and lives until its `Fmu` drops; every
+            // pointer argument is a local that outlives the call.
             unsafe { fmi2GetInteger(self.c, &VR_SUBSTEPS, 1, &mut v) },
             fmi2OK
         );
@@ -227,6 +242,8 @@ impl Fmu {
     }
 
     pub fn do_step(&self, t: f64, h: f64) -> fmi2Status {
+        // SAFETY: `self.c` came from `fmi2Instantiate` and lives until its `Fmu` drops; every
+        // pointer argument is a local that outlives the call.
         unsafe { fmi2DoStep(self.c, t, h, fmi2True) }
     }
 
@@ -247,6 +264,8 @@ impl Fmu {
 
     pub fn get_state(&self) -> fmi2FMUstate {
         let mut s: fmi2FMUstate = std::ptr::null_mut();
+        // SAFETY: `self.c` came from `fmi2Instantiate` and lives until its `Fmu` drops; every
+        // pointer argument is a local that outlives the call.
         assert_eq!(unsafe { fmi2GetFMUstate(self.c, &mut s) }, fmi2OK);
         assert!(!s.is_null());
         s
@@ -255,11 +274,15 @@ impl Fmu {
     pub fn serialize(&self, s: fmi2FMUstate) -> Vec<u8> {
         let mut n = 0usize;
         assert_eq!(
+            // SAFETY: `self.c` came from `fmi2Instantiate` and lives until its `Fmu` drops; every
+            // pointer argument is a local that outlives the call.
             unsafe { fmi2SerializedFMUstateSize(self.c, s, &mut n) },
             fmi2OK
         );
         let mut buf = vec![0u8; n];
         assert_eq!(
+            // SAFETY: `self.c` came from `fmi2Instantiate` and lives until its `Fmu` drops; every
+            // pointer argument is a local that outlives the call.
             unsafe { fmi2SerializeFMUstate(self.c, s, buf.as_mut_ptr() as *mut c_char, n) },
             fmi2OK
         );
@@ -269,6 +292,8 @@ impl Fmu {
     /// Deserializes into a new state; the status and the state (null on failure).
     pub fn deserialize(&self, bytes: &[u8]) -> (fmi2Status, fmi2FMUstate) {
         let mut s: fmi2FMUstate = std::ptr::null_mut();
+        // SAFETY: `self.c` came from `fmi2Instantiate` and lives until its `Fmu` drops; every
+        // pointer argument is a local that outlives the call.
         let st = unsafe {
             fmi2DeSerializeFMUstate(self.c, bytes.as_ptr() as *const c_char, bytes.len(), &mut s)
         };
@@ -276,6 +301,8 @@ impl Fmu {
     }
 
     pub fn free_state(&self, mut s: fmi2FMUstate) {
+        // SAFETY: `self.c` came from `fmi2Instantiate` and lives until its `Fmu` drops; every
+        // pointer argument is a local that outlives the call.
         assert_eq!(unsafe { fmi2FreeFMUstate(self.c, &mut s) }, fmi2OK);
         assert!(s.is_null());
     }
@@ -283,6 +310,8 @@ impl Fmu {
 
 impl Drop for Fmu {
     fn drop(&mut self) {
+        // SAFETY: `self.c` came from `fmi2Instantiate` and is freed once, here, when the `Fmu`
+        // drops.
         unsafe { fmi2FreeInstance(self.c) };
         let _ = std::fs::remove_dir_all(&self.dir);
     }

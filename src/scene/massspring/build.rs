@@ -90,7 +90,7 @@ impl MassSpringScene {
             add_driven(&mut p, &mut kinematics, di, d, src)?;
         }
         let time_step = self.checked_time_step(src)?;
-        crate::scene::overlap::check_particles_outside_spheres(&p.positions, &self.spheres, text)?;
+        super::overlap::check_particles_outside_spheres(&p.positions, &self.spheres, text)?;
         Ok(System {
             positions: p.positions,
             velocities: p.velocities,

@@ -14,6 +14,7 @@
 
 mod build;
 pub mod builtin;
+pub mod overlap;
 pub mod system;
 
 use serde::{Deserialize, Deserializer, Serialize};

@@ -1,0 +1,311 @@
+//! yarnsim's entry of the rod benchmark against MuJoCo and PyElastica
+//! (`tools/peers/bench.py`): the oracle scenes of `tests/yarn_oracles.rs`
+//! run through the library, timing the stepping loop only, one JSON line
+//! on stdout per run.
+//!
+//! ```text
+//! cargo run --release --example peers_chain -- chain VERTICES GRID DT
+//! cargo run --release --example peers_chain -- cantilever VERTICES
+//! cargo run --release --example peers_chain -- capstan R L1 L2 MU
+//! cargo run --release --example peers_chain -- bundle DURATION
+//! ```
+//!
+//! * `chain`: the hanging chain of the oracle test (L = 0.8 m pinned at the
+//!   top, k = 2000, no bending, started in the first mode shape
+//!   `u = A J0(j01 sqrt(z / L))`, A = 0.02 m), run for 3.4 s; the period is
+//!   twice the mean spacing of the free end's zero crossings (interpolated
+//!   within the substep). `DT` is a TOML value (`1e-4` or `"auto"`).
+//! * `cantilever`: the Euler-Bernoulli cantilever of the oracle test
+//!   (L = 0.5 m, B = 1, rho = 1, 64^2, dt 5e-5, two vertices pinned), the tip
+//!   deflection averaged over two measured periods of the first mode.
+//! * `capstan`: the bending-free yarn over a half circle (128^2, dt 1e-4,
+//!   g = 2) loaded for 0.2 s, then up to 1 s more: slid if a free end moved
+//!   vertically by more than 0.5 % of its hanging length.
+//! * `bundle`: the built-in `yarn-reference` scene for `DURATION` s; prints
+//!   every yarn's vertex positions for the driver's common metrics.
+//!
+//! Threads: set `RAYON_NUM_THREADS=1` for one thread.
+
+use std::time::Instant;
+
+use yarnsim::math::bessel_j0;
+use yarnsim::scene::builtin::yarn_reference;
+use yarnsim::scene::YarnScene;
+use yarnsim::YarnSim;
+
+const J01: f64 = 2.404_825_557_695_773;
+
+fn scene(text: &str) -> YarnScene {
+    YarnScene::from_toml_str(text).unwrap_or_else(|e| {
+        eprintln!("scene: {e}");
+        std::process::exit(3)
+    })
+}
+
+fn arg<T: std::str::FromStr>(args: &[String], i: usize, name: &str) -> T {
+    args.get(i).and_then(|s| s.parse().ok()).unwrap_or_else(|| {
+        eprintln!("missing or invalid argument {name}");
+        std::process::exit(2)
+    })
+}
+
+fn chain(vertices: u32, grid: u32, dt: &str) -> String {
+    let (len, g, amp, n) = (0.8, 9.8, 0.02, 200);
+    let points = (0..=n)
+        .map(|i| {
+            let z = len * (n - i) as f64 / n as f64;
+            let u = amp * bessel_j0(J01 * (z / len).sqrt());
+            format!("[{:.12}, {:.12}]", 0.5 + u, 0.1 + z)
+        })
+        .collect::<Vec<_>>()
+        .join(", ");
+    let s = scene(&format!(
+        r#"
+gravity = [0.0, -{g}]
+[grid]
+resolution = {grid}
+[time]
+dt = {dt}
+[material]
+k = 2000.0
+gamma = 0.0
+youngs_modulus = 0.0
+friction = 0.0
+bending = 0.0
+plasticity = false
+[walls]
+mode = "none"
+[[yarns]]
+points = [{points}]
+vertices = {vertices}
+[[pins]]
+yarn = 0
+end = "start"
+"#
+    ));
+    let mut sim = YarnSim::new(&s).unwrap();
+    let duration = 3.4;
+    let mut crossings = Vec::new();
+    let mut prev = sim.yarn_endpoints(0).1.x - 0.5;
+    let mut ok = true;
+    let t0 = Instant::now();
+    while sim.time() < duration {
+        let before = sim.time();
+        if sim.step().is_err() {
+            ok = false;
+            break;
+        }
+        let h = sim.time() - before;
+        let u = sim.yarn_endpoints(0).1.x - 0.5;
+        if prev * u < 0.0 {
+            crossings.push(sim.time() - h * u / (u - prev));
+        }
+        prev = u;
+    }
+    let wall = t0.elapsed().as_secs_f64();
+    let period = if crossings.len() >= 2 {
+        2.0 * (crossings[crossings.len() - 1] - crossings[0]) / (crossings.len() - 1) as f64
+    } else {
+        f64::NAN
+    };
+    let oracle = 2.0 * std::f64::consts::PI / (0.5 * J01 * (g / len).sqrt());
+    format!(
+        "{{\"ok\": {ok}, \"period\": {period}, \"oracle\": {oracle}, \"error\": {}, \"crossings\": {}, \
+         \"wall_s\": {wall}, \"sim_s\": {}, \"steps\": {}}}",
+        (period - oracle) / oracle,
+        crossings.len(),
+        sim.time(),
+        sim.steps()
+    )
+}
+
+fn cantilever(vertices: u32) -> String {
+    let (len, b, rho): (f64, f64, f64) = (0.5, 1.0, 1.0);
+    let g = 0.08 * b / (rho * len * len * len);
+    let s = scene(&format!(
+        r#"
+gravity = [0.0, -{g}]
+[grid]
+resolution = 64
+[time]
+dt = 5e-5
+[material]
+k = 1e4
+gamma = 0.0
+youngs_modulus = 0.0
+friction = 0.0
+bending = {b}
+density = {rho}
+plasticity = false
+[walls]
+mode = "none"
+[[yarns]]
+start = [0.25, 0.5]
+end = [{}, 0.5]
+vertices = {vertices}
+[[pins]]
+yarn = 0
+end = "start"
+count = 2
+"#,
+        0.25 + len
+    ));
+    let mut sim = YarnSim::new(&s).unwrap();
+    let free = len - 0.5 * len / (vertices - 1) as f64;
+    let oracle = rho * g * free.powi(4) / (8.0 * b);
+    let omega1 = 1.8751f64.powi(2) * (b / (rho * free.powi(4))).sqrt();
+    let steps = (2.5 * 2.0 * std::f64::consts::PI / omega1 / sim.dt()).round() as u64;
+    let y0 = sim.yarn_endpoints(0).1.y;
+    let mut d = Vec::with_capacity(steps as usize);
+    let mut ok = true;
+    let t0 = Instant::now();
+    for _ in 0..steps {
+        if sim.step().is_err() {
+            ok = false;
+            break;
+        }
+        d.push(y0 - sim.yarn_endpoints(0).1.y);
+    }
+    let wall = t0.elapsed().as_secs_f64();
+    let m0 = d.iter().sum::<f64>() / d.len().max(1) as f64;
+    let up: Vec<usize> = (1..d.len())
+        .filter(|&k| d[k - 1] < m0 && d[k] >= m0)
+        .collect();
+    let tip = if up.len() >= 3 {
+        d[up[0]..up[2]].iter().sum::<f64>() / (up[2] - up[0]) as f64
+    } else {
+        f64::NAN
+    };
+    format!(
+        "{{\"ok\": {ok}, \"tip\": {tip}, \"oracle\": {oracle}, \"error\": {}, \"wall_s\": {wall}, \
+         \"sim_s\": {}, \"steps\": {}}}",
+        (tip - oracle) / oracle,
+        sim.time(),
+        sim.steps()
+    )
+}
+
+fn capstan(r: f64, l1: f64, l2: f64, mu: f64) -> String {
+    let (cx, cy, res, g) = (0.5, 0.75, 128u32, 2.0);
+    let mut pts = vec![[cx - r, cy - l1]];
+    let arc = 64;
+    for i in 0..=arc {
+        let psi = std::f64::consts::PI * (1.0 - i as f64 / arc as f64);
+        pts.push([cx + r * psi.cos(), cy + r * psi.sin()]);
+    }
+    pts.push([cx + r, cy - l2]);
+    let length = l1 + l2 + std::f64::consts::PI * r;
+    let vertices = (length / (0.5 / res as f64)).round() as u32 + 1;
+    let points = pts
+        .iter()
+        .map(|p| format!("[{:.12}, {:.12}]", p[0], p[1]))
+        .collect::<Vec<_>>()
+        .join(", ");
+    let s = scene(&format!(
+        r#"
+gravity = [0.0, -{g}]
+[grid]
+resolution = {res}
+[time]
+dt = 1e-4
+[material]
+k = 1000.0
+gamma = 0.0
+youngs_modulus = 0.0
+friction = 0.0
+bending = 0.0
+plasticity = false
+[walls]
+mode = "none"
+[[obstacles]]
+center = [{cx}, {cy}]
+radius = {r}
+friction = {mu}
+[[yarns]]
+points = [{points}]
+vertices = {vertices}
+"#
+    ));
+    let mut sim = YarnSim::new(&s).unwrap();
+    let t0 = Instant::now();
+    let mut ok = sim.advance(0.2).is_ok();
+    let (a0, b0) = sim.yarn_endpoints(0);
+    let steps = (1.0 / sim.dt()).round() as u64;
+    let (mut worst, mut slid) = (0.0f64, false);
+    for k in 0..steps {
+        if !ok || sim.step().is_err() {
+            ok = false;
+            break;
+        }
+        if k % 50 == 49 || k + 1 == steps {
+            let (a, b) = sim.yarn_endpoints(0);
+            let rel = ((a.y - a0.y).abs() / l1).max((b.y - b0.y).abs() / l2);
+            worst = worst.max(rel);
+            if rel > 0.005 {
+                slid = true;
+                break;
+            }
+        }
+    }
+    let wall = t0.elapsed().as_secs_f64();
+    format!(
+        "{{\"ok\": {ok}, \"slid\": {slid}, \"moved\": {worst}, \"wall_s\": {wall}, \"sim_s\": {}, \
+         \"steps\": {}, \"vertices\": {vertices}}}",
+        sim.time(),
+        sim.steps()
+    )
+}
+
+fn bundle(duration: f64) -> String {
+    let s = yarn_reference();
+    let mut sim = YarnSim::new(&s).unwrap();
+    let t0 = Instant::now();
+    let ok = sim.advance(duration).is_ok();
+    let wall = t0.elapsed().as_secs_f64();
+    let p = sim.particles();
+    let r = &p.yarn_vertices;
+    let yarns = (0..sim.num_yarns())
+        .map(|y| {
+            let xs = p.vert.x[r[y]..r[y + 1]]
+                .iter()
+                .map(|x| format!("[{:.6}, {:.6}]", x.x, x.y))
+                .collect::<Vec<_>>()
+                .join(", ");
+            format!("[{xs}]")
+        })
+        .collect::<Vec<_>>()
+        .join(", ");
+    let d = sim.diagnostics();
+    format!(
+        "{{\"ok\": {ok}, \"wall_s\": {wall}, \"sim_s\": {}, \"steps\": {}, \"min_stretch\": {}, \
+         \"max_stretch\": {}, \"yarns\": [{yarns}]}}",
+        sim.time(),
+        sim.steps(),
+        d.min_stretch,
+        d.max_stretch
+    )
+}
+
+fn main() {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let out = match args.first().map(String::as_str) {
+        Some("chain") => chain(
+            arg(&args, 1, "VERTICES"),
+            arg(&args, 2, "GRID"),
+            &arg::<String>(&args, 3, "DT"),
+        ),
+        Some("cantilever") => cantilever(arg(&args, 1, "VERTICES")),
+        Some("capstan") => capstan(
+            arg(&args, 1, "R"),
+            arg(&args, 2, "L1"),
+            arg(&args, 3, "L2"),
+            arg(&args, 4, "MU"),
+        ),
+        Some("bundle") => bundle(arg(&args, 1, "DURATION")),
+        _ => {
+            eprintln!("usage: peers_chain chain|cantilever|capstan|bundle ARGS (see the source)");
+            std::process::exit(2)
+        }
+    };
+    println!("{out}");
+}

@@ -1,0 +1,244 @@
+#!/usr/bin/env python3
+"""Side-by-side rod benchmark: yarnsim against MuJoCo 4.0.0 and PyElastica
+1.0.0 on the oracle scenes of yarnsim's tests (hanging chain, cantilever,
+heavy-rope capstan) and the reference bundle.
+
+    bash tools/peers/setup.sh && tools/peers/.venv/bin/python tools/peers/bench.py
+        [--quick] [--rounds 3] [--out docs/performance] [--skip-bundle]
+
+Every run is one thread (NUMBA_NUM_THREADS, OMP_NUM_THREADS and
+RAYON_NUM_THREADS are set to 1 before the peers are imported) and times
+its stepping loop only. The timed cases run in `--rounds` rounds; within a
+round the tools take turns (the order rotates from round to round) and the
+wall time is the median over the rounds; errors are deterministic. The
+capstan threshold is a bisection (slides at 0.7 mu*, holds at 1.4 mu*, then
+five halvings: a bracket of 2.2 % of mu*; yarnsim's test does three) and the bundle a single window; both run
+once. `--quick` (under a minute) runs the coarsest chain and cantilever of
+each tool, once, and writes `peers_quick.csv` / `.svg` into `--out` (default
+for quick: the system temp directory) instead of `peers.csv` / `.svg`.
+"""
+
+import argparse
+import csv
+import math
+import os
+import statistics
+import sys
+import tempfile
+import time
+
+for _v in ("NUMBA_NUM_THREADS", "OMP_NUM_THREADS", "RAYON_NUM_THREADS", "OPENBLAS_NUM_THREADS"):
+    os.environ[_v] = "1"
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+
+import numpy as np  # noqa: E402
+
+import bundle_metrics  # noqa: E402
+import elastica_rope  # noqa: E402
+import mujoco_rope  # noqa: E402
+import oracles as O  # noqa: E402
+import plot  # noqa: E402
+import yarnsim_rope  # noqa: E402
+
+ROOT = yarnsim_rope.ROOT
+
+
+def cases(quick):
+    """(tool, integrator, case, setting, callable) of the timed cases."""
+    c = []
+    ch_mj = [(25, 1e-2)] if quick else [(25, 1e-2), (50, 5e-3), (99, 2e-3)]
+    ch_el = [25] if quick else [25, 50]
+    ch_ys = [(25, 16, '"auto"')] if quick else [(25, 16, '"auto"'), (50, 32, '"auto"'),
+                                                (100, 64, "1e-4")]
+    for n, dt in ch_mj:
+        c.append(("mujoco", "discrete", "chain", f"{n} elements, dt {dt:g}",
+                  lambda n=n, dt=dt: mujoco_rope.chain(n, dt)))
+    for n in ch_el:
+        dt = 1.4e-4 * 25 / n
+        c.append(("pyelastica", "position-verlet", "chain", f"{n} elements, dt {dt:.3g}",
+                  lambda n=n: elastica_rope.chain(n)))
+    for v, g, dt in ch_ys:
+        c.append(("yarnsim", "mpm-explicit", "chain",
+                  f"{v} vertices, {g}^2, dt {dt.strip(chr(34))}",
+                  lambda v=v, g=g, dt=dt: yarnsim_rope.chain(v, g, dt)))
+    ca_mj = [25] if quick else [25, 50, 100]
+    ca_el = [] if quick else [25, 50]
+    ca_ys = [] if quick else [100, 200]
+    for n in ca_mj:
+        c.append(("mujoco", "discrete", "cantilever", f"{n} elements, dt 1e-3",
+                  lambda n=n: mujoco_rope.cantilever(n, 1e-3)))
+    for n in ca_el:
+        c.append(("pyelastica", "position-verlet", "cantilever", f"{n} elements",
+                  lambda n=n: elastica_rope.cantilever(n)))
+    for v in ca_ys:
+        c.append(("yarnsim", "mpm-explicit", "cantilever", f"{v} vertices, 64^2, dt 5e-5",
+                  lambda v=v: yarnsim_rope.cantilever(v)))
+    return c
+
+
+def interleave(cs, rounds):
+    """Runs every case `rounds` times, the tools taking turns within a
+    round (order rotated by round); returns {index: [results]}."""
+    tools = sorted({t for t, *_ in cs})
+    by_tool = {t: [i for i, x in enumerate(cs) if x[0] == t] for t in tools}
+    results = {i: [] for i in range(len(cs))}
+    for r in range(rounds):
+        order = tools[r % len(tools):] + tools[:r % len(tools)]
+        queues = {t: list(by_tool[t]) for t in order}
+        while any(queues.values()):
+            for t in order:
+                if queues[t]:
+                    i = queues[t].pop(0)
+                    res = cs[i][4]()
+                    results[i].append(res)
+                    print(f"  round {r + 1} {cs[i][0]:10s} {cs[i][2]:10s} {cs[i][3]:28s} "
+                          f"error {res['error']:+.4%} wall {res['wall_s']:.3f} s "
+                          f"for {res['sim_s']:.3f} s", flush=True)
+    return results
+
+
+def capstan(tool, slides, setting, integrator, rows):
+    """Bisection of the slip threshold between 0.7 and 1.4 mu* with
+    `slides(mu) -> (slid, wall, sim)`; one row."""
+    c = O.CAPSTAN
+    # the rope's centreline radius: MuJoCo's rope radius is 1 mm,
+    # PyElastica's 2 mm; yarnsim's yarn has no radius
+    r_eff = c["radius"] + {"mujoco": 1e-3, "pyelastica": 2e-3}.get(tool, 0.0)
+    mu_star = O.capstan_threshold(r_eff, c["l1"], c["l2"])
+    wall = sim = 0.0
+    ok = True
+
+    def run(mu):
+        nonlocal wall, sim
+        s, w, t = slides(mu)
+        wall += w
+        sim += t
+        return s
+
+    lo, hi = 0.7 * mu_star, 1.4 * mu_star
+    if not run(lo) or run(hi):
+        ok = False
+    else:
+        for _ in range(5):
+            mid = 0.5 * (lo + hi)
+            if run(mid):
+                lo = mid
+            else:
+                hi = mid
+    mu = 0.5 * (lo + hi)
+    err = (mu - mu_star) / mu_star
+    print(f"  capstan {tool:10s} {setting}: mu* {mu_star:.4f}, threshold in [{lo:.4f}, {hi:.4f}], "
+          f"error {err:+.2%} (bracket [{(lo - mu_star) / mu_star:+.1%}, "
+          f"{(hi - mu_star) / mu_star:+.1%}]), {wall:.2f} s wall for {sim:.2f} s", flush=True)
+    rows.append(dict(tool=tool, integrator=integrator, case="capstan", setting=setting,
+                     error=err if ok else float("nan"), wall_s_per_sim_s=wall / sim,
+                     wall_s=wall, sim_s=sim, rounds=1, ok=ok,
+                     note=f"mu* {mu_star:.4f}, bracket [{(lo - mu_star) / mu_star:+.1%}, "
+                          f"{(hi - mu_star) / mu_star:+.1%}]"))
+
+
+def bundle(rows, duration):
+    b = O.BUNDLE
+    for tool, integ, setting, fn in [
+        ("yarnsim", "mpm-explicit", "256^2, dt 4e-5 (yarn-reference)",
+         lambda: yarnsim_rope.bundle(duration)),
+        ("mujoco", "discrete", "CG, dt 1e-3, r 1.9 mm, planar (y armature 1e6)",
+         lambda: mujoco_rope.bundle(duration)),
+    ]:
+        res = fn()
+        m = bundle_metrics.describe(res["yarns"], b)
+        if "out_of_plane" in res:
+            m += f"; out-of-plane drift {res['out_of_plane']:.2e} m"
+        print(f"  bundle {tool:10s} {setting}: {res['wall_s']:.2f} s wall for "
+              f"{res['sim_s']:.3f} s; {m}", flush=True)
+        rows.append(dict(tool=tool, integrator=integ, case="bundle", setting=setting,
+                         error=float("nan"), wall_s_per_sim_s=res["wall_s"] / res["sim_s"],
+                         wall_s=res["wall_s"], sim_s=res["sim_s"], rounds=1, ok=res["ok"],
+                         note=m))
+    rows.append(dict(tool="pyelastica", integrator="position-verlet", case="bundle",
+                     setting="not run", error=float("nan"), wall_s_per_sim_s=float("nan"),
+                     wall_s=float("nan"), sim_s=float("nan"), rounds=0, ok=False,
+                     note="RodRodContact has no friction (normal spring-dashpot only); "
+                          "see README"))
+
+
+TITLE = "Rod peers against analytic oracles, one thread ({date})"
+
+
+def replot(path):
+    rows = []
+    with open(path) as f:
+        for r in csv.DictReader(f):
+            for k in ("error", "wall_s_per_sim_s"):
+                r[k] = float(r[k])
+            r["ok"] = r["ok"] == "True"
+            rows.append(r)
+    date = time.strftime("%Y-%m-%d", time.localtime(os.path.getmtime(path)))
+    plot.work_precision(rows, os.path.splitext(path)[0] + ".svg", title=TITLE.format(date=date))
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--quick", action="store_true")
+    ap.add_argument("--rounds", type=int, default=3)
+    ap.add_argument("--out", default=None)
+    ap.add_argument("--skip-bundle", action="store_true")
+    ap.add_argument("--bundle-duration", type=float, default=0.2)
+    ap.add_argument("--replot", metavar="CSV", help="only redraw the SVG next to CSV")
+    a = ap.parse_args()
+    if a.replot:
+        replot(a.replot)
+        return
+    out = a.out or (tempfile.gettempdir() if a.quick else os.path.join(ROOT, "docs",
+                                                                        "performance"))
+    stem = "peers_quick" if a.quick else "peers"
+    rounds = 1 if a.quick else a.rounds
+    if not os.path.exists(yarnsim_rope.BIN):
+        yarnsim_rope.build()
+    # warm-up: Numba compiles PyElastica's kernels on the first run (cached)
+    elastica_rope.chain(4, dt=1e-4, duration=0.01)
+    if not a.quick:
+        elastica_rope.capstan_slides(8, 0.3, load=1e-3, hold=1e-3)
+    t_start = time.time()
+    cs = cases(a.quick)
+    res = interleave(cs, rounds)
+    rows = []
+    for i, (tool, integ, case, setting, _) in enumerate(cs):
+        rs = res[i]
+        wall = statistics.median(r["wall_s"] for r in rs)
+        sim = rs[0]["sim_s"]
+        rows.append(dict(tool=tool, integrator=integ, case=case, setting=setting,
+                         error=rs[0]["error"], wall_s_per_sim_s=wall / sim, wall_s=wall,
+                         sim_s=sim, rounds=len(rs), ok=all(r["ok"] for r in rs), note=""))
+    if not a.quick:
+        capstan("yarnsim", lambda mu: yarnsim_rope.capstan_slides(
+            O.CAPSTAN["radius"], O.CAPSTAN["l1"], O.CAPSTAN["l2"], mu),
+            "184 vertices, 128^2, dt 1e-4", "mpm-explicit", rows)
+        capstan("pyelastica", lambda mu: elastica_rope.capstan_slides(70, mu),
+                "70 elements, dt 5e-5, c_v 50", "position-verlet", rows)
+        for n in (50, 100):
+            capstan("mujoco", lambda mu, n=n: mujoco_rope.capstan_slides(n, 1e-3, mu),
+                    f"{n} elements, dt 1e-3", "discrete", rows)
+        if not a.skip_bundle:
+            bundle(rows, a.bundle_duration)
+    # ratios against yarnsim's first setting of the same case (same run)
+    for r in rows:
+        ref = next((x for x in rows if x["tool"] == "yarnsim" and x["case"] == r["case"]), None)
+        r["wall_vs_yarnsim"] = (r["wall_s_per_sim_s"] / ref["wall_s_per_sim_s"]
+                                if ref and ref["wall_s_per_sim_s"] > 0 else float("nan"))
+    os.makedirs(out, exist_ok=True)
+    fields = ["tool", "integrator", "case", "setting", "error", "wall_s_per_sim_s",
+              "wall_vs_yarnsim", "wall_s", "sim_s", "rounds", "ok", "note"]
+    path = os.path.join(out, stem + ".csv")
+    with open(path, "w", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=fields)
+        w.writeheader()
+        for r in rows:
+            w.writerow({k: (f"{r[k]:.6g}" if isinstance(r[k], float) else r[k]) for k in fields})
+    svg = os.path.join(out, stem + ".svg")
+    plot.work_precision(rows, svg, title=TITLE.format(date=time.strftime("%Y-%m-%d")))
+    print(f"wrote {path} and {svg} ({time.time() - t_start:.1f} s)")
+
+
+if __name__ == "__main__":
+    main()
