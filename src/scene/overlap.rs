@@ -5,8 +5,14 @@
 //! both objects and the distances that triggered them.
 
 use super::error::{table_line, SceneError};
-use super::yarn::YarnScene;
 use crate::math::Vec2;
+
+/// A circular obstacle: centre in m, radius in m.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Circle {
+    pub center: [f64; 2],
+    pub radius: f64,
+}
 
 /// Distance from `c` to the segment `a`-`b`.
 fn segment_distance(c: Vec2, a: Vec2, b: Vec2) -> f64 {
@@ -25,19 +31,24 @@ fn segment_distance(c: Vec2, a: Vec2, b: Vec2) -> f64 {
 /// contact's resolution; a yarn laid on the surface, whose chords cut the
 /// circle by their sagitta, is fine). Yarns are numbered as in the
 /// simulation, the CSV and the recording: copies of a `[[yarns]]` entry one
-/// after another. `text` (the scene file) gives the obstacle's line.
+/// after another: `entries` holds each `[[yarns]]` entry's curves (`None`:
+/// an entry whose geometry is invalid, reported by the geometry checks),
+/// `obstacles` the obstacles as circles, `dx` the grid cell size. `text`
+/// (the scene file) gives the obstacle's line.
 pub fn check_yarns_clear_of_obstacles(
-    scene: &YarnScene,
+    dx: f64,
+    entries: &[Option<Vec<Vec<Vec2>>>],
+    obstacles: &[Circle],
     text: Option<&str>,
 ) -> Result<(), SceneError> {
-    let tolerance = 0.5 * scene.dx();
+    let tolerance = 0.5 * dx;
     let mut yarn = 0;
-    for (entry, spec) in scene.yarns.iter().enumerate() {
-        let Ok(curves) = spec.curves() else {
+    for (entry, curves) in entries.iter().enumerate() {
+        let Some(curves) = curves else {
             continue; // reported by the geometry checks
         };
         for (copy, curve) in curves.iter().enumerate() {
-            for (j, o) in scene.obstacles.iter().enumerate() {
+            for (j, o) in obstacles.iter().enumerate() {
                 let c = Vec2::from(o.center);
                 let d = match curve.len() {
                     0 => f64::INFINITY,
@@ -75,7 +86,12 @@ mod tests {
     use super::*;
     use crate::scene::massspring::overlap::check_particles_outside_spheres;
     use crate::scene::massspring::{SphereSpec, V3};
-    use crate::scene::{builtin_names, Scene};
+    use crate::scene::{builtin_names, Scene, YarnScene};
+
+    fn yarn_check(s: &YarnScene) -> Result<(), SceneError> {
+        let entries: Vec<_> = s.yarns.iter().map(|y| y.curves().ok()).collect();
+        check_yarns_clear_of_obstacles(s.dx(), &entries, &s.obstacle_circles(), None)
+    }
 
     #[test]
     fn builtin_scenes_start_apart() {
@@ -95,7 +111,7 @@ mod tests {
         let first = s.curves()[3][100];
         s.obstacles[1].center = [first.x + 0.01, first.y];
         s.obstacles[1].radius = 0.05;
-        let err = check_yarns_clear_of_obstacles(&s, None).unwrap_err();
+        let err = yarn_check(&s).unwrap_err();
         let text = err.to_string();
         assert!(text.contains("obstacles[1]"), "{text}");
         assert!(text.contains("overlaps yarn"), "{text}");
@@ -125,7 +141,7 @@ mod tests {
         s.yarns[0].length = None;
         s.yarns[0].points = Some(points);
         s.yarns[0].vertices = 21;
-        check_yarns_clear_of_obstacles(&s, None).unwrap();
+        yarn_check(&s).unwrap();
     }
 
     #[test]

@@ -445,6 +445,17 @@ impl YarnScene {
         toml::to_string_pretty(self).expect("a yarn scene always serializes")
     }
 
+    /// The obstacles as circles, for the overlap check.
+    pub fn obstacle_circles(&self) -> Vec<super::overlap::Circle> {
+        self.obstacles
+            .iter()
+            .map(|o| super::overlap::Circle {
+                center: o.center,
+                radius: o.radius,
+            })
+            .collect()
+    }
+
     /// Grid spacing `dx` in m.
     pub fn dx(&self) -> f64 {
         self.grid.size / self.grid.resolution as f64
@@ -513,7 +524,16 @@ impl YarnScene {
         }
         self.validate_pins(text)?;
         self.validate_time(text)?;
-        super::overlap::check_yarns_clear_of_obstacles(self, text)?;
+        super::overlap::check_yarns_clear_of_obstacles(
+            self.dx(),
+            &self
+                .yarns
+                .iter()
+                .map(|s| s.curves().ok())
+                .collect::<Vec<_>>(),
+            &self.obstacle_circles(),
+            text,
+        )?;
         Ok(())
     }
 
