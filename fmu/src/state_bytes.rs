@@ -15,7 +15,9 @@ pub const STATE_MAGICS: [&[u8; 8]; 2] = [YARN_STATE_MAGIC, MASS_SPRING_STATE_MAG
 /// Format version of the serialized FMU state.
 /// Version 2: the YarnBundle part holds the transfer scheme, the
 /// `transfer.flip_ratio` override, the pin inputs and the pin force sums.
-pub const STATE_VERSION: u32 = 2;
+/// Version 3: the YarnBundle part no longer repeats gravity and the
+/// attractor, which only the library's state bytes hold.
+pub const STATE_VERSION: u32 = 3;
 
 pub(crate) const STATE_HEADER: usize = 8 + 4 + 8 + 8;
 

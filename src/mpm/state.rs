@@ -23,14 +23,26 @@ const HEADER: usize = 8 + 4 + 8 * 5;
 /// Why a byte string is not a state of this simulation.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub enum StateError {
-    TooShort { len: usize, need: usize },
+    TooShort {
+        len: usize,
+        need: usize,
+    },
     BadMagic,
     BadVersion(u32),
     OtherScene,
-    CountMismatch { vertices: u64, quads: u64 },
-    LengthMismatch { declared: u64, actual: u64 },
+    CountMismatch {
+        vertices: u64,
+        quads: u64,
+    },
+    LengthMismatch {
+        declared: u64,
+        actual: u64,
+    },
     Checksum,
     NonFinite,
+    /// A stored input (gravity, attractor) outside the limits the
+    /// simulation accepts from its setters.
+    BadInput(String),
 }
 
 impl std::fmt::Display for StateError {
@@ -55,6 +67,7 @@ impl std::fmt::Display for StateError {
                 write!(f, "state checksum does not match: the bytes are corrupt")
             }
             StateError::NonFinite => write!(f, "state contains non-finite numbers"),
+            StateError::BadInput(m) => write!(f, "state holds a refused input: {m}"),
         }
     }
 }
@@ -429,16 +442,21 @@ impl YarnSim {
         if !finite || dt <= 0.0 {
             return Err(StateError::NonFinite);
         }
+        let attractor = Attractor {
+            position: apos,
+            strength: astr,
+            active: aact,
+        };
+        // The inputs' limits are the setters' (one check for each input).
+        YarnSim::check_gravity(gravity)
+            .and_then(|_| attractor.check())
+            .map_err(|e| StateError::BadInput(e.to_string()))?;
         // quad.4 (F) is determined by d; it is stored for readers of the format
         Ok(DynamicState {
             time,
             steps,
             gravity,
-            attractor: Attractor {
-                position: apos,
-                strength: astr,
-                active: aact,
-            },
+            attractor,
             dt,
             targets,
             vert_x: vert.0,
@@ -449,5 +467,44 @@ impl YarnSim {
             quad_c: quad.2,
             quad_d: quad.3,
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::{builtin, Scene};
+
+    fn small_sim() -> YarnSim {
+        let Some(Scene::Yarn(scene)) = builtin("yarn-drape") else {
+            unreachable!()
+        };
+        YarnSim::new(&scene).unwrap()
+    }
+
+    /// A stored gravity or attractor beyond the setters' limits is refused
+    /// on decoding, by the same checks as the setters (finite, 1e6).
+    #[test]
+    fn stored_inputs_beyond_the_setters_limits_are_refused() {
+        let sim = small_sim();
+        let good = sim.dynamic_state();
+        assert!(sim.decode_state(&sim.encode_state(&good).unwrap()).is_ok());
+        let mut far = good.clone();
+        far.attractor.position.x = 2e6;
+        let mut strong = good.clone();
+        strong.attractor.strength = -1.0;
+        let mut heavy = good.clone();
+        heavy.gravity.y = -2e6;
+        for (what, s) in [
+            ("attractor", far),
+            ("attractor", strong),
+            ("gravity", heavy),
+        ] {
+            let bytes = sim.encode_state(&s).unwrap();
+            match sim.decode_state(&bytes) {
+                Err(StateError::BadInput(m)) => assert!(m.contains(what), "{m}"),
+                other => panic!("{what}: {other:?}"),
+            }
+        }
     }
 }

@@ -1,8 +1,10 @@
-//! The YarnBundle's inputs: attractor, gravity and the driven pins, with
-//! the library's limits checked before they reach the simulation.
+//! The YarnBundle's driven-pin inputs, held until a communication step
+//! begins (they become the pins' targets then). The attractor and gravity
+//! inputs are not held here: the simulation holds them, sets them at once
+//! through its checked setters, and saves them in its state.
 
 use yarnsim::math::Vec2;
-use yarnsim::mpm::{Attractor, YarnSim};
+use yarnsim::mpm::YarnSim;
 use yarnsim::scene::YarnScene;
 
 use super::variables::fmu_pins;
@@ -19,13 +21,9 @@ pub struct PinInput {
     pub velocity: [f64; 2],
 }
 
-/// Values of the inputs.
+/// Values of the driven-pin inputs.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Inputs {
-    pub attractor: [f64; 2],
-    pub strength: f64,
-    pub active: bool,
-    pub gravity: [f64; 2],
     /// The driven pins, in `[[pins]]` order.
     pub pins: Vec<PinInput>,
 }
@@ -33,10 +31,6 @@ pub struct Inputs {
 impl Inputs {
     pub(super) fn from_scene(s: &YarnScene) -> Self {
         Inputs {
-            attractor: s.attractor.position,
-            strength: s.attractor.strength,
-            active: s.attractor.active,
-            gravity: s.gravity,
             pins: fmu_pins(s)
                 .iter()
                 .enumerate()
@@ -65,44 +59,11 @@ impl Inputs {
         Ok(())
     }
 
-    /// The attractor inputs as the library's [`Attractor`].
-    pub(super) fn attractor(&self) -> Attractor {
-        Attractor {
-            position: Vec2::from(self.attractor),
-            strength: self.strength,
-            active: self.active,
-        }
-    }
-
-    /// Hands the inputs to `sim`, which checks them as [`Self::check`] does.
-    pub(super) fn apply(&self, sim: &mut YarnSim) -> ModelResult {
-        sim.set_gravity(Vec2::from(self.gravity))
-            .and_then(|_| sim.set_attractor(self.attractor()))
-            .or_else(|e| refuse(e.to_string()))
-    }
-
-    /// The library's input limits, without a simulation at hand.
+    /// The pin inputs' limits: the library's ([`YarnSim::check_pin_target`]).
     pub(super) fn check(&self) -> ModelResult {
-        let g = Vec2::from(self.gravity);
-        if g.norm() > 1e6 {
-            return refuse(format!(
-                "gravity ({}, {}) is absurd (|g| above 1e6 m/s2)",
-                g.x, g.y
-            ));
-        }
-        // The attractor's limits are the library's, checked in one place.
-        self.attractor()
-            .check()
-            .or_else(|e| refuse(e.to_string()))?;
         for p in &self.pins {
-            let x = Vec2::from(p.position);
-            let v = Vec2::from(p.velocity);
-            if x.norm() > 1e6 || v.norm() > 1e6 {
-                return refuse(format!(
-                    "pin[{}] position ({}, {}) m or velocity ({}, {}) m/s is absurd (beyond 1e6)",
-                    p.pin, x.x, x.y, v.x, v.y
-                ));
-            }
+            YarnSim::check_pin_target(p.pin, Vec2::from(p.position), Vec2::from(p.velocity))
+                .or_else(|e| refuse(e.to_string()))?;
         }
         Ok(())
     }

@@ -285,20 +285,14 @@ impl YarnModel {
         Ok(())
     }
 
-    /// A saved state's part of a serialized FMU state: the inputs, the
+    /// A saved state's part of a serialized FMU state: the pin inputs, the
     /// parameters, the scene text and the library's own state bytes (which
     /// carry their own header and checksum; encoded by this model's
     /// simulation when it runs the state's scene, else by one built for
     /// it).
     pub fn write(&self, s: &YarnState, w: &mut Writer) -> Result<(), String> {
-        let i = &s.inputs;
-        w.f64(i.attractor[0]);
-        w.f64(i.attractor[1]);
-        w.f64(i.strength);
-        w.u8(i.active as u8);
-        w.f64(i.gravity[0]);
-        w.f64(i.gravity[1]);
-        for p in &i.pins {
+        // Gravity and the attractor are in the library's state bytes.
+        for p in &s.inputs.pins {
             w.f64(p.position[0]);
             w.f64(p.position[1]);
             w.f64(p.velocity[0]);
@@ -339,10 +333,6 @@ impl YarnModel {
     /// stored scene with the stored parameters, else by one built for them.
     pub fn read(r: &mut Reader, current: &YarnModel, yarns: usize) -> Result<YarnState, String> {
         let mut inputs = Inputs {
-            attractor: [r.f64()?, r.f64()?],
-            strength: r.f64()?,
-            active: r.bool()?,
-            gravity: [r.f64()?, r.f64()?],
             pins: current.inputs.pins.clone(),
         };
         // The pins are the bundled scene's (the `scene` parameter keeps them).
@@ -440,7 +430,10 @@ impl FmuModel for YarnModel {
                 sim.num_yarns()
             ));
         }
-        self.inputs.apply(&mut sim)?;
+        // The inputs the simulation holds carry over to the new one.
+        sim.set_gravity(self.sim.gravity())
+            .and_then(|_| sim.set_attractor(self.sim.attractor()))
+            .or_else(|e| refuse(e.to_string()))?;
         self.sim = sim;
         self.diag = None;
         self.forces = PinForces::new(self.base.pins.len());
@@ -501,11 +494,11 @@ impl FmuModel for YarnModel {
     /// The value of the Real variable `vr`, `None` if there is none.
     fn get_real(&mut self, vr: u32) -> Option<f64> {
         Some(match vr {
-            VR_ATTRACTOR_X => self.inputs.attractor[0],
-            VR_ATTRACTOR_Y => self.inputs.attractor[1],
-            VR_ATTRACTOR_STRENGTH => self.inputs.strength,
-            VR_GRAVITY_X => self.inputs.gravity[0],
-            VR_GRAVITY_Y => self.inputs.gravity[1],
+            VR_ATTRACTOR_X => self.sim.attractor().position.x,
+            VR_ATTRACTOR_Y => self.sim.attractor().position.y,
+            VR_ATTRACTOR_STRENGTH => self.sim.attractor().strength,
+            VR_GRAVITY_X => self.sim.gravity().x,
+            VR_GRAVITY_Y => self.sim.gravity().y,
             _ if real_param(vr).is_some() => {
                 let (i, field) = real_param(vr).unwrap();
                 self.config.reals[i].unwrap_or_else(|| (field.get)(&self.base))
@@ -535,7 +528,7 @@ impl FmuModel for YarnModel {
     }
     fn get_boolean(&self, vr: u32) -> Option<bool> {
         match vr {
-            VR_ATTRACTOR_ACTIVE => Some(self.inputs.active),
+            VR_ATTRACTOR_ACTIVE => Some(self.sim.attractor().active),
             VR_PLASTICITY => Some(
                 self.config
                     .plasticity
@@ -557,6 +550,8 @@ impl FmuModel for YarnModel {
     /// simulation must be rebuilt). A rejected call changes nothing.
     fn set_real(&mut self, vrs: &[u32], vals: &[f64], param_ok: ParamCheck) -> ModelResult<bool> {
         let mut inputs = self.inputs.clone();
+        let mut attractor = self.sim.attractor();
+        let mut gravity = self.sim.gravity();
         let mut reals = self.config.reals;
         for (&vr, &v) in vrs.iter().zip(vals) {
             match vr {
@@ -574,11 +569,11 @@ impl FmuModel for YarnModel {
                         _ => p.velocity[1] = v,
                     }
                 }
-                VR_ATTRACTOR_X => inputs.attractor[0] = v,
-                VR_ATTRACTOR_Y => inputs.attractor[1] = v,
-                VR_ATTRACTOR_STRENGTH => inputs.strength = v,
-                VR_GRAVITY_X => inputs.gravity[0] = v,
-                VR_GRAVITY_Y => inputs.gravity[1] = v,
+                VR_ATTRACTOR_X => attractor.position.x = v,
+                VR_ATTRACTOR_Y => attractor.position.y = v,
+                VR_ATTRACTOR_STRENGTH => attractor.strength = v,
+                VR_GRAVITY_X => gravity.x = v,
+                VR_GRAVITY_Y => gravity.y = v,
                 _ if real_param(vr).is_some() => {
                     param_ok(vr)?;
                     let (i, field) = real_param(vr).unwrap();
@@ -599,11 +594,17 @@ impl FmuModel for YarnModel {
                 }
             }
         }
+        // Every value is checked (by the library's limits) before any is
+        // set, so a rejected call changes nothing.
+        YarnSim::check_gravity(gravity)
+            .and_then(|_| attractor.check())
+            .or_else(|e| refuse(e.to_string()))?;
         inputs.check()?;
-        if inputs != self.inputs {
-            inputs.apply(&mut self.sim)?;
-            self.inputs = inputs;
-        }
+        self.sim
+            .set_gravity(gravity)
+            .and_then(|_| self.sim.set_attractor(attractor))
+            .or_else(|e| refuse(e.to_string()))?;
+        self.inputs = inputs;
         let changed = reals != self.config.reals;
         self.config.reals = reals;
         Ok(changed)
@@ -615,11 +616,11 @@ impl FmuModel for YarnModel {
         vals: &[bool],
         param_ok: ParamCheck,
     ) -> ModelResult<bool> {
-        let mut active = self.inputs.active;
+        let mut attractor = self.sim.attractor();
         let mut plasticity = self.config.plasticity;
         for (&vr, &v) in vrs.iter().zip(vals) {
             match vr {
-                VR_ATTRACTOR_ACTIVE => active = v,
+                VR_ATTRACTOR_ACTIVE => attractor.active = v,
                 VR_PLASTICITY => {
                     param_ok(vr)?;
                     plasticity = Some(v);
@@ -631,10 +632,9 @@ impl FmuModel for YarnModel {
                 }
             }
         }
-        if active != self.inputs.active {
-            self.inputs.active = active;
-            self.inputs.apply(&mut self.sim)?;
-        }
+        self.sim
+            .set_attractor(attractor)
+            .or_else(|e| refuse(e.to_string()))?;
         let changed = plasticity != self.config.plasticity;
         self.config.plasticity = plasticity;
         Ok(changed)

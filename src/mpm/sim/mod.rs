@@ -265,13 +265,10 @@ impl YarnSim {
                 p.motion
             )));
         }
-        let finite = [position.x, position.y, velocity.x, velocity.y, since]
-            .iter()
-            .all(|v| v.is_finite());
-        if !finite || position.norm() > 1e6 || velocity.norm() > 1e6 {
+        Self::check_pin_target(pin, position, velocity)?;
+        if !since.is_finite() {
             return Err(SimError::BadInput(format!(
-                "pin {pin} target position ({}, {}) m and velocity ({}, {}) m/s must be finite, within 1e6 m and 1e6 m/s",
-                position.x, position.y, velocity.x, velocity.y
+                "pin {pin} target time {since} must be finite"
             )));
         }
         p.motion = super::PinMotion::Input {
@@ -286,6 +283,22 @@ impl YarnSim {
         Ok(())
     }
 
+    /// A driven pin's target limits, the one check every caller (the
+    /// setter, the FMU's pin inputs) applies: finite, `|position| <= 1e6` m,
+    /// `|velocity| <= 1e6` m/s.
+    pub fn check_pin_target(pin: usize, position: Vec2, velocity: Vec2) -> Result<(), SimError> {
+        let finite = [position.x, position.y, velocity.x, velocity.y]
+            .iter()
+            .all(|v| v.is_finite());
+        if !finite || position.norm() > 1e6 || velocity.norm() > 1e6 {
+            return Err(SimError::BadInput(format!(
+                "pin {pin} target position ({}, {}) m or velocity ({}, {}) m/s is absurd: both must be finite, within 1e6 m and 1e6 m/s",
+                position.x, position.y, velocity.x, velocity.y
+            )));
+        }
+        Ok(())
+    }
+
     /// Sets an input pin's motion as stored in a state (no checks, no
     /// change of the particles).
     pub(crate) fn restore_pin_target(&mut self, pin: usize, motion: super::PinMotion) {
@@ -294,13 +307,21 @@ impl YarnSim {
 
     /// Sets gravity; rejects non-finite or absurd values (|g| > 1e6 m/s^2).
     pub fn set_gravity(&mut self, g: Vec2) -> Result<(), SimError> {
+        Self::check_gravity(g)?;
+        self.gravity = g;
+        Ok(())
+    }
+
+    /// The gravity input's limits, the one check every caller (the
+    /// simulation's setter, the FMU, a restored state) applies: finite and
+    /// `|g| <= 1e6` m/s^2.
+    pub fn check_gravity(g: Vec2) -> Result<(), SimError> {
         if !(g.x.is_finite() && g.y.is_finite()) || g.norm() > 1e6 {
             return Err(SimError::BadInput(format!(
                 "gravity ({}, {}) must be finite and at most 1e6 m/s^2",
                 g.x, g.y
             )));
         }
-        self.gravity = g;
         Ok(())
     }
 
