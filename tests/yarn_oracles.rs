@@ -638,16 +638,7 @@ fn momenta_are_kept_under_flip() {
         yarnsim::mpm::transfer::Transfer::Flip { ratio: 1.0 }
     );
     let d0 = sim.diagnostics();
-    let scale: f64 = {
-        let p = sim.particles();
-        p.vert
-            .v
-            .iter()
-            .zip(&p.vert.m)
-            .chain(p.quad.v.iter().zip(&p.quad.m))
-            .map(|(v, m)| m * v.norm())
-            .sum()
-    };
+    let scale = common::momentum_scale(&sim);
     let t = 0.5;
     sim.advance(t).unwrap();
     let d1 = sim.diagnostics();
@@ -734,43 +725,24 @@ fn flip_converges_at_first_order_in_dt_and_apic_does_not() {
 #[test]
 #[cfg_attr(debug_assertions, ignore = "release-mode test (cargo test --release)")]
 fn line_and_circle_pins_hold_their_path_bitwise_every_substep() {
-    let s = scene(
-        r#"
-[grid]
-resolution = 64
-[time]
-dt = 1e-4
-[material]
-k = 1000.0
-gamma = 500.0
-youngs_modulus = 1000.0
-friction = 0.05
-bending = 1e-4
-[walls]
-mode = "none"
-[[yarns]]
-start = [0.2, 0.7]
-end = [0.6, 0.7]
-vertices = 60
-[[yarns]]
-start = [0.3, 0.4]
-end = [0.7, 0.4]
-vertices = 60
-[[pins]]
-yarn = 0
-end = "start"
-count = 2
-motion = "line"
-velocity = [0.2, -0.1]
-[[pins]]
-yarn = 1
-vertex = 28
-count = 3
-motion = "circle"
-center = [0.5, 0.45]
-angular_velocity = 3.0
-"#,
-    );
+    use yarnsim::scene::{PinMotionKind, YarnEnd};
+    let s = common::SceneBuilder::bare()
+        .gravity([0.0, -9.8])
+        .material(|m| m.plasticity = true)
+        .yarn(common::straight([0.2, 0.7], [0.6, 0.7], 60))
+        .yarn(common::straight([0.3, 0.4], [0.7, 0.4], 60))
+        .pin(yarnsim::scene::PinSpec {
+            motion: PinMotionKind::Line,
+            velocity: Some([0.2, -0.1]),
+            ..common::pin_end(0, YarnEnd::Start, 2)
+        })
+        .pin(yarnsim::scene::PinSpec {
+            motion: PinMotionKind::Circle,
+            center: Some([0.5, 0.45]),
+            angular_velocity: Some(3.0),
+            ..common::pin_vertex(1, 28, 3)
+        })
+        .build();
     let mut sim = YarnSim::new(&s).unwrap();
     let mut worst: f64 = 0.0;
     for _ in 0..3000 {
