@@ -7,7 +7,7 @@
 //! * [`scene`]: scene descriptions and their TOML files (the bottom layer:
 //!   the models import it).
 //! * [`mpm`]: the yarn-bundle MPM solver.
-//! * [`massspring`]: mass-spring wires and cloth (seeds 002, 004, 001).
+//! * [`massspring`]: mass-spring wires and cloth (course lecture notes; Baraff and Witkin 1998; Wang 2015, Müller et al. 2007).
 //! * [`pool`]: running a call's parallel passes on a rayon worker.
 //! * `testing` (cargo feature `testing`): scenes and oracles for tests and
 //!   evidence studies.

@@ -1,4 +1,4 @@
-//! Adversarial cases (issue 6): every case must end with a finite,
+//! Adversarial cases: every case must end with a finite,
 //! physically bounded state, or with a clear error naming the step where the
 //! state went bad. A non-finite state is never reported as success.
 
@@ -311,7 +311,7 @@ fn attractor_inside_an_obstacle_cannot_pull_yarn_into_it() {
         .is_err());
 }
 
-/// The seed-001 cloth stretched 10x away from its pinned edge and released
+/// The built-in cloth stretched 10x away from its pinned edge and released
 /// for 30 frames (1 s).
 fn cloth_stretched_ten_times_and_released(integ: Integrator) {
     {

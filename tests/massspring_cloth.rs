@@ -1,4 +1,4 @@
-//! Seed 001's cloth: sphere collision, strain limiting, pinned corners,
+//! The cloth (Wang 2015; Müller et al. 2007; Provot 1995): sphere collision, strain limiting, pinned corners,
 //! free fall against each scheme's own analytic trajectory.
 
 use yarnsim::massspring::{
@@ -79,7 +79,7 @@ fn strain_after_limiting_is_within_the_configured_limit() {
     // above can fail.
     let (none, _) = run(StrainSolver::GaussSeidel, 0);
     assert!(none > 2.0 * limit, "{none}");
-    // Seed 001's Jacobi averaging approaches the limit as passes are added.
+    // The Unity cloth scripts' Jacobi averaging approaches the limit as passes are added.
     let j: Vec<f64> = [10, 100, 20_000]
         .iter()
         .map(|&p| run(StrainSolver::Jacobi, p).0)
@@ -87,7 +87,7 @@ fn strain_after_limiting_is_within_the_configured_limit() {
     assert!(j[0] > j[1] && j[1] > j[2] && j[0] > limit, "{j:?}");
     assert!(j[2] <= limit + 1e-9, "{j:?}");
 
-    // The same pass after an implicit step (seed 001's optimisation form).
+    // The same pass after an implicit step (Wang 2015's optimisation form).
     let o = IntegratorOptions {
         strain_limit: Some(0.02),
         strain_iterations: 3000,

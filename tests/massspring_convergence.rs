@@ -5,7 +5,7 @@
 
 use yarnsim::massspring::{scenes, Integrator, IntegratorOptions, MassSpringScene, Simulation, V3};
 
-/// Seed 004's three particles with damped springs (so the damping force
+/// Baraff and Witkin 1998's three particles with damped springs (so the damping force
 /// and its Jacobian take part), in free flight under gravity.
 fn damped_three_particle() -> MassSpringScene {
     let mut l = scenes::three_particle();

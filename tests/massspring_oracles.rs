@@ -6,7 +6,7 @@ use yarnsim::massspring::{scenes, Integrator, IntegratorOptions, MassSpringScene
 
 const G: f64 = 9.81;
 
-/// Seed 002's wire with the top particle pinned instead of driven.
+/// The course lecture notes' wire with the top particle pinned instead of driven.
 fn hanging_wire() -> MassSpringScene {
     let mut l = scenes::wire();
     l.driven.clear();

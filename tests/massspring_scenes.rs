@@ -292,7 +292,7 @@ fn runs_are_bitwise_deterministic() {
 #[cfg_attr(debug_assertions, ignore)]
 fn full_default_runs_gain_no_energy() {
     // Regressions: the linearised trapezoidal rule at the cloth's h = 1/30 s
-    // blew up after about 35 frames, and Chebyshev with seed 001's rho on
+    // blew up after about 35 frames, and Chebyshev with Wang 2015's rho on
     // the three particles gained energy every step.
     for name in ["three-particle", "cloth"] {
         let layout = scenes::by_name(name).unwrap();

@@ -1,5 +1,5 @@
 //! Linear and iterative solvers of the mass-spring integrators: IC(0)-PCG on
-//! the wire, seed 004's 3-particle system against a dense direct solve,
+//! the wire, Baraff and Witkin 1998's 3-particle system against a dense direct solve,
 //! Chebyshev against plain Jacobi.
 
 use nalgebra::{DMatrix, DVector, Matrix3};
@@ -44,20 +44,20 @@ fn ic0_pcg_on_the_driven_wire_converges_in_one_iteration() {
     }
 }
 
-/// Seed 004's block `K^s_ij = E/l^2 ((l-L)/l dx^T dx I + (1 - (l-L)/l) dx dx^T)`.
-fn seed_block(e: f64, rest: f64, dx: V3) -> Matrix3<f64> {
+/// Baraff and Witkin 1998's block `K^s_ij = E/l^2 ((l-L)/l dx^T dx I + (1 - (l-L)/l) dx dx^T)`.
+fn baraff_witkin_block(e: f64, rest: f64, dx: V3) -> Matrix3<f64> {
     let l = dx.norm();
     let r = (l - rest) / l;
     (Matrix3::identity() * (r * dx.dot(&dx)) + dx * dx.transpose() * (1.0 - r)) * (e / (l * l))
 }
 
 #[test]
-fn three_particle_backward_euler_matches_seed_004_and_a_direct_solve() {
+fn three_particle_backward_euler_matches_baraff_witkin_and_a_direct_solve() {
     let layout = scenes::three_particle();
     let sys = layout.build().unwrap();
     let st = State::initial(&sys);
     let h = 0.1;
-    // Seed 004, written out: f, K (force Jacobian), A = M - h^2 K, b = M v + h f.
+    // Baraff and Witkin 1998, written out: f, K (force Jacobian), A = M - h^2 K, b = M v + h f.
     let x = &st.x;
     let v = &st.v;
     let g = sys.gravity;
@@ -69,8 +69,8 @@ fn three_particle_backward_euler_matches_seed_004_and_a_direct_solve() {
     let f01 = dx01 * (e * (dx01.norm() - l01) / dx01.norm());
     let f12 = dx12 * (e * (dx12.norm() - l12) / dx12.norm());
     let f = [g * m[0] + f01, g * m[1] - f01 + f12, g * m[2] - f12];
-    let k01 = seed_block(e, l01, dx01);
-    let k12 = seed_block(e, l12, dx12);
+    let k01 = baraff_witkin_block(e, l01, dx01);
+    let k12 = baraff_witkin_block(e, l12, dx12);
     let mut kk = DMatrix::<f64>::zeros(9, 9);
     let mut put = |i: usize, j: usize, b: Matrix3<f64>| {
         for r in 0..3 {
@@ -137,7 +137,7 @@ fn three_particle_backward_euler_matches_seed_004_and_a_direct_solve() {
 
 #[test]
 fn chebyshev_reduces_the_residual_faster_than_plain_jacobi() {
-    // A deformed cloth state: a few frames of the seed 001 model.
+    // A deformed cloth state: a few frames of the cloth model.
     let mut sim = Simulation::new(
         &scenes::cloth(),
         Integrator::ChebyshevJacobi,

@@ -1,4 +1,4 @@
-//! Physical oracles of the MPM yarn model (issue 12, item 5), release-only:
+//! Physical oracles of the MPM yarn model, release-only:
 //! the heavy-rope capstan threshold, the Euler-Bernoulli cantilever, the
 //! hanging chain's first pendulum mode, conservation (free fall, linear and
 //! angular momentum), self-convergence in dt, and pins. Every assertion

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
-# yarnsim bench against the seed's Taichi implementation, alternating
-# (tools/taichi_bench.py; see "Against the Taichi seed" in the README).
-# Usage: tools/taichi_bench.sh SEED_FILE [--yarnsim BIN] [--threads 1,2] [--rounds 3] ...
+# yarnsim bench against the reference Taichi implementation of Jiang et al. 2017, alternating
+# (tools/taichi_bench.py; see "Against the reference Taichi implementation"
+# in docs/performance.md).
+# Usage: tools/taichi_bench.sh REFERENCE_FILE [--yarnsim BIN] [--threads 1,2] [--rounds 3] ...
 # Installs Taichi 1.7.4 into tools/.venv-taichi on first use. Does not build
 # yarnsim: it uses target/release/yarnsim unless --yarnsim is given.
 set -euo pipefail

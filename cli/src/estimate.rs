@@ -20,7 +20,7 @@ pub const YARN_RECORDING_MEMORY_PER_VERTEX: f64 = 240.0;
 /// Bytes of a recording per yarn vertex and frame (a vertex and a quadrature
 /// particle: positions, colours, velocities, stretch and yield values, the
 /// line-strip point), after Rerun's compression: 15 measured on a bundle in
-/// free fall, 29 on the 1e7-vertex scene of issue 14.
+/// free fall, 29 on a scene of 1e7 vertices.
 pub const YARN_RECORDING_BYTES_PER_VERTEX: f64 = 25.0;
 /// Bytes of memory per mass-spring particle with its springs (state, solver
 /// vectors, sparse matrix; backward Euler): 2230 measured (500x500 cloth).

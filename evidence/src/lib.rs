@@ -1,6 +1,6 @@
 //! # yarnsim-evidence
 //!
-//! Evidence of speed and accuracy of the `yarnsim` library (issue 6):
+//! Evidence of speed and accuracy of the `yarnsim` library:
 //! work-precision diagrams, stability stress maps and the "skip what a scene
 //! doesn't need" benchmark. A crate of its own so that `yarnsim` holds physics
 //! only; the CLI (`yarnsim bench precision`, `yarnsim stress`,

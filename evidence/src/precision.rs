@@ -282,12 +282,12 @@ fn yarn_scene(
     })
 }
 
-/// The wire of seed 002 as a system.
+/// The course lecture notes' wire as a system.
 pub fn wire_system() -> System {
     scenes::wire().build().expect("built-in wire builds")
 }
 
-/// The cloth of seed 001 without its sphere (see the module documentation).
+/// The cloth (Wang 2015; Provot 1995) without its sphere (see the module documentation).
 pub fn cloth_system() -> System {
     let mut l = scenes::cloth();
     l.spheres.clear();
@@ -573,7 +573,7 @@ mod tests {
     }
 
     /// The study's observed orders on the wire: trapezoidal 2, the Euler
-    /// schemes 1 (the oracles of issue 5, measured through this module).
+    /// schemes 1 (the convergence oracles, measured through this module).
     #[test]
     #[cfg_attr(debug_assertions, ignore = "runs the wire ladder; release only")]
     fn wire_orders_match_the_schemes() {

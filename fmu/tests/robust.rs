@@ -1,4 +1,4 @@
-//! Bounded work and resources (issue 13): the substep budget of one
+//! Bounded work and resources: the substep budget of one
 //! `fmi2DoStep`, the stability warning at initialization, the instance's own
 //! thread pool, and the limits on the `scene` parameter.
 

@@ -1,4 +1,4 @@
-//! The scene-independent driver (seed 002's `SIMULATION_DRIVER`): frame loop,
+//! The scene-independent driver (the course notes' `SIMULATION_DRIVER`): frame loop,
 //! step-size choice and the per-step sequence shared by all integrators:
 //!
 //! 1. velocity damping of the free particles, `v *= d^(h / frame_time)`;

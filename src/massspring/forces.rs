@@ -2,11 +2,11 @@
 //! 3x3 Hessian blocks the implicit integrators assemble.
 //!
 //! Conventions: for a spring between `a` and `b` with `d = (x_b - x_a) / l`,
-//! the elastic force on `a` is `k (l - l0) d` (seed 002: `E (l/l0 - 1)` with
-//! `k = E / l0`; seed 004: `E (l - L)/l dx`), the damping force on `a` is
+//! the elastic force on `a` is `k (l - l0) d` (course notes: `E (l/l0 - 1)` with
+//! `k = E / l0`; Baraff-Witkin: `E (l - L)/l dx`), the damping force on `a` is
 //! `b d d^T (v_b - v_a)`, and `b` gets the opposite of both.
 //! The energy Hessian block is
-//! `H = k [d d^T + max(0, 1 - l0/l) (I - d d^T)]`: seed 004's `K^s` with the
+//! `H = k [d d^T + max(0, 1 - l0/l) (I - d d^T)]`: Baraff and Witkin 1998's `K^s` with the
 //! transverse term clamped at 0 under compression so that `H` stays positive
 //! semi-definite; the force Jacobian is `df_a/dx_a = -H`, `df_a/dx_b = +H`.
 
@@ -70,7 +70,7 @@ pub fn total_forces(sys: &System, x: &[V3], v: &[V3], f: &mut [V3]) {
 }
 
 /// Energy Hessian block `k [d d^T + max(0, 1 - l0/l)(I - d d^T)]` (positive
-/// semi-definite). `clamp = false` gives seed 004's unclamped `K^s`.
+/// semi-definite). `clamp = false` gives Baraff-Witkin's unclamped `K^s`.
 pub fn hessian_block(x: &[V3], s: &Spring, clamp: bool) -> Matrix3<f64> {
     match direction(x, s) {
         Some((d, l)) => {

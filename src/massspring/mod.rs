@@ -1,4 +1,4 @@
-//! Mass-spring wires and cloth (seeds 002, 004 and 001). The scene
+//! Mass-spring wires and cloth (course lecture notes; Baraff and Witkin 1998; Wang 2015, Müller et al. 2007). The scene
 //! ([`MassSpringScene`], its expansion [`System`] and the built-in
 //! [`scenes`]) lives in [`crate::scene::massspring`]; this module holds the
 //! scene-independent forces, solvers and integrators ("driver").

@@ -1,4 +1,4 @@
-//! The Material Point Method solver for 2D yarn bundles (seed 000, after
+//! The Material Point Method solver for 2D yarn bundles (after
 //! Jiang, Gast, Teran 2017), one file per stage of a substep:
 //!
 //! * [`constitutive`]: the anisotropic energy, its stress and the return mapping.

@@ -1,7 +1,7 @@
 //! How particles take their velocity and affine matrix back from the grid
 //! (the particle side of grid-to-particle).
 //!
-//! * [`Transfer::Apic`] (Jiang et al. 2015, the seed's choice): `v` and `C`
+//! * [`Transfer::Apic`] (Jiang et al. 2015, the reference Taichi implementation's choice): `v` and `C`
 //!   are replaced by the grid's interpolation. Whatever part of a particle's
 //!   velocity the grid cannot hold (the non-affine part) is dropped at every
 //!   transfer, so the dissipation grows with the number of substeps and a

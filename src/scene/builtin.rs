@@ -13,7 +13,7 @@ pub fn builtin_names() -> Vec<(&'static str, &'static str)> {
     vec![
         (
             "yarn-reference",
-            "seed 000 reference: 12 yarns x 200 vertices fall onto three circles (256^2 grid, dt 4e-5)",
+            "Jiang et al. 2017 reference: 12 yarns x 200 vertices fall onto three circles (256^2 grid, dt 4e-5)",
         ),
         (
             "yarn-vertical",
@@ -66,13 +66,14 @@ fn reference_obstacles() -> Vec<Obstacle> {
         .collect()
 }
 
-/// Seed 000's reference scene: 12 horizontal yarns of 200 vertices (4788
+/// The reference scene (the reference Taichi implementation of Jiang et al. 2017's yarn bundle): 12 horizontal yarns of 200 vertices (4788
 /// particles), 256^2 grid, dt 4e-5, three circles of radius 0.08.
 pub fn yarn_reference() -> YarnScene {
     YarnScene {
         kind: "yarn".into(),
         name: "yarn-reference".into(),
-        description: "seed 000 reference: 12 yarns x 200 vertices fall onto three circles".into(),
+        description: "Jiang et al. 2017 reference: 12 yarns x 200 vertices fall onto three circles"
+            .into(),
         grid: GridSpec {
             resolution: 256,
             size: 1.0,

@@ -1,4 +1,4 @@
-//! The limit: a roofline of the yarn substep on this machine (issue 16).
+//! The limit: a roofline of the yarn substep on this machine.
 //!
 //! * Peaks, measured with simple kernels on one core: `f64` multiply-adds
 //!   over 12 independent vector registers (intrinsics: SSE2 multiply and

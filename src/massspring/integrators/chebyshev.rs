@@ -1,4 +1,4 @@
-//! Seed 001's implicit model: backward Euler written as the minimisation
+//! The implicit cloth model: backward Euler written as the minimisation
 //! `x' = argmin 1/(2h^2) |x - y|_M^2 + E(x) + 1/(2h) |x - x_n|_B^2`,
 //! `y = x_n + h v_n`, solved by Jacobi iterations
 //! `x <- x - D^{-1} g(x)` with Chebyshev acceleration (Wang 2015):
@@ -8,8 +8,8 @@
 //! `g = M (x - y)/h^2 - m g_grav - f_elastic(x) + B (x - x_n)/h` (the last
 //! term is the Rayleigh form of the spring damping, directions frozen at
 //! `x_n`). The Jacobi diagonal is `D_i = m_i/h^2 + sum_{s at i} (k_s + b_s/h)`,
-//! seed 001's `m/h^2 + 4k` with the actual springs at each vertex. The seed's
-//! Unity code re-declares `w = 1` inside its loop, so its weights from the
+//! the Unity cloth scripts' `m/h^2 + 4k` with the actual springs at each vertex. The
+//! scripts re-declare `w = 1` inside their loop, so their weights from the
 //! third iteration on are the constant `4/(4 - rho^2)`; the recurrence here is
 //! the one of the paper. The `rho` used is capped at the bound
 //! `max_i (D_i - m_i/h^2)/D_i` of the Jacobi spectral radius (valid while
@@ -61,7 +61,7 @@ pub fn step(
     }
     // Cap rho at a bound of the Jacobi spectral radius: with stretched
     // springs, |lambda(I - D^-1 A)| <= max_i (D_i - m_i/h^2) / D_i. A rho
-    // above the true radius only slows the iteration down (seed 001's 0.995
+    // above the true radius only slows the iteration down (Wang 2015's 0.995
     // leaves the 3-particle system at a 5 % residual after 32 iterations,
     // enough to pump energy into it); below it, it diverges.
     let bound = (0..n)

@@ -1,4 +1,4 @@
-//! Forward and symplectic Euler (seed 002's first driver).
+//! Forward and symplectic Euler (the course notes' first driver).
 
 use super::{set_kinematics, State, StepStats};
 use crate::massspring::forces::total_forces;

@@ -1,5 +1,5 @@
 //! Backward Euler and the trapezoidal rule with the velocity system solved by
-//! preconditioned CG (seeds 002 and 004).
+//! preconditioned CG (course notes; Baraff and Witkin 1998).
 //!
 //! Both schemes solve, for the velocity change `dv` of the free particles,
 //! `M dv = h [(1 - theta) f(x, v) + theta f(x + dx, v + dv)]` with
@@ -13,7 +13,7 @@
 //! `(M + theta h B + theta h c H) dv = h f - theta h (H a + B dv_k)`, `a` being
 //! `h v` on free and the prescribed displacement on kinematic particles. One
 //! solve is Baraff-Witkin's step; for backward Euler without damping it is
-//! exactly seed 004's `(M - h^2 K) v' = M v + h f`. The trapezoidal rule
+//! exactly Baraff-Witkin's `(M - h^2 K) v' = M v + h f`. The trapezoidal rule
 //! keeps the same (clamped, SPD) matrix but multiplies `a` by the exact
 //! position Jacobian (unclamped Hessian plus the position derivative of the
 //! damping force): with the clamped one `f(x + a) - f(x) + H a = O(h)`
@@ -87,7 +87,7 @@ pub fn step_system(sys: &System, s: &State, h: f64, scheme: Scheme) -> StepSyste
     let mut corr = vec![V3::zeros(); n];
     match scheme {
         Scheme::BackwardEuler => {
-            // Baraff-Witkin / seed 004: the clamped Hessian for J.
+            // Baraff-Witkin 1998: the clamped Hessian for J.
             add_block_product(&sys.springs, &hb, &a, &mut corr);
         }
         Scheme::Trapezoidal => {

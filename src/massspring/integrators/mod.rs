@@ -1,4 +1,4 @@
-//! Scene-independent time integrators (seed 002's "driver" side). Each one
+//! Scene-independent time integrators (the course notes' "driver" side). Each one
 //! advances a [`State`] of a [`System`] by one step `h`; the frame loop and
 //! the choice of `h` live in [`crate::massspring::driver`].
 //!
@@ -6,9 +6,9 @@
 //!   step bounded by [`stability::StabilityInfo`].
 //! * [`Integrator::BackwardEuler`], [`Integrator::Trapezoidal`]: the velocity
 //!   system solved by PCG (Jacobi or IC(0)), see [`implicit`].
-//! * [`Integrator::ChebyshevJacobi`]: seed 001's optimisation form of
+//! * [`Integrator::ChebyshevJacobi`]: Wang 2015's optimisation form of
 //!   backward Euler, Jacobi iterations with Chebyshev acceleration.
-//! * [`Integrator::Pbd`]: seed 001's position-based model (inertia, gravity
+//! * [`Integrator::Pbd`]: Müller et al. 2007's position-based model (inertia, gravity
 //!   and strain limiting, no spring forces).
 
 pub mod chebyshev;
@@ -59,17 +59,17 @@ pub fn set_kinematics(sys: &System, t: f64, x: &mut [V3], v: &mut [V3]) {
 /// The time integration scheme: one argument switches it.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Integrator {
-    /// `x += h v; v += h f(x, v) / m`, step from the CFL bound (seed 002).
+    /// `x += h v; v += h f(x, v) / m`, step from the CFL bound (course notes).
     ForwardEuler,
     /// `v += h f(x, v) / m; x += h v`.
     SymplecticEuler,
     /// Trapezoidal rule, linearised (one Newton step) or iterated.
     Trapezoidal,
-    /// Backward Euler, linearised (Baraff-Witkin, seed 004) or iterated.
+    /// Backward Euler, linearised (Baraff-Witkin 1998) or iterated.
     BackwardEuler,
-    /// Seed 001: backward Euler as a minimisation, Chebyshev-accelerated Jacobi.
+    /// Wang 2015: backward Euler as a minimisation, Chebyshev-accelerated Jacobi.
     ChebyshevJacobi,
-    /// Seed 001: position-based dynamics with strain limiting.
+    /// Müller et al. 2007: position-based dynamics with strain limiting (Provot 1995).
     Pbd,
 }
 
@@ -105,22 +105,22 @@ impl Integrator {
     pub fn description(self) -> &'static str {
         match self {
             Integrator::ForwardEuler => {
-                "explicit Euler, step cfl x the computed stability bound (seed 002); needs spring damping"
+                "explicit Euler, step cfl x the computed stability bound (course notes); needs spring damping"
             }
             Integrator::SymplecticEuler => {
                 "semi-implicit Euler (velocity first), step cfl x the bound 2/w_max"
             }
             Integrator::Trapezoidal => {
-                "trapezoidal rule, velocity system by PCG with IC(0) or Jacobi (seed 002), 2nd order"
+                "trapezoidal rule, velocity system by PCG with IC(0) or Jacobi (course notes), 2nd order"
             }
             Integrator::BackwardEuler => {
-                "backward Euler, velocity system by PCG (seeds 002/004), 1st order, unconditionally stable"
+                "backward Euler, velocity system by PCG (Baraff-Witkin 1998), 1st order, unconditionally stable"
             }
             Integrator::ChebyshevJacobi => {
-                "backward Euler as a minimisation, Jacobi iterations with Chebyshev acceleration (seed 001)"
+                "backward Euler as a minimisation, Jacobi iterations with Chebyshev acceleration (Wang 2015)"
             }
             Integrator::Pbd => {
-                "position-based dynamics: inertia + gravity, then strain limiting (seed 001)"
+                "position-based dynamics: inertia + gravity, then strain limiting (Müller et al. 2007)"
             }
         }
     }
@@ -175,19 +175,19 @@ pub struct IntegratorOptions {
     /// CG iteration cap (default 1000).
     pub cg_max_iterations: usize,
     /// Newton (chord) iterations of the implicit schemes; 1 = the linearised
-    /// step of seeds 002/004 (default 1).
+    /// step of the course notes and Baraff-Witkin (default 1).
     pub newton_iterations: usize,
     /// Newton stops when the residual is below this fraction of `|h f|` (default 1e-10).
     pub newton_tolerance: f64,
-    /// Chebyshev spectral-radius estimate rho (default 0.995, seed 001); 0 = plain Jacobi.
+    /// Chebyshev spectral-radius estimate rho (default 0.995, Wang 2015); 0 = plain Jacobi.
     pub rho: f64,
-    /// Jacobi iterations per step of `chebyshev-jacobi` (default 32, seed 001).
+    /// Jacobi iterations per step of `chebyshev-jacobi` (default 32, Wang 2015).
     pub iterations: usize,
     /// Strain limit; overrides the scene's `time.strain_limit`.
     pub strain_limit: Option<f64>,
-    /// Passes of the strain-limiting projection (default 32, seed 001).
+    /// Passes of the strain-limiting projection (default 32, as the Unity cloth scripts).
     pub strain_iterations: usize,
-    /// How a strain-limiting pass visits the springs (default Jacobi, seed 001).
+    /// How a strain-limiting pass visits the springs (default Jacobi, as the Unity cloth scripts).
     pub strain_solver: StrainSolver,
 }
 

@@ -1,4 +1,4 @@
-//! Seed 001's position-based pieces: the PBD model (inertia and gravity, then
+//! The cloth's position-based pieces (Müller et al. 2007; Provot 1995): the PBD model (inertia and gravity, then
 //! strain limiting), the strain-limiting projection itself (usable after any
 //! integrator), and sphere collision by projection with a velocity fix-up.
 
@@ -9,13 +9,13 @@ use super::{set_kinematics, State, StepStats};
 use crate::massspring::forces::max_strain;
 use crate::scene::massspring::{System, V3};
 
-/// Weight of a vertex's own position in the Jacobi averaging (seed 001: 0.2).
+/// Weight of a vertex's own position in the Jacobi averaging (the Unity cloth scripts: 0.2).
 pub const SELF_WEIGHT: f64 = 0.2;
 
 /// How the strain-limiting passes visit the springs.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default)]
 pub enum StrainSolver {
-    /// Seed 001: every spring proposes positions for its two ends, each free
+    /// The Unity cloth scripts: every spring proposes positions for its two ends, each free
     /// vertex moves to the average of its proposals and itself (weight
     /// [`SELF_WEIGHT`]). Order-independent, but it only approaches the limit
     /// asymptotically (slowly on large sheets).
@@ -65,7 +65,7 @@ fn within(strain: f64, limit: f64) -> bool {
     strain <= limit * (1.0 + 1e-12) + 1e-14
 }
 
-/// Seed 001's PBD step: `v += h g; x += h v`, kinematics at `t + h`, then
+/// The PBD step (Müller et al. 2007): `v += h g; x += h v`, kinematics at `t + h`, then
 /// strain limiting with `limit` (0 = pull every spring to its rest length).
 pub fn step(
     sys: &System,
@@ -89,7 +89,7 @@ pub fn step(
     stats
 }
 
-/// Strain-limiting projection (seed 001's `Strain_Limiting`, with each
+/// Strain-limiting projection (Provot 1995; the Unity cloth scripts' `Strain_Limiting`, with each
 /// spring's target length clamped into `[(1-limit) l0, (1+limit) l0]`), run
 /// for up to `passes` passes, stopping early once every spring is within
 /// the limit. Each moved free vertex gets the velocity fix-up `dx / h`.
@@ -211,7 +211,7 @@ fn strain_limit_jacobi(
 }
 
 /// Projects free particles inside a sphere onto its surface, adding the
-/// displacement over `h` to their velocity (seed 001's `Collision_Handling`).
+/// displacement over `h` to their velocity (the Unity cloth scripts' `Collision_Handling`).
 /// Returns the number of projections.
 pub fn collide_spheres(sys: &System, x: &mut [V3], v: &mut [V3], h: f64) -> usize {
     let mut count = 0;

@@ -1,4 +1,4 @@
-//! The explicit schemes' stability bound (seed 002's `Maximum_Dt`, computed
+//! The explicit schemes' stability bound (the course notes' `Maximum_Dt`, computed
 //! from the scene instead of estimated per spring).
 //!
 //! Linearised about a configuration, the axial spring forces give

@@ -1,5 +1,5 @@
 //! Preconditioned conjugate gradients with Jacobi or incomplete-Cholesky
-//! IC(0) preconditioning (seed 002: "CG with an Incomplete Cholesky
+//! IC(0) preconditioning (course notes: "CG with an Incomplete Cholesky
 //! preconditioner").
 
 use std::fmt;

@@ -1,5 +1,5 @@
 //! Dense direct solve (Cholesky, falling back to LU) for small systems such
-//! as seed 004's 9x9 three-particle system.
+//! as Baraff and Witkin 1998's 9x9 three-particle system.
 
 use nalgebra::{DMatrix, DVector};
 

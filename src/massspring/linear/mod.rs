@@ -1,7 +1,7 @@
 //! Linear algebra for the implicit integrators: a symmetric sparse matrix in
 //! CSR form assembled from 3x3 spring blocks, preconditioned conjugate
 //! gradients with Jacobi or incomplete-Cholesky IC(0) preconditioning, and a
-//! dense direct solve used to check CG on small systems (seed 004).
+//! dense direct solve used to check CG on small systems (the three-particle system).
 
 pub mod cg;
 pub mod dense;

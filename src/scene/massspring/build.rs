@@ -257,7 +257,7 @@ fn add_sheet(p: &mut Particles, si: usize, sh: &SheetSpec, src: Source) -> Resul
             rest_length,
         });
     };
-    // Edges in the order of seed 001's sorted unique edge list:
+    // Edges in the order of the Unity cloth scripts' sorted unique edge list:
     // by smaller index, then larger.
     for j in 0..nv {
         for i in 0..nu {

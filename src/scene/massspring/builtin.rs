@@ -10,15 +10,15 @@ pub fn names() -> Vec<(&'static str, &'static str)> {
     vec![
         (
             "wire",
-            "seed 002: 11-particle wire (mass 1, length 1), top end driven on a circle, 100 frames of 0.05 s",
+            "course notes: 11-particle wire (mass 1, length 1), top end driven on a circle, 100 frames of 0.05 s",
         ),
         (
             "three-particle",
-            "seed 004: three particles joined by two springs, the 9x9 backward-Euler system",
+            "Baraff-Witkin 1998: three particles joined by two springs, the 9x9 backward-Euler system",
         ),
         (
             "cloth",
-            "seed 001: 21x21 sheet (10x10 m, k 8000) pinned at two corners falls onto a sphere",
+            "Wang 2015, Provot 1995: 21x21 sheet (10x10 m, k 8000) pinned at two corners falls onto a sphere",
         ),
     ]
 }
@@ -33,7 +33,7 @@ pub fn by_name(name: &str) -> Option<MassSpringScene> {
     }
 }
 
-/// Seed 002's wire: 11 particles from `(0, 0, 0.5)` to `(0, -1, 0.5)`, total
+/// The course lecture notes' wire: 11 particles from `(0, 0, 0.5)` to `(0, -1, 0.5)`, total
 /// mass 1, `youngs_modulus` 100 (k = 1000 N/m per spring), damping 100 N s/m,
 /// gravity 9.81, the top particle driven on the circle of radius 0.5 about the
 /// origin in the x-z plane with period 5 s (= 100 frames of 0.05 s).
@@ -41,7 +41,7 @@ pub fn wire() -> MassSpringScene {
     MassSpringScene {
         kind: "wire".into(),
         name: "wire".into(),
-        description: "seed 002: 11-particle wire, top end driven on a circle".into(),
+        description: "course notes: 11-particle wire, top end driven on a circle".into(),
         gravity: [0.0, -9.81, 0.0],
         pinned: vec![],
         time: TimeParams {
@@ -75,7 +75,7 @@ pub fn wire() -> MassSpringScene {
     }
 }
 
-/// Seed 004's three-particle system: masses 1, 2 and 1.5 kg, springs 0-1 and
+/// Baraff and Witkin 1998's three-particle system: masses 1, 2 and 1.5 kg, springs 0-1 and
 /// 1-2 (stiffness 50 N/m, both stretched), no constraints, so the whole 9x9
 /// system `A = M - h^2 K` is solved.
 pub fn three_particle() -> MassSpringScene {
@@ -93,8 +93,9 @@ pub fn three_particle() -> MassSpringScene {
     MassSpringScene {
         kind: "three-particle".into(),
         name: "three-particle".into(),
-        description: "seed 004: three particles, two springs, one backward-Euler solve per step"
-            .into(),
+        description:
+            "Baraff-Witkin 1998: three particles, two springs, one backward-Euler solve per step"
+                .into(),
         gravity: [0.0, -9.81, 0.0],
         pinned: vec![],
         time: TimeParams {
@@ -118,17 +119,18 @@ pub fn three_particle() -> MassSpringScene {
     }
 }
 
-/// Seed 001's cloth: 21 x 21 vertices spanning 10 x 10 m in the plane y = 0,
+/// The cloth (Wang 2015; Müller et al. 2007; Provot 1995): 21 x 21 vertices spanning 10 x 10 m in the plane y = 0,
 /// vertex `(i, j)` at `(5 - 10 i/20, 0, 5 - 10 j/20)`, mass 1 each, springs of
 /// k = 8000 N/m on the triangle edges, vertices 0 and 20 pinned,
 /// h = 1/30 s, velocity damping 0.99 per step, gravity 9.8, and a sphere of
-/// radius 2.7 centred at `(0, -3, 0)` (the seed moves it with the mouse; this
+/// radius 2.7 centred at `(0, -3, 0)` (the Unity cloth scripts move it with the mouse; this
 /// position puts it in the path of the swinging sheet).
 pub fn cloth() -> MassSpringScene {
     MassSpringScene {
         kind: "cloth".into(),
         name: "cloth".into(),
-        description: "seed 001: 21x21 sheet pinned at two corners falls onto a sphere".into(),
+        description:
+            "Wang 2015, Provot 1995: 21x21 sheet pinned at two corners falls onto a sphere".into(),
         gravity: [0.0, -9.8, 0.0],
         pinned: vec![0, 20],
         time: TimeParams {

@@ -1,4 +1,4 @@
-//! The mass-spring scene (seed 002's `SIMULATION_LAYOUT`): what exists in a
+//! The mass-spring scene (the course notes' `SIMULATION_LAYOUT`): what exists in a
 //! wire or cloth scene, as plain data read from TOML. Particles and springs are
 //! given one by one (`[[particles]]`, `[[springs]]`) or generated
 //! (`[[chains]]`, `[[sheets]]`); kinematic constraints (`pinned`,
@@ -72,7 +72,7 @@ pub struct MassSpringScene {
     pub spheres: Vec<SphereSpec>,
 }
 
-/// Frame loop and step parameters (seed 002's "user-specified parameters").
+/// Frame loop and step parameters (the course notes' "user-specified parameters").
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct TimeParams {
@@ -91,12 +91,12 @@ pub struct TimeParams {
     )]
     pub time_step: Option<f64>,
     /// Fraction of the stability bound the explicit integrators step at
-    /// (0 < c <= 1, default 0.5 as in seed 002).
+    /// (0 < c <= 1, default 0.5 as in the course notes).
     #[serde(default = "half", deserialize_with = "unit_interval_open_low")]
     pub cfl_number: f64,
     /// Fraction of the free particles' velocity kept per `frame_time`
     /// (0 < d <= 1, default 1 = none); a step of size `h` multiplies the
-    /// velocity by `d^(h / frame_time)` before it starts (seed 001: 0.99).
+    /// velocity by `d^(h / frame_time)` before it starts (the Unity cloth scripts: 0.99).
     #[serde(default = "one", deserialize_with = "unit_interval_open_low")]
     pub velocity_damping: f64,
     /// Strain limit `s` of the position-based pass: after each step every
@@ -146,7 +146,7 @@ pub struct SpringSpec {
     pub rest_length: Option<f64>,
 }
 
-/// A straight chain of `particles` equal masses joined by springs (seed 002's wire).
+/// A straight chain of `particles` equal masses joined by springs (the course notes' wire).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ChainSpec {
@@ -162,16 +162,16 @@ pub struct ChainSpec {
     /// Total mass in kg, shared equally.
     #[serde(deserialize_with = "positive")]
     pub mass: f64,
-    /// Seed 002's `youngs_modulus` E in N: a spring of rest length `l0` has
+    /// The course notes' `youngs_modulus` E in N: a spring of rest length `l0` has
     /// stiffness `k = E / l0` (force `E (l / l0 - 1)`).
     #[serde(deserialize_with = "nonnegative")]
     pub youngs_modulus: f64,
-    /// Seed 002's `damping_coefficient` b in N s/m, per spring (default 0).
+    /// The course notes' `damping_coefficient` b in N s/m, per spring (default 0).
     #[serde(default, deserialize_with = "nonnegative")]
     pub damping: f64,
 }
 
-/// A rectangular sheet of `nu x nv` vertices, triangulated as in seed 001
+/// A rectangular sheet of `nu x nv` vertices, triangulated as in the Unity cloth scripts
 /// (structural edges plus the diagonal `(i, j)-(i+1, j+1)` of every quad).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -206,7 +206,7 @@ pub struct SheetSpec {
 }
 
 /// A particle moved on the circle `center + u sin(w t + phase) + v cos(w t + phase)`,
-/// `w = 2 pi / period` (seed 002's upper endpoint).
+/// `w = 2 pi / period` (the course notes' upper endpoint).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct DrivenSpec {
@@ -339,7 +339,7 @@ damping = 100.0
 "#;
 
     #[test]
-    fn chain_expands_to_seed_002_wire() {
+    fn chain_expands_to_the_course_wire() {
         let s = MassSpringScene::from_toml_str(WIRE)
             .unwrap()
             .build()
@@ -374,7 +374,7 @@ damping = 100.0
     }
 
     #[test]
-    fn sheet_has_seed_001_edge_count() {
+    fn sheet_has_the_cloth_scripts_edge_count() {
         let text = r#"
 [time]
 frame_time = 0.0333

@@ -77,7 +77,7 @@ pub enum TransferScheme {
     /// with APIC by `flip_ratio`).
     #[default]
     Flip,
-    /// APIC (the seed's): velocity and affine matrix replaced by the grid's.
+    /// APIC (the reference Taichi implementation's): velocity and affine matrix replaced by the grid's.
     Apic,
 }
 
