@@ -31,8 +31,8 @@ use std::time::Instant;
 use yarnsim::scene::builtin::yarn_reference;
 use yarnsim::scene::YarnScene;
 use yarnsim::testing::{
-    cantilever_setup, cantilever_toml, hanging_chain_period, hanging_chain_toml,
-    two_periods_about_mean, ZeroCrossings,
+    cantilever_setup, cantilever_toml, capstan_toml, capstan_vertices, hanging_chain_period,
+    hanging_chain_toml, two_periods_about_mean, ZeroCrossings, CAPSTAN_PURE_STRING,
 };
 use yarnsim::YarnSim;
 
@@ -113,46 +113,9 @@ fn cantilever(vertices: u32) -> String {
 }
 
 fn capstan(r: f64, l1: f64, l2: f64, mu: f64) -> String {
-    let (cx, cy, res, g) = (0.5, 0.75, 128u32, 2.0);
-    let mut pts = vec![[cx - r, cy - l1]];
-    let arc = 64;
-    for i in 0..=arc {
-        let psi = std::f64::consts::PI * (1.0 - i as f64 / arc as f64);
-        pts.push([cx + r * psi.cos(), cy + r * psi.sin()]);
-    }
-    pts.push([cx + r, cy - l2]);
-    let length = l1 + l2 + std::f64::consts::PI * r;
-    let vertices = (length / (0.5 / res as f64)).round() as u32 + 1;
-    let points = pts
-        .iter()
-        .map(|p| format!("[{:.12}, {:.12}]", p[0], p[1]))
-        .collect::<Vec<_>>()
-        .join(", ");
-    let s = scene(&format!(
-        r#"
-gravity = [0.0, -{g}]
-[grid]
-resolution = {res}
-[time]
-dt = 1e-4
-[material]
-k = 1000.0
-gamma = 0.0
-youngs_modulus = 0.0
-friction = 0.0
-bending = 0.0
-plasticity = false
-[walls]
-mode = "none"
-[[obstacles]]
-center = [{cx}, {cy}]
-radius = {r}
-friction = {mu}
-[[yarns]]
-points = [{points}]
-vertices = {vertices}
-"#
-    ));
+    let c = CAPSTAN_PURE_STRING;
+    let vertices = capstan_vertices(r, l1, l2, c.res);
+    let s = scene(&capstan_toml(r, l1, l2, mu, &c));
     let mut sim = YarnSim::new(&s).unwrap();
     let t0 = Instant::now();
     let mut ok = sim.advance(0.2).is_ok();

@@ -199,6 +199,90 @@ count = 2
     )
 }
 
+/// Resolution, time step, gravity and material of a capstan scene (a yarn
+/// over a half circle).
+#[derive(Clone, Copy, Debug)]
+pub struct Capstan {
+    pub res: u32,
+    pub dt: f64,
+    /// Gravity (the capstan's slip threshold does not depend on it).
+    pub g: f64,
+    pub gamma: f64,
+    pub youngs_modulus: f64,
+    pub friction: f64,
+    pub bending: f64,
+    pub plasticity: bool,
+}
+
+/// Material: a pure string at 128^2, dt 1e-4. Bending 0 (all the
+/// resistance is friction), k = 1000 (strain below 0.1 %), plasticity off,
+/// and no cross-section energy (gamma = 0, E = 0); a small gravity keeps the
+/// elastic stretch small.
+pub const CAPSTAN_PURE_STRING: Capstan = Capstan {
+    res: 128,
+    dt: 1e-4,
+    g: 2.0,
+    gamma: 0.0,
+    youngs_modulus: 0.0,
+    friction: 0.0,
+    bending: 0.0,
+    plasticity: false,
+};
+
+/// The vertices of the capstan yarn (hanging `l1` and `l2` over a half
+/// circle of radius `r`) on a `res`^2 grid: a vertex spacing of about dx / 2.
+pub fn capstan_vertices(r: f64, l1: f64, l2: f64, res: u32) -> u32 {
+    let length = l1 + l2 + std::f64::consts::PI * r;
+    let dx = 1.0 / res as f64;
+    (length / (0.5 * dx)).round() as u32 + 1
+}
+
+/// A yarn over a half circle of radius `r` centred at (0.5, 0.75), hanging
+/// `l1` on the left and `l2` on the right, on a circle with friction `mu`,
+/// as scene TOML: k = 1000, no walls, the rest from `c`.
+pub fn capstan_toml(r: f64, l1: f64, l2: f64, mu: f64, c: &Capstan) -> String {
+    let (cx, cy) = (0.5, 0.75);
+    let mut pts = vec![[cx - r, cy - l1]];
+    let arc = 64;
+    for i in 0..=arc {
+        let psi = std::f64::consts::PI * (1.0 - i as f64 / arc as f64);
+        pts.push([cx + r * psi.cos(), cy + r * psi.sin()]);
+    }
+    pts.push([cx + r, cy - l2]);
+    let vertices = capstan_vertices(r, l1, l2, c.res);
+    let points = pts
+        .iter()
+        .map(|p| format!("[{:.12}, {:.12}]", p[0], p[1]))
+        .collect::<Vec<_>>()
+        .join(", ");
+    format!(
+        r#"
+gravity = [0.0, -{}]
+[grid]
+resolution = {}
+[time]
+dt = {}
+[material]
+k = 1000.0
+gamma = {}
+youngs_modulus = {}
+friction = {}
+bending = {}
+plasticity = {}
+[walls]
+mode = "none"
+[[obstacles]]
+center = [{cx}, {cy}]
+radius = {r}
+friction = {mu}
+[[yarns]]
+points = [{points}]
+vertices = {vertices}
+"#,
+        c.g, c.res, c.dt, c.gamma, c.youngs_modulus, c.friction, c.bending, c.plasticity
+    )
+}
+
 /// The window of two whole periods of an oscillation about its mean: the
 /// indices of the first and third upward crossings of `d` through its
 /// mean, or `None` with fewer than three.
@@ -222,6 +306,10 @@ mod tests {
     #[test]
     fn oracle_scenes_are_valid() {
         YarnScene::from_toml_str(&hanging_chain_toml(100, 64, "1e-4"))
+            .unwrap()
+            .validate()
+            .unwrap();
+        YarnScene::from_toml_str(&capstan_toml(0.1, 0.2, 0.3, 0.5, &CAPSTAN_PURE_STRING))
             .unwrap()
             .validate()
             .unwrap();
