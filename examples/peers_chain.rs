@@ -30,10 +30,11 @@ use std::time::Instant;
 
 use yarnsim::scene::builtin::yarn_reference;
 use yarnsim::scene::YarnScene;
-use yarnsim::testing::bessel_j0;
+use yarnsim::testing::{
+    cantilever_setup, cantilever_toml, capstan_toml, capstan_vertices, hanging_chain_period,
+    hanging_chain_toml, two_periods_about_mean, ZeroCrossings, CAPSTAN_PURE_STRING,
+};
 use yarnsim::YarnSim;
-
-const J01: f64 = 2.404_825_557_695_773;
 
 fn scene(text: &str) -> YarnScene {
     YarnScene::from_toml_str(text).unwrap_or_else(|e| {
@@ -50,43 +51,10 @@ fn arg<T: std::str::FromStr>(args: &[String], i: usize, name: &str) -> T {
 }
 
 fn chain(vertices: u32, grid: u32, dt: &str) -> String {
-    let (len, g, amp, n) = (0.8, 9.8, 0.02, 200);
-    let points = (0..=n)
-        .map(|i| {
-            let z = len * (n - i) as f64 / n as f64;
-            let u = amp * bessel_j0(J01 * (z / len).sqrt());
-            format!("[{:.12}, {:.12}]", 0.5 + u, 0.1 + z)
-        })
-        .collect::<Vec<_>>()
-        .join(", ");
-    let s = scene(&format!(
-        r#"
-gravity = [0.0, -{g}]
-[grid]
-resolution = {grid}
-[time]
-dt = {dt}
-[material]
-k = 2000.0
-gamma = 0.0
-youngs_modulus = 0.0
-friction = 0.0
-bending = 0.0
-plasticity = false
-[walls]
-mode = "none"
-[[yarns]]
-points = [{points}]
-vertices = {vertices}
-[[pins]]
-yarn = 0
-end = "start"
-"#
-    ));
+    let s = scene(&hanging_chain_toml(vertices, grid, dt));
     let mut sim = YarnSim::new(&s).unwrap();
     let duration = 3.4;
-    let mut crossings = Vec::new();
-    let mut prev = sim.yarn_endpoints(0).1.x - 0.5;
+    let mut crossings = ZeroCrossings::new(sim.yarn_endpoints(0).1.x - 0.5);
     let mut ok = true;
     let t0 = Instant::now();
     while sim.time() < duration {
@@ -96,60 +64,24 @@ end = "start"
             break;
         }
         let h = sim.time() - before;
-        let u = sim.yarn_endpoints(0).1.x - 0.5;
-        if prev * u < 0.0 {
-            crossings.push(sim.time() - h * u / (u - prev));
-        }
-        prev = u;
+        crossings.push(sim.time(), h, sim.yarn_endpoints(0).1.x - 0.5);
     }
     let wall = t0.elapsed().as_secs_f64();
-    let period = if crossings.len() >= 2 {
-        2.0 * (crossings[crossings.len() - 1] - crossings[0]) / (crossings.len() - 1) as f64
-    } else {
-        f64::NAN
-    };
-    let oracle = 2.0 * std::f64::consts::PI / (0.5 * J01 * (g / len).sqrt());
+    let period = crossings.period();
+    let oracle = hanging_chain_period();
     format!(
         "{{\"ok\": {ok}, \"period\": {period}, \"oracle\": {oracle}, \"error\": {}, \"crossings\": {}, \
          \"wall_s\": {wall}, \"sim_s\": {}, \"steps\": {}}}",
         (period - oracle) / oracle,
-        crossings.len(),
+        crossings.times.len(),
         sim.time(),
         sim.steps()
     )
 }
 
 fn cantilever(vertices: u32) -> String {
-    let (len, b, rho): (f64, f64, f64) = (0.5, 1.0, 1.0);
-    let g = 0.08 * b / (rho * len * len * len);
-    let s = scene(&format!(
-        r#"
-gravity = [0.0, -{g}]
-[grid]
-resolution = 64
-[time]
-dt = 5e-5
-[material]
-k = 1e4
-gamma = 0.0
-youngs_modulus = 0.0
-friction = 0.0
-bending = {b}
-density = {rho}
-plasticity = false
-[walls]
-mode = "none"
-[[yarns]]
-start = [0.25, 0.5]
-end = [{}, 0.5]
-vertices = {vertices}
-[[pins]]
-yarn = 0
-end = "start"
-count = 2
-"#,
-        0.25 + len
-    ));
+    let (len, b, rho, g) = cantilever_setup();
+    let s = scene(&cantilever_toml(vertices));
     let mut sim = YarnSim::new(&s).unwrap();
     let free = len - 0.5 * len / (vertices - 1) as f64;
     let oracle = rho * g * free.powi(4) / (8.0 * b);
@@ -167,14 +99,9 @@ count = 2
         d.push(y0 - sim.yarn_endpoints(0).1.y);
     }
     let wall = t0.elapsed().as_secs_f64();
-    let m0 = d.iter().sum::<f64>() / d.len().max(1) as f64;
-    let up: Vec<usize> = (1..d.len())
-        .filter(|&k| d[k - 1] < m0 && d[k] >= m0)
-        .collect();
-    let tip = if up.len() >= 3 {
-        d[up[0]..up[2]].iter().sum::<f64>() / (up[2] - up[0]) as f64
-    } else {
-        f64::NAN
+    let tip = match two_periods_about_mean(&d) {
+        Some((a, e)) => d[a..e].iter().sum::<f64>() / (e - a) as f64,
+        None => f64::NAN,
     };
     format!(
         "{{\"ok\": {ok}, \"tip\": {tip}, \"oracle\": {oracle}, \"error\": {}, \"wall_s\": {wall}, \
@@ -186,46 +113,9 @@ count = 2
 }
 
 fn capstan(r: f64, l1: f64, l2: f64, mu: f64) -> String {
-    let (cx, cy, res, g) = (0.5, 0.75, 128u32, 2.0);
-    let mut pts = vec![[cx - r, cy - l1]];
-    let arc = 64;
-    for i in 0..=arc {
-        let psi = std::f64::consts::PI * (1.0 - i as f64 / arc as f64);
-        pts.push([cx + r * psi.cos(), cy + r * psi.sin()]);
-    }
-    pts.push([cx + r, cy - l2]);
-    let length = l1 + l2 + std::f64::consts::PI * r;
-    let vertices = (length / (0.5 / res as f64)).round() as u32 + 1;
-    let points = pts
-        .iter()
-        .map(|p| format!("[{:.12}, {:.12}]", p[0], p[1]))
-        .collect::<Vec<_>>()
-        .join(", ");
-    let s = scene(&format!(
-        r#"
-gravity = [0.0, -{g}]
-[grid]
-resolution = {res}
-[time]
-dt = 1e-4
-[material]
-k = 1000.0
-gamma = 0.0
-youngs_modulus = 0.0
-friction = 0.0
-bending = 0.0
-plasticity = false
-[walls]
-mode = "none"
-[[obstacles]]
-center = [{cx}, {cy}]
-radius = {r}
-friction = {mu}
-[[yarns]]
-points = [{points}]
-vertices = {vertices}
-"#
-    ));
+    let c = CAPSTAN_PURE_STRING;
+    let vertices = capstan_vertices(r, l1, l2, c.res);
+    let s = scene(&capstan_toml(r, l1, l2, mu, &c));
     let mut sim = YarnSim::new(&s).unwrap();
     let t0 = Instant::now();
     let mut ok = sim.advance(0.2).is_ok();

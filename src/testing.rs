@@ -58,9 +58,283 @@ pub fn bessel_j0(x: f64) -> f64 {
     sum
 }
 
+/// The first zero of `J0`, `j_{0,1}`.
+pub const J0_FIRST_ZERO: f64 = 2.404_825_557_695_773;
+
+/// The hanging chain's length (m) and gravity (m/s^2).
+pub const CHAIN_LENGTH: f64 = 0.8;
+/// The hanging chain's gravity (m/s^2).
+pub const CHAIN_GRAVITY: f64 = 9.8;
+
+/// The hanging chain of the yarn oracles as scene TOML: L = 0.8 m pinned at
+/// (0.5, 0.9), bending 0, k = 2000 (static strain at the top g L rho / k =
+/// 0.4 %), no cross-section energy, default FLIP, started in the first mode
+/// shape `u = A J0(j01 sqrt(z / L))` with A = 0.02 m (200 polyline
+/// segments, resampled to `vertices`), on a `resolution`^2 grid with the
+/// substep `dt` (a TOML value: `1e-4` or `"auto"`).
+pub fn hanging_chain_toml(vertices: u32, resolution: u32, dt: &str) -> String {
+    let (len, g, amp, n) = (CHAIN_LENGTH, CHAIN_GRAVITY, 0.02, 200);
+    let points = (0..=n)
+        .map(|i| {
+            let z = len * (n - i) as f64 / n as f64; // from the top down
+            let u = amp * bessel_j0(J0_FIRST_ZERO * (z / len).sqrt());
+            format!("[{:.12}, {:.12}]", 0.5 + u, 0.1 + z)
+        })
+        .collect::<Vec<_>>()
+        .join(", ");
+    format!(
+        r#"
+gravity = [0.0, -{g}]
+[grid]
+resolution = {resolution}
+[time]
+dt = {dt}
+[material]
+k = 2000.0
+gamma = 0.0
+youngs_modulus = 0.0
+friction = 0.0
+bending = 0.0
+plasticity = false
+[walls]
+mode = "none"
+[[yarns]]
+points = [{points}]
+vertices = {vertices}
+[[pins]]
+yarn = 0
+end = "start"
+"#
+    )
+}
+
+/// The hanging chain's first-mode period, `2 pi / omega_1` with
+/// `omega_1 = (j01 / 2) sqrt(g / L)` (Daniel Bernoulli's hanging chain,
+/// whose modes are `J0(j sqrt(z / L))`).
+pub fn hanging_chain_period() -> f64 {
+    let omega = J0_FIRST_ZERO / 2.0 * (CHAIN_GRAVITY / CHAIN_LENGTH).sqrt();
+    2.0 * std::f64::consts::PI / omega
+}
+
+/// The zero crossings of a sampled signal, each time interpolated linearly
+/// within the step that crossed.
+#[derive(Clone, Debug)]
+pub struct ZeroCrossings {
+    prev: f64,
+    /// The crossing times, in order.
+    pub times: Vec<f64>,
+}
+
+impl ZeroCrossings {
+    /// Starts from the signal's first sample `u0`.
+    pub fn new(u0: f64) -> Self {
+        Self {
+            prev: u0,
+            times: Vec::new(),
+        }
+    }
+
+    /// Takes the sample `u` at the time `t`, a step `h` after the previous
+    /// one; returns whether the signal crossed zero in that step.
+    pub fn push(&mut self, t: f64, h: f64, u: f64) -> bool {
+        let crossed = self.prev * u < 0.0;
+        if crossed {
+            self.times.push(t - h * u / (u - self.prev));
+        }
+        self.prev = u;
+        crossed
+    }
+
+    /// The period of an oscillation, twice the mean spacing of the
+    /// crossings (NaN with fewer than two).
+    pub fn period(&self) -> f64 {
+        let c = &self.times;
+        if c.len() < 2 {
+            return f64::NAN;
+        }
+        2.0 * (c[c.len() - 1] - c[0]) / (c.len() - 1) as f64
+    }
+}
+
+/// The Euler-Bernoulli cantilever of the yarn oracles: length (m), bending
+/// stiffness B (N m), line density (kg/m), and the gravity `0.08 B / (rho
+/// L^3)` that sags the tip by about 1 % of L.
+pub fn cantilever_setup() -> (f64, f64, f64, f64) {
+    let (len, b, rho): (f64, f64, f64) = (0.5, 1.0, 1.0);
+    (len, b, rho, 0.08 * b / (rho * len * len * len))
+}
+
+/// The cantilever of [`cantilever_setup`] as scene TOML: from (0.25, 0.5)
+/// along +x with `vertices` vertices, the first two pinned, k = 1e4, no
+/// cross-section energy, 64^2 grid, dt 5e-5 s.
+pub fn cantilever_toml(vertices: u32) -> String {
+    let (len, b, rho, g) = cantilever_setup();
+    format!(
+        r#"
+gravity = [0.0, -{g}]
+[grid]
+resolution = 64
+[time]
+dt = 5e-5
+[material]
+k = 1e4
+gamma = 0.0
+youngs_modulus = 0.0
+friction = 0.0
+bending = {b}
+density = {rho}
+plasticity = false
+[walls]
+mode = "none"
+[[yarns]]
+start = [0.25, 0.5]
+end = [{}, 0.5]
+vertices = {vertices}
+[[pins]]
+yarn = 0
+end = "start"
+count = 2
+"#,
+        0.25 + len
+    )
+}
+
+/// Resolution, time step, gravity and material of a capstan scene (a yarn
+/// over a half circle).
+#[derive(Clone, Copy, Debug)]
+pub struct Capstan {
+    pub res: u32,
+    pub dt: f64,
+    /// Gravity (the capstan's slip threshold does not depend on it).
+    pub g: f64,
+    pub gamma: f64,
+    pub youngs_modulus: f64,
+    pub friction: f64,
+    pub bending: f64,
+    pub plasticity: bool,
+}
+
+/// Material: a pure string at 128^2, dt 1e-4. Bending 0 (all the
+/// resistance is friction), k = 1000 (strain below 0.1 %), plasticity off,
+/// and no cross-section energy (gamma = 0, E = 0); a small gravity keeps the
+/// elastic stretch small.
+pub const CAPSTAN_PURE_STRING: Capstan = Capstan {
+    res: 128,
+    dt: 1e-4,
+    g: 2.0,
+    gamma: 0.0,
+    youngs_modulus: 0.0,
+    friction: 0.0,
+    bending: 0.0,
+    plasticity: false,
+};
+
+/// The vertices of the capstan yarn (hanging `l1` and `l2` over a half
+/// circle of radius `r`) on a `res`^2 grid: a vertex spacing of about dx / 2.
+pub fn capstan_vertices(r: f64, l1: f64, l2: f64, res: u32) -> u32 {
+    let length = l1 + l2 + std::f64::consts::PI * r;
+    let dx = 1.0 / res as f64;
+    (length / (0.5 * dx)).round() as u32 + 1
+}
+
+/// A yarn over a half circle of radius `r` centred at (0.5, 0.75), hanging
+/// `l1` on the left and `l2` on the right, on a circle with friction `mu`,
+/// as scene TOML: k = 1000, no walls, the rest from `c`.
+pub fn capstan_toml(r: f64, l1: f64, l2: f64, mu: f64, c: &Capstan) -> String {
+    let (cx, cy) = (0.5, 0.75);
+    let mut pts = vec![[cx - r, cy - l1]];
+    let arc = 64;
+    for i in 0..=arc {
+        let psi = std::f64::consts::PI * (1.0 - i as f64 / arc as f64);
+        pts.push([cx + r * psi.cos(), cy + r * psi.sin()]);
+    }
+    pts.push([cx + r, cy - l2]);
+    let vertices = capstan_vertices(r, l1, l2, c.res);
+    let points = pts
+        .iter()
+        .map(|p| format!("[{:.12}, {:.12}]", p[0], p[1]))
+        .collect::<Vec<_>>()
+        .join(", ");
+    format!(
+        r#"
+gravity = [0.0, -{}]
+[grid]
+resolution = {}
+[time]
+dt = {}
+[material]
+k = 1000.0
+gamma = {}
+youngs_modulus = {}
+friction = {}
+bending = {}
+plasticity = {}
+[walls]
+mode = "none"
+[[obstacles]]
+center = [{cx}, {cy}]
+radius = {r}
+friction = {mu}
+[[yarns]]
+points = [{points}]
+vertices = {vertices}
+"#,
+        c.g, c.res, c.dt, c.gamma, c.youngs_modulus, c.friction, c.bending, c.plasticity
+    )
+}
+
+/// The window of two whole periods of an oscillation about its mean: the
+/// indices of the first and third upward crossings of `d` through its
+/// mean, or `None` with fewer than three.
+pub fn two_periods_about_mean(d: &[f64]) -> Option<(usize, usize)> {
+    let m0 = d.iter().sum::<f64>() / d.len() as f64;
+    let up: Vec<usize> = (1..d.len())
+        .filter(|&k| d[k - 1] < m0 && d[k] >= m0)
+        .collect();
+    (up.len() >= 3).then(|| (up[0], up[2]))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn first_zero_of_j0() {
+        assert!(bessel_j0(J0_FIRST_ZERO).abs() < 1e-12);
+    }
+
+    #[test]
+    fn oracle_scenes_are_valid() {
+        YarnScene::from_toml_str(&hanging_chain_toml(100, 64, "1e-4"))
+            .unwrap()
+            .validate()
+            .unwrap();
+        YarnScene::from_toml_str(&capstan_toml(0.1, 0.2, 0.3, 0.5, &CAPSTAN_PURE_STRING))
+            .unwrap()
+            .validate()
+            .unwrap();
+        YarnScene::from_toml_str(&cantilever_toml(100))
+            .unwrap()
+            .validate()
+            .unwrap();
+    }
+
+    #[test]
+    fn crossings_of_a_sine_give_its_period() {
+        let (period, h) = (0.5, 1e-3);
+        let f = |t: f64| (2.0 * std::f64::consts::PI * t / period + 0.3).sin();
+        let mut c = ZeroCrossings::new(f(0.0));
+        for k in 1..=2000 {
+            let t = k as f64 * h;
+            c.push(t, h, f(t));
+        }
+        assert_eq!(c.times.len(), 8);
+        // linear interpolation within a step of 1e-3 of a 0.5 s sine
+        assert!((c.period() - period).abs() < 1e-6, "{}", c.period());
+        let d: Vec<f64> = (0..2000).map(|k| f(k as f64 * h)).collect();
+        let (a, e) = two_periods_about_mean(&d).unwrap();
+        assert!(((e - a) as f64 * h - 2.0 * period).abs() < 2.0 * h);
+    }
 
     #[test]
     fn small_scene_is_valid() {

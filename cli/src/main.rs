@@ -4,7 +4,7 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
-use yarnsim::scene::DEFAULT_SCENE;
+use yarnsim::scene::{Scene, DEFAULT_SCENE};
 use yarnsim_cli::bench::{bench, format_bench, BenchOptions};
 use yarnsim_cli::duration::parse_duration;
 use yarnsim_cli::error::{CliError, EXIT_INTERRUPTED};
@@ -46,13 +46,8 @@ enum Command {
     Scene(SceneCommand),
     /// Run a scene and print a summary table (steps, wall time, throughput, energy, stretch).
     Run {
-        /// Built-in scene name or scene file.
-        #[arg(default_value = DEFAULT_SCENE)]
-        scene: String,
-        /// Override a scene field, KEY=VALUE with VALUE in TOML (repeatable):
-        /// --set material.friction=0.1 --set gravity=[0,-3] --set yarns.0.count=4.
-        #[arg(long = "set", value_name = "KEY=VALUE")]
-        set: Vec<String>,
+        #[command(flatten)]
+        scene: SceneArgs,
         /// Simulated time, in seconds: 2, 2.5s or 250ms.
         #[arg(short, long, default_value = "1", value_parser = parse_duration, allow_negative_numbers = true)]
         duration: f64,
@@ -69,13 +64,8 @@ enum Command {
     /// `--connect`), or served to viewers that connect (`--serve`).
     /// Timelines are `frame` and `sim_time`; there is no wall-clock timeline.
     Record {
-        /// Built-in scene name or scene file.
-        #[arg(default_value = DEFAULT_SCENE)]
-        scene: String,
-        /// Override a scene field, KEY=VALUE with VALUE in TOML (repeatable):
-        /// --set material.friction=0.1 --set gravity=[0,-3] --set yarns.0.count=4.
-        #[arg(long = "set", value_name = "KEY=VALUE")]
-        set: Vec<String>,
+        #[command(flatten)]
+        scene: SceneArgs,
         /// Simulated time, in seconds: 2, 2.5s or 250ms.
         #[arg(short, long, default_value = "1", value_parser = parse_duration, allow_negative_numbers = true)]
         duration: f64,
@@ -125,13 +115,8 @@ enum Command {
     ///
     /// Prints a line `<number> particle-substeps/s`.
     Bench {
-        /// Built-in scene name or scene file.
-        #[arg(default_value = DEFAULT_SCENE)]
-        scene: String,
-        /// Override a scene field, KEY=VALUE with VALUE in TOML (repeatable):
-        /// --set material.friction=0.1 --set gravity=[0,-3] --set yarns.0.count=4.
-        #[arg(long = "set", value_name = "KEY=VALUE")]
-        set: Vec<String>,
+        #[command(flatten)]
+        scene: SceneArgs,
         /// Timed substeps.
         #[arg(short, long, default_value_t = 1000)]
         steps: u64,
@@ -146,6 +131,24 @@ enum Command {
     },
     #[command(flatten)]
     Evidence(yarnsim_cli::evidence::EvidenceCommand),
+}
+
+/// The scene of `run`, `record` and `bench`, with its overrides.
+#[derive(clap::Args, Debug, Clone)]
+struct SceneArgs {
+    /// Built-in scene name or scene file.
+    #[arg(default_value = DEFAULT_SCENE)]
+    scene: String,
+    /// Override a scene field, KEY=VALUE with VALUE in TOML (repeatable):
+    /// --set material.friction=0.1 --set gravity=[0,-3] --set yarns.0.count=4.
+    #[arg(long = "set", value_name = "KEY=VALUE")]
+    set: Vec<String>,
+}
+
+impl SceneArgs {
+    fn load(&self) -> Result<Scene, CliError> {
+        load_scene(&self.scene, &self.set)
+    }
 }
 
 /// Integrator choice for mass-spring scenes.
@@ -207,9 +210,8 @@ fn execute(command: Command) -> Result<u8, CliError> {
             duration,
             csv,
             integrator,
-            set,
         } => {
-            let scene = load_scene(&scene, &set)?;
+            let scene = scene.load()?;
             announce(&Estimate::of(&scene, duration, None));
             let summary = run(&scene, duration, csv.as_deref(), &integrator.args())?;
             print!("{}", format_summary(&summary, Timing::Show));
@@ -234,7 +236,6 @@ fn execute(command: Command) -> Result<u8, CliError> {
             server_memory_limit,
             every,
             integrator,
-            set,
         } => {
             let sink = if serve {
                 Sink::serve(bind, port, server_memory_limit, output.as_deref())?
@@ -245,7 +246,7 @@ fn execute(command: Command) -> Result<u8, CliError> {
             } else {
                 Sink::output(output.as_deref().unwrap_or("run.rrd".as_ref()))?
             };
-            let scene = load_scene(&scene, &set)?;
+            let scene = scene.load()?;
             announce(&Estimate::of(&scene, duration, Some(every)));
             let opts = RecordOptions { sink, every };
             let r = record(&scene, duration, &opts, &integrator.args())?;
@@ -309,9 +310,8 @@ fn execute(command: Command) -> Result<u8, CliError> {
             warmup,
             threads,
             integrator,
-            set,
         } => {
-            let scene = load_scene(&scene, &set)?;
+            let scene = scene.load()?;
             announce(&Estimate::of(&scene, 0.0, None));
             let r = bench(
                 &scene,

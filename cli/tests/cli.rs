@@ -29,6 +29,46 @@ fn tmp(name: &str) -> PathBuf {
     Path::new(env!("CARGO_TARGET_TMPDIR")).join(name)
 }
 
+/// `yarnsim run SCENE --duration 2ms --csv CSV` (CSV named `csv` in the
+/// test folder), which must succeed: its output and the CSV text.
+fn run_2ms_with_csv(scene: &Path, csv: &str) -> (Output, String) {
+    let csv = tmp(csv);
+    let out = yarnsim(&[
+        "run",
+        scene.to_str().unwrap(),
+        "--duration",
+        "2ms",
+        "--csv",
+        csv.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    (out, std::fs::read_to_string(&csv).unwrap())
+}
+
+/// `yarnsim bench` of the small scene, 5 steps after 1 of warm-up, which
+/// must succeed: its stdout.
+fn bench_small() -> String {
+    let out = yarnsim(&[
+        "bench",
+        small_scene().to_str().unwrap(),
+        "--steps",
+        "5",
+        "--warmup",
+        "1",
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    stdout(&out)
+}
+
+/// The small scene with `from` replaced by `to`, written as `name` in the
+/// test folder.
+fn small_scene_with(from: &str, to: &str, name: &str) -> PathBuf {
+    let text = std::fs::read_to_string(small_scene()).unwrap();
+    let scene = tmp(name);
+    std::fs::write(&scene, text.replace(from, to)).unwrap();
+    scene
+}
+
 /// Masks the wall-clock figures of a summary table.
 fn masked(f: impl FnOnce()) {
     let mut settings = insta::Settings::clone_current();
@@ -79,20 +119,10 @@ fn scene_show_round_trips() {
 
 #[test]
 fn run_summary_of_a_yarn_scene() {
-    let csv = tmp("run-small.csv");
-    let out = yarnsim(&[
-        "run",
-        small_scene().to_str().unwrap(),
-        "--duration",
-        "2ms",
-        "--csv",
-        csv.to_str().unwrap(),
-    ]);
-    assert!(out.status.success(), "{}", stderr(&out));
+    let (out, text) = run_2ms_with_csv(&small_scene(), "run-small.csv");
     masked(|| insta::assert_snapshot!("run_small", stdout(&out)));
 
     // One CSV row per frame (0..=5), endpoints of both yarns.
-    let text = std::fs::read_to_string(&csv).unwrap();
     let lines: Vec<&str> = text.lines().collect();
     assert_eq!(lines.len(), 1 + 6);
     let header: Vec<&str> = lines[0].split(',').collect();
@@ -122,16 +152,7 @@ fn run_summary_of_a_massspring_scene() {
 
 #[test]
 fn bench_prints_the_throughput_line() {
-    let out = yarnsim(&[
-        "bench",
-        small_scene().to_str().unwrap(),
-        "--steps",
-        "5",
-        "--warmup",
-        "1",
-    ]);
-    assert!(out.status.success(), "{}", stderr(&out));
-    let text = stdout(&out);
+    let text = bench_small();
     let line = text
         .lines()
         .find(|l| l.ends_with(" particle-substeps/s"))
@@ -211,11 +232,11 @@ fn errors_have_clear_messages_and_exit_codes() {
 #[test]
 fn overlapping_bodies_at_the_start_are_refused_naming_both() {
     // The small scene's obstacle moved onto its first yarn.
-    let text = std::fs::read_to_string(small_scene())
-        .unwrap()
-        .replace("center = [0.5, 0.45]", "center = [0.5, 0.60]");
-    let scene = tmp("overlap.toml");
-    std::fs::write(&scene, text).unwrap();
+    let scene = small_scene_with(
+        "center = [0.5, 0.45]",
+        "center = [0.5, 0.60]",
+        "overlap.toml",
+    );
     let out = yarnsim(&["run", scene.to_str().unwrap(), "-d", "1ms"]);
     assert_eq!(out.status.code(), Some(3));
     let err = stderr(&out);
@@ -320,17 +341,7 @@ fn output_errors_state_their_cause_once() {
 
 #[test]
 fn csv_times_are_steps_times_dt_printed_shortest() {
-    let csv = tmp("run-times.csv");
-    let out = yarnsim(&[
-        "run",
-        small_scene().to_str().unwrap(),
-        "--duration",
-        "2ms",
-        "--csv",
-        csv.to_str().unwrap(),
-    ]);
-    assert!(out.status.success(), "{}", stderr(&out));
-    let text = std::fs::read_to_string(&csv).unwrap();
+    let (_, text) = run_2ms_with_csv(&small_scene(), "run-times.csv");
     let times: Vec<&str> = text
         .lines()
         .skip(1)
@@ -344,16 +355,7 @@ fn csv_times_are_steps_times_dt_printed_shortest() {
 
 #[test]
 fn bench_table_fits_100_columns() {
-    let out = yarnsim(&[
-        "bench",
-        small_scene().to_str().unwrap(),
-        "--steps",
-        "5",
-        "--warmup",
-        "1",
-    ]);
-    assert!(out.status.success(), "{}", stderr(&out));
-    for line in stdout(&out).lines() {
+    for line in bench_small().lines() {
         assert!(line.chars().count() <= 100, "{line}");
     }
 }
@@ -363,21 +365,8 @@ fn bench_table_fits_100_columns() {
 /// them too.
 #[test]
 fn adaptive_substeps_are_reported_and_hit_every_frame() {
-    let text = std::fs::read_to_string(small_scene())
-        .unwrap()
-        .replace("dt = 0.00004", "dt = \"auto\"");
-    let scene = tmp("small-auto.toml");
-    std::fs::write(&scene, text).unwrap();
-    let csv = tmp("run-auto.csv");
-    let out = yarnsim(&[
-        "run",
-        scene.to_str().unwrap(),
-        "--duration",
-        "2ms",
-        "--csv",
-        csv.to_str().unwrap(),
-    ]);
-    assert!(out.status.success(), "{}", stderr(&out));
+    let scene = small_scene_with("dt = 0.00004", "dt = \"auto\"", "small-auto.toml");
+    let (out, text) = run_2ms_with_csv(&scene, "run-auto.csv");
     let s = stdout(&out);
     let line = s.lines().find(|l| l.starts_with("substeps")).unwrap();
     assert!(
@@ -386,7 +375,6 @@ fn adaptive_substeps_are_reported_and_hit_every_frame() {
     );
     let n: u64 = line.split_whitespace().nth(1).unwrap().parse().unwrap();
     assert!((5..50).contains(&n), "{line}: fixed 4e-5 s takes 50");
-    let text = std::fs::read_to_string(&csv).unwrap();
     let rows: Vec<Vec<&str>> = text
         .lines()
         .skip(1)

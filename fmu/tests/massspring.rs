@@ -7,8 +7,6 @@
 
 mod common;
 
-use std::ffi::{c_char, CString};
-
 use common::*;
 use yarnsim::massspring::scenes::{cloth, wire};
 use yarnsim::massspring::{Integrator, IntegratorOptions, MassSpringScene, Simulation, V3};
@@ -19,26 +17,6 @@ use YarnBundle::SceneFmu;
 
 /// The wire's frame time, used as the communication step.
 const H: f64 = 0.05;
-
-fn set_string(f: &Fmu, vr: u32, v: &str) -> fmi2Status {
-    let v = CString::new(v).unwrap();
-    let p = v.as_ptr();
-    // SAFETY: `f.c` came from `fmi2Instantiate` and lives until its `Fmu` drops; every pointer
-    // argument is a local that outlives the call.
-    unsafe { fmi2SetString(f.c, &vr, 1, &p) }
-}
-
-fn get_string(f: &Fmu, vr: u32) -> String {
-    let mut p: *const c_char = std::ptr::null();
-    // SAFETY: `f.c` came from `fmi2Instantiate` and lives until its `Fmu` drops; every pointer
-    // argument is a local that outlives the call.
-    assert_eq!(unsafe { fmi2GetString(f.c, &vr, 1, &mut p) }, fmi2OK);
-    // SAFETY: `fmi2GetString` returned OK, so `p` is a NUL-terminated string the instance keeps
-    // until its next call.
-    unsafe { std::ffi::CStr::from_ptr(p) }
-        .to_string_lossy()
-        .into_owned()
-}
 
 fn particle_vrs(n: usize) -> Vec<u32> {
     (0..3 * n as u32).map(|k| VR_PARTICLE_BASE + k).collect()
@@ -79,9 +57,9 @@ fn every_integrator_gives_the_library_bits_on_the_wire() {
     for integrator in Integrator::ALL {
         let f = Fmu::mass_spring(&layout);
         assert_eq!(f.yarns, 11);
-        assert_eq!(set_string(&f, VR_INTEGRATOR, integrator.name()), fmi2OK);
+        assert_eq!(f.set_string(VR_INTEGRATOR, integrator.name()), fmi2OK);
         f.init();
-        assert_eq!(get_string(&f, VR_INTEGRATOR), integrator.name());
+        assert_eq!(f.get_string(VR_INTEGRATOR), integrator.name());
         let mut sim = Simulation::new(&layout, integrator, IntegratorOptions::default()).unwrap();
         let dt = sim.dt();
         let mut done = 0;
@@ -165,7 +143,7 @@ fn cloth_through_the_fmu_stays_outside_the_sphere() {
 #[test]
 fn forward_euler_on_the_undamped_cloth_is_refused_at_initialization() {
     let f = Fmu::mass_spring(&cloth());
-    assert_eq!(set_string(&f, VR_INTEGRATOR, "forward-euler"), fmi2OK);
+    assert_eq!(f.set_string(VR_INTEGRATOR, "forward-euler"), fmi2OK);
     assert_eq!(f.setup(0.0, None), fmi2OK);
     // SAFETY: `f.c` came from `fmi2Instantiate` and lives until its `Fmu` drops; every pointer
     // argument is a local that outlives the call.
@@ -176,7 +154,7 @@ fn forward_euler_on_the_undamped_cloth_is_refused_at_initialization() {
     assert!(f.last_error().contains("no damping"), "{}", f.last_error());
     // An unknown integrator is refused when it is set.
     let g = Fmu::mass_spring(&wire());
-    assert_eq!(set_string(&g, VR_INTEGRATOR, "runge-kutta"), fmi2Error);
+    assert_eq!(g.set_string(VR_INTEGRATOR, "runge-kutta"), fmi2Error);
     assert!(g.last_error().contains("unknown integrator"));
 }
 
@@ -233,7 +211,7 @@ fn diverging_wire_is_discarded_never_ok_with_inf_outputs() {
     // SAFETY: `f.c` came from `fmi2Instantiate` and lives until its `Fmu` drops; every pointer
     // argument is a local that outlives the call.
     assert_eq!(unsafe { fmi2EnterInitializationMode(f.c) }, fmi2OK);
-    assert_eq!(set_string(&f, VR_INTEGRATOR, "symplectic-euler"), fmi2OK);
+    assert_eq!(f.set_string(VR_INTEGRATOR, "symplectic-euler"), fmi2OK);
     assert_eq!(f.set_real(&[VR_DT], &[0.5]), fmi2OK);
     // dt is beyond the stability bound: a warning, not an error.
     // SAFETY: `f.c` came from `fmi2Instantiate` and lives until its `Fmu` drops; every pointer
@@ -259,26 +237,7 @@ fn diverging_wire_is_discarded_never_ok_with_inf_outputs() {
     }
     assert_eq!(status, fmi2Discard, "{:?}", f.lines());
     assert!(steps > 2, "diverged only after {steps} steps");
-    assert!(f
-        .lines()
-        .iter()
-        .any(|l| l.0 == fmi2Discard && l.1 == "logStatusDiscard"));
-    let mut term = 0;
-    assert_eq!(
-        // SAFETY: `f.c` came from `fmi2Instantiate` and lives until its `Fmu` drops; every
-        // pointer argument is a local that outlives the call.
-        unsafe { fmi2GetBooleanStatus(f.c, fmi2Terminated, &mut term) },
-        fmi2OK
-    );
-    assert_eq!(term, fmi2True);
-    let mut lst = -1.0;
-    assert_eq!(
-        // SAFETY: `f.c` came from `fmi2Instantiate` and lives until its `Fmu` drops; every
-        // pointer argument is a local that outlives the call.
-        unsafe { fmi2GetRealStatus(f.c, fmi2LastSuccessfulTime, &mut lst) },
-        fmi2OK
-    );
-    assert_eq!(lst, t);
+    f.assert_discarded_at(t);
     assert_eq!(outputs(&f), before);
     assert_eq!(f.substeps(), steps);
     assert!(f.do_step(t, h) >= fmi2Error);
@@ -309,7 +268,7 @@ fn dt_parameter_sets_the_substep() {
 #[test]
 fn fmu_state_round_trip_gives_identical_bits() {
     let f = Fmu::mass_spring(&wire());
-    assert_eq!(set_string(&f, VR_INTEGRATOR, "trapezoidal"), fmi2OK);
+    assert_eq!(f.set_string(VR_INTEGRATOR, "trapezoidal"), fmi2OK);
     f.init();
     for k in 0..5 {
         assert_eq!(f.do_step(k as f64 * H, H), fmi2OK);
@@ -333,7 +292,7 @@ fn fmu_state_round_trip_gives_identical_bits() {
     assert_eq!(unsafe { fmi2SetFMUstate(f.c, restored) }, fmi2OK);
     // 5 frames of 10 substeps (the scene's time_step 0.005 s).
     assert_eq!(f.substeps(), 50);
-    assert_eq!(get_string(&f, VR_INTEGRATOR), "trapezoidal");
+    assert_eq!(f.get_string(VR_INTEGRATOR), "trapezoidal");
     assert_eq!(run_on(&f), first);
     // Into a fresh instance (default integrator): the state carries its
     // parameters.

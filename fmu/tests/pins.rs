@@ -6,8 +6,6 @@
 
 mod common;
 
-use std::ffi::CString;
-
 use common::*;
 use yarnsim::math::Vec2;
 use yarnsim::mpm::YarnSim;
@@ -16,26 +14,6 @@ use YarnBundle::ffi::*;
 use YarnBundle::yarn::variables::*;
 
 const H: f64 = 0.01;
-
-fn set_string(f: &Fmu, vr: u32, v: &str) -> fmi2Status {
-    let s = CString::new(v).unwrap();
-    let p = s.as_ptr();
-    // SAFETY: `f.c` came from `fmi2Instantiate` and lives until its `Fmu` drops; every pointer
-    // argument is a local that outlives the call.
-    unsafe { fmi2SetString(f.c, &vr, 1, &p) }
-}
-
-fn get_string(f: &Fmu, vr: u32) -> String {
-    let mut p: fmi2String = std::ptr::null();
-    // SAFETY: `f.c` came from `fmi2Instantiate` and lives until its `Fmu` drops; every pointer
-    // argument is a local that outlives the call.
-    assert_eq!(unsafe { fmi2GetString(f.c, &vr, 1, &mut p) }, fmi2OK);
-    // SAFETY: `fmi2GetString` returned OK, so `p` is a NUL-terminated string the instance keeps
-    // until its next call.
-    unsafe { std::ffi::CStr::from_ptr(p) }
-        .to_string_lossy()
-        .into_owned()
-}
 
 fn bits(v: &[f64]) -> Vec<u64> {
     v.iter().map(|x| x.to_bits()).collect()
@@ -70,7 +48,7 @@ fn transfer_parameters_give_the_library_bits() {
     let default = {
         let f = Fmu::new(&scene);
         f.init();
-        assert_eq!(get_string(&f, VR_TRANSFER_SCHEME), "flip");
+        assert_eq!(f.get_string(VR_TRANSFER_SCHEME), "flip");
         assert_eq!(f.get_real(&[VR_FLIP_RATIO]), Ok(vec![1.0]));
         fmu_run(&f)
     };
@@ -78,12 +56,12 @@ fn transfer_parameters_give_the_library_bits() {
     let mut outs = Vec::new();
     for (scheme, ratio) in [("apic", None), ("flip", Some(0.9)), ("apic", Some(0.5))] {
         let f = Fmu::new(&scene);
-        assert_eq!(set_string(&f, VR_TRANSFER_SCHEME, scheme), fmi2OK);
+        assert_eq!(f.set_string(VR_TRANSFER_SCHEME, scheme), fmi2OK);
         if let Some(r) = ratio {
             assert_eq!(f.set_real(&[VR_FLIP_RATIO], &[r]), fmi2OK);
         }
         f.init();
-        assert_eq!(get_string(&f, VR_TRANSFER_SCHEME), scheme);
+        assert_eq!(f.get_string(VR_TRANSFER_SCHEME), scheme);
         let out = fmu_run(&f);
         let mut lib = scene.clone();
         lib.transfer.scheme = if scheme == "apic" {
@@ -106,7 +84,7 @@ fn transfer_parameters_give_the_library_bits() {
 fn bad_transfer_values_are_refused_with_a_log_line() {
     let f = Fmu::new(&small_scene());
     for bad in ["", "FLIP", "asflip", "pic"] {
-        assert_eq!(set_string(&f, VR_TRANSFER_SCHEME, bad), fmi2Error, "{bad}");
+        assert_eq!(f.set_string(VR_TRANSFER_SCHEME, bad), fmi2Error, "{bad}");
         let e = f.last_error();
         assert!(
             e.contains("transfer.scheme") && e.contains("\"flip\" or \"apic\""),
@@ -132,17 +110,17 @@ fn bad_transfer_values_are_refused_with_a_log_line() {
         assert_eq!(f.set_real(&[VR_FLIP_RATIO], &[ok]), fmi2OK);
     }
     f.init();
-    assert_eq!(get_string(&f, VR_TRANSFER_SCHEME), "flip");
+    assert_eq!(f.get_string(VR_TRANSFER_SCHEME), "flip");
     assert_eq!(f.get_real(&[VR_FLIP_RATIO]), Ok(vec![1.0]));
     // Fixed parameters: refused after initialization.
-    assert_eq!(set_string(&f, VR_TRANSFER_SCHEME, "apic"), fmi2Error);
+    assert_eq!(f.set_string(VR_TRANSFER_SCHEME, "apic"), fmi2Error);
 }
 
 #[test]
 fn transfer_parameters_travel_in_the_fmu_state() {
     let scene = small_scene();
     let f = Fmu::new(&scene);
-    assert_eq!(set_string(&f, VR_TRANSFER_SCHEME, "apic"), fmi2OK);
+    assert_eq!(f.set_string(VR_TRANSFER_SCHEME, "apic"), fmi2OK);
     f.init();
     for k in 0..3 {
         assert_eq!(f.do_step(k as f64 * H, H), fmi2OK);
@@ -163,7 +141,7 @@ fn transfer_parameters_travel_in_the_fmu_state() {
     // argument is a local that outlives the call.
     assert_eq!(unsafe { fmi2SetFMUstate(g.c, d) }, fmi2OK);
     g.free_state(d);
-    assert_eq!(get_string(&g, VR_TRANSFER_SCHEME), "apic");
+    assert_eq!(g.get_string(VR_TRANSFER_SCHEME), "apic");
     for k in 3..6 {
         assert_eq!(g.do_step(k as f64 * H, H), fmi2OK);
     }
@@ -357,7 +335,7 @@ fn driven_pin_state_round_trip_gives_identical_bits() {
         out
     };
     let f = Fmu::new(&s);
-    assert_eq!(set_string(&f, VR_TRANSFER_SCHEME, "flip"), fmi2OK);
+    assert_eq!(f.set_string(VR_TRANSFER_SCHEME, "flip"), fmi2OK);
     f.init();
     drive(&f, 0, 4);
     let st = f.get_state();
@@ -377,7 +355,7 @@ fn driven_pin_state_round_trip_gives_identical_bits() {
     // argument is a local that outlives the call.
     assert_eq!(unsafe { fmi2SetFMUstate(g.c, d) }, fmi2OK);
     g.free_state(d);
-    assert_eq!(get_string(&g, VR_TRANSFER_SCHEME), "flip");
+    assert_eq!(g.get_string(VR_TRANSFER_SCHEME), "flip");
     assert_eq!(drive(&g, 4, 6), first);
 }
 
@@ -516,7 +494,7 @@ fn scene_parameter_must_keep_the_pins() {
     let f = Fmu::new(&s);
     let fixed = pinned_scene("");
     std::fs::write(f.dir.join("fixed.toml"), fixed.to_toml_string()).unwrap();
-    assert_eq!(set_string(&f, VR_SCENE, "fixed.toml"), fmi2Error);
+    assert_eq!(f.set_string(VR_SCENE, "fixed.toml"), fmi2Error);
     assert!(f.last_error().contains("other pins"), "{}", f.last_error());
     // SAFETY: `f.c` came from `fmi2Instantiate` and lives until its `Fmu` drops; every pointer
     // argument is a local that outlives the call.
@@ -525,7 +503,7 @@ fn scene_parameter_must_keep_the_pins() {
     moved.gravity = [0.0, -5.0];
     std::fs::write(f.dir.join("moved.toml"), moved.to_toml_string()).unwrap();
     assert_eq!(
-        set_string(&f, VR_SCENE, "moved.toml"),
+        f.set_string(VR_SCENE, "moved.toml"),
         fmi2OK,
         "{:?}",
         f.lines()

@@ -139,17 +139,7 @@ def capstan_slides(elements, mu, dt=5e-5, radius=2e-3, k_contact=1e4, nu=10.0, c
     c = O.CAPSTAN
     R, l1, l2, g = c["radius"], c["l1"], c["l2"], c["g"]
     Rc = R + radius
-    total = l1 + l2 + math.pi * Rc
-    pts = []
-    for i in range(elements + 1):
-        s = total * i / elements
-        if s <= l1:
-            pts.append((-Rc, -l1 + s))
-        elif s <= l1 + math.pi * Rc:
-            psi = math.pi - (s - l1) / Rc
-            pts.append((Rc * math.cos(psi), Rc * math.sin(psi)))
-        else:
-            pts.append((Rc, -(s - l1 - math.pi * Rc)))
+    pts, total = O.capstan_centreline(elements, Rc, c)
     pos = np.array([[x for x, _ in pts], [0.0] * (elements + 1), [z for _, z in pts]])
     area = math.pi * radius ** 2
     sim = Sim()

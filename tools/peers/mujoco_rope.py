@@ -121,17 +121,7 @@ def capstan_slides(elements, dt, mu, radius=1e-3):
     c = O.CAPSTAN
     R, l1, l2 = c["radius"], c["l1"], c["l2"]
     Rc = R + radius  # the centreline lies on the cylinder surface
-    total = l1 + l2 + math.pi * Rc
-    pts = []
-    for i in range(elements + 1):
-        s = total * i / elements
-        if s <= l1:
-            pts.append((-Rc, -l1 + s))
-        elif s <= l1 + math.pi * Rc:
-            psi = math.pi - (s - l1) / Rc
-            pts.append((Rc * math.cos(psi), Rc * math.sin(psi)))
-        else:
-            pts.append((Rc, -(s - l1 - math.pi * Rc)))
+    pts, total = O.capstan_centreline(elements, Rc, c)
     fr = f"{mu} 0.005 0.0001"
     contact = f'<contact condim="3" friction="{fr}" solref="2e-3 1" selfcollide="none"/>'
     xml = (

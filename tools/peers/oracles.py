@@ -84,6 +84,26 @@ def mean_over_two_periods(d):
     return sum(seg) / len(seg)
 
 
+def capstan_centreline(elements, rc, c=CAPSTAN):
+    """The capstan rope's centreline at `elements + 1` evenly spaced points
+    (x, z): up from `l1` below the centre on the left, over the half circle
+    of radius `rc` (the cylinder's radius plus the rope's), down to `l2` on
+    the right. Returns (points, total length)."""
+    l1, l2 = c["l1"], c["l2"]
+    total = l1 + l2 + math.pi * rc
+    pts = []
+    for i in range(elements + 1):
+        s = total * i / elements
+        if s <= l1:
+            pts.append((-rc, -l1 + s))
+        elif s <= l1 + math.pi * rc:
+            psi = math.pi - (s - l1) / rc
+            pts.append((rc * math.cos(psi), rc * math.sin(psi)))
+        else:
+            pts.append((rc, -(s - l1 - math.pi * rc)))
+    return pts, total
+
+
 def capstan_tension(mu, r, w, l1, n=2000):
     """Tension at the heavy end of the wrapped half circle: dT/ds = mu T / R
     + w (mu sin psi - cos psi), psi = pi - s / R, T(0) = w l1 (RK4)."""

@@ -220,6 +220,50 @@ impl Fmu {
         unsafe { fmi2SetBoolean(self.c, &vr, 1, &v) }
     }
 
+    pub fn set_string(&self, vr: u32, v: &str) -> fmi2Status {
+        let s = CString::new(v).unwrap();
+        let p = s.as_ptr();
+        // SAFETY: `self.c` came from `fmi2Instantiate` and lives until its `Fmu` drops; every
+        // pointer argument is a local that outlives the call.
+        unsafe { fmi2SetString(self.c, &vr, 1, &p) }
+    }
+
+    pub fn get_string(&self, vr: u32) -> String {
+        let mut p: fmi2String = std::ptr::null();
+        // SAFETY: `self.c` came from `fmi2Instantiate` and lives until its `Fmu` drops; every
+        // pointer argument is a local that outlives the call.
+        assert_eq!(unsafe { fmi2GetString(self.c, &vr, 1, &mut p) }, fmi2OK);
+        // SAFETY: `fmi2GetString` returned OK, so `p` is a NUL-terminated string the instance
+        // keeps until its next call.
+        unsafe { CStr::from_ptr(p) }.to_string_lossy().into_owned()
+    }
+
+    /// After a step that returned fmi2Discard: the log names
+    /// `logStatusDiscard`, the instance reports itself terminated, and its
+    /// last successful time is `t`.
+    pub fn assert_discarded_at(&self, t: f64) {
+        assert!(self
+            .lines()
+            .iter()
+            .any(|l| l.0 == fmi2Discard && l.1 == "logStatusDiscard"));
+        let mut term = 0;
+        assert_eq!(
+            // SAFETY: `self.c` came from `fmi2Instantiate` and lives until its `Fmu` drops;
+            // every pointer argument is a local that outlives the call.
+            unsafe { fmi2GetBooleanStatus(self.c, fmi2Terminated, &mut term) },
+            fmi2OK
+        );
+        assert_eq!(term, fmi2True);
+        let mut lst = -1.0;
+        assert_eq!(
+            // SAFETY: `self.c` came from `fmi2Instantiate` and lives until its `Fmu` drops;
+            // every pointer argument is a local that outlives the call.
+            unsafe { fmi2GetRealStatus(self.c, fmi2LastSuccessfulTime, &mut lst) },
+            fmi2OK
+        );
+        assert_eq!(lst, t);
+    }
+
     pub fn get_real(&self, vr: &[u32]) -> Result<Vec<f64>, fmi2Status> {
         let mut out = vec![f64::NAN; vr.len()];
         // SAFETY: `self.c` came from `fmi2Instantiate` and lives until its `Fmu` drops; every

@@ -103,111 +103,110 @@ pub fn strain_limit(
     passes: usize,
     solver: StrainSolver,
 ) -> (usize, f64) {
-    match solver {
-        StrainSolver::Jacobi => strain_limit_jacobi(sys, x, v, h, limit, passes),
-        StrainSolver::GaussSeidel => strain_limit_gauss_seidel(sys, x, v, h, limit, passes),
-    }
-}
-
-fn strain_limit_gauss_seidel(
-    sys: &System,
-    x: &mut [V3],
-    v: &mut [V3],
-    h: f64,
-    limit: f64,
-    passes: usize,
-) -> (usize, f64) {
-    let inv_mass: Vec<f64> = (0..sys.len())
-        .map(|i| {
-            if sys.is_free(i) {
-                1.0 / sys.masses[i]
-            } else {
-                0.0
-            }
-        })
-        .collect();
+    let mut sweep = Sweep::new(sys, solver);
     let mut done = 0;
     for _ in 0..passes {
         if within(max_strain(&sys.springs, x), limit) {
             break;
         }
         done += 1;
-        for sp in &sys.springs {
-            let (a, b) = (sp.a, sp.b);
-            let w = inv_mass[a] + inv_mass[b];
-            let dx = x[b] - x[a];
-            let l = dx.norm();
-            if w == 0.0 || l == 0.0 {
-                continue;
-            }
-            let target = l.clamp(
-                (1.0 - limit) * sp.rest_length,
-                (1.0 + limit) * sp.rest_length,
-            );
-            if target == l {
-                continue;
-            }
-            // Move a and b so that |x_b - x_a| = target.
-            let corr = dx * ((l - target) / (l * w));
-            let da = corr * inv_mass[a];
-            let db = -corr * inv_mass[b];
-            x[a] += da;
-            v[a] += da / h;
-            x[b] += db;
-            v[b] += db / h;
-        }
+        sweep.pass(sys, x, v, h, limit);
     }
     (done, max_strain(&sys.springs, x))
 }
 
-fn strain_limit_jacobi(
-    sys: &System,
-    x: &mut [V3],
-    v: &mut [V3],
-    h: f64,
-    limit: f64,
-    passes: usize,
-) -> (usize, f64) {
-    let n = sys.len();
-    let mut sum_x = vec![V3::zeros(); n];
-    let mut sum_n = vec![0u32; n];
-    let mut done = 0;
-    for _ in 0..passes {
-        if within(max_strain(&sys.springs, x), limit) {
-            break;
-        }
-        done += 1;
-        sum_x.iter_mut().for_each(|s| *s = V3::zeros());
-        sum_n.iter_mut().for_each(|c| *c = 0);
-        for sp in &sys.springs {
-            let (a, b) = (sp.a, sp.b);
-            let dx = x[a] - x[b];
-            let l = dx.norm();
-            let mid = (x[a] + x[b]) * 0.5;
-            let half = if l > 0.0 {
-                let target = l.clamp(
-                    (1.0 - limit) * sp.rest_length,
-                    (1.0 + limit) * sp.rest_length,
-                );
-                dx * (0.5 * target / l)
-            } else {
-                V3::zeros()
-            };
-            sum_x[a] += mid + half;
-            sum_x[b] += mid - half;
-            sum_n[a] += 1;
-            sum_n[b] += 1;
-        }
-        for i in 0..n {
-            if !sys.is_free(i) || sum_n[i] == 0 {
-                continue;
-            }
-            let xt = (x[i] * SELF_WEIGHT + sum_x[i]) / (SELF_WEIGHT + sum_n[i] as f64);
-            v[i] += (xt - x[i]) / h;
-            x[i] = xt;
+/// The length `l` of a spring clamped into `[(1-limit) l0, (1+limit) l0]`.
+fn target_length(l: f64, rest_length: f64, limit: f64) -> f64 {
+    l.clamp((1.0 - limit) * rest_length, (1.0 + limit) * rest_length)
+}
+
+/// One strain-limiting pass of either solver, with its scratch space.
+enum Sweep {
+    /// Spring by spring, in place: each free vertex moved by its inverse
+    /// mass share (zero for pinned and driven ones).
+    GaussSeidel { inv_mass: Vec<f64> },
+    /// Every spring's projection of both ends summed per vertex, then each
+    /// free vertex moved to the average, its own position weighted by
+    /// `SELF_WEIGHT`.
+    Jacobi { sum_x: Vec<V3>, sum_n: Vec<u32> },
+}
+
+impl Sweep {
+    fn new(sys: &System, solver: StrainSolver) -> Self {
+        let n = sys.len();
+        match solver {
+            StrainSolver::GaussSeidel => Sweep::GaussSeidel {
+                inv_mass: (0..n)
+                    .map(|i| {
+                        if sys.is_free(i) {
+                            1.0 / sys.masses[i]
+                        } else {
+                            0.0
+                        }
+                    })
+                    .collect(),
+            },
+            StrainSolver::Jacobi => Sweep::Jacobi {
+                sum_x: vec![V3::zeros(); n],
+                sum_n: vec![0u32; n],
+            },
         }
     }
-    (done, max_strain(&sys.springs, x))
+
+    fn pass(&mut self, sys: &System, x: &mut [V3], v: &mut [V3], h: f64, limit: f64) {
+        match self {
+            Sweep::GaussSeidel { inv_mass } => {
+                for sp in &sys.springs {
+                    let (a, b) = (sp.a, sp.b);
+                    let w = inv_mass[a] + inv_mass[b];
+                    let dx = x[b] - x[a];
+                    let l = dx.norm();
+                    if w == 0.0 || l == 0.0 {
+                        continue;
+                    }
+                    let target = target_length(l, sp.rest_length, limit);
+                    if target == l {
+                        continue;
+                    }
+                    // Move a and b so that |x_b - x_a| = target.
+                    let corr = dx * ((l - target) / (l * w));
+                    let da = corr * inv_mass[a];
+                    let db = -corr * inv_mass[b];
+                    x[a] += da;
+                    v[a] += da / h;
+                    x[b] += db;
+                    v[b] += db / h;
+                }
+            }
+            Sweep::Jacobi { sum_x, sum_n } => {
+                sum_x.iter_mut().for_each(|s| *s = V3::zeros());
+                sum_n.iter_mut().for_each(|c| *c = 0);
+                for sp in &sys.springs {
+                    let (a, b) = (sp.a, sp.b);
+                    let dx = x[a] - x[b];
+                    let l = dx.norm();
+                    let mid = (x[a] + x[b]) * 0.5;
+                    let half = if l > 0.0 {
+                        dx * (0.5 * target_length(l, sp.rest_length, limit) / l)
+                    } else {
+                        V3::zeros()
+                    };
+                    sum_x[a] += mid + half;
+                    sum_x[b] += mid - half;
+                    sum_n[a] += 1;
+                    sum_n[b] += 1;
+                }
+                for i in 0..sys.len() {
+                    if !sys.is_free(i) || sum_n[i] == 0 {
+                        continue;
+                    }
+                    let xt = (x[i] * SELF_WEIGHT + sum_x[i]) / (SELF_WEIGHT + sum_n[i] as f64);
+                    v[i] += (xt - x[i]) / h;
+                    x[i] = xt;
+                }
+            }
+        }
+    }
 }
 
 /// Projects free particles inside a sphere onto its surface, adding the
