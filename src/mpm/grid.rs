@@ -11,6 +11,7 @@
 //! buffer; the buffers are summed in chunk order, so results do not depend on
 //! the number of threads.
 
+use super::contact::ContactNode;
 use super::line_pool::{fit, LinePool};
 use crate::math::bspline::base_of;
 use crate::math::Vec2;
@@ -264,6 +265,9 @@ pub struct Grid {
     /// `is_active[b]` for every block.
     pub is_active: Vec<bool>,
     pub buffers: Vec<ScatterBuffer>,
+    /// The grid update's obstacle contact nodes, one list per block row
+    /// (kept between substeps so their storage is reused).
+    pub contacts: Vec<Vec<ContactNode>>,
 }
 
 /// The bounding box of stencil bases (lower-left nodes, clamped at 0) that
@@ -334,6 +338,7 @@ impl Grid {
             active: Vec::new(),
             is_active: Vec::new(),
             buffers: (0..CHUNKS).map(|_| ScatterBuffer::new(&geom)).collect(),
+            contacts: Vec::new(),
         }
     }
 

@@ -68,21 +68,21 @@ pub fn grid_update(grid: &mut Grid, dt: f64, ext: &GridForces, flip: bool) {
         wedges: &wedges,
     };
     let ctx = &ctx;
-    let contacts: Vec<Vec<ContactNode>> = grid
-        .node
+    let mut contacts = std::mem::take(&mut grid.contacts);
+    contacts.resize_with(geom.nbi, Vec::new);
+    grid.node
         .par_chunks_mut(band_len)
         .zip(bands)
+        .zip(contacts.par_iter_mut())
         .enumerate()
-        .map(|(bi, (band, mut srcs))| {
-            let mut contacts = Vec::new();
+        .for_each(|(bi, ((band, mut srcs), contacts))| {
+            contacts.clear();
             if flip {
-                grid_band::<true>(bi, band, &mut srcs, ctx, &mut contacts)
+                grid_band::<true>(bi, band, &mut srcs, ctx, contacts)
             } else {
-                grid_band::<false>(bi, band, &mut srcs, ctx, &mut contacts)
+                grid_band::<false>(bi, band, &mut srcs, ctx, contacts)
             }
-            contacts
-        })
-        .collect();
+        });
     if contacts.iter().any(|c| !c.is_empty()) {
         let (walls, cells, n) = (ext.walls, ext.wall_cells, geom.n);
         obstacle_friction(
@@ -106,6 +106,7 @@ pub fn grid_update(grid: &mut Grid, dt: f64, ext: &GridForces, flip: bool) {
             },
         );
     }
+    grid.contacts = contacts;
 }
 
 multiversion! {
@@ -117,7 +118,7 @@ multiversion! {
         ctx: &BandCtx,
         contacts: &mut Vec<ContactNode>,
     ) {
-        let BandCtx { is_active, geom, dt, ext, wedges } = *ctx;
+        let BandCtx { is_active, geom, ext, .. } = *ctx;
         let band_base = bi * geom.stride * BLOCK;
         let cells = ext.wall_cells;
         let dx = geom.dx;
@@ -151,65 +152,109 @@ multiversion! {
                     || j0 < cells
                     || i0 + BLOCK + cells > geom.n
                     || j0 + BLOCK + cells > geom.n);
-            for r in 0..BLOCK {
-                let i = i0 + r;
-                let row = r * geom.stride + bj * BLOCK;
-                for c in 0..BLOCK {
-                    let j = j0 + c;
-                    let mut acc = [0.0; P2G_LANES];
-                    for &k in srcs {
-                        let n = &mut buffers[k].node[row + c];
-                        for l in 0..P2G_LANES {
-                            acc[l] += n[l];
+            let blk = BlockAt { bj, i0, j0, near_wall };
+            if near_obstacle {
+                update_block::<FLIP, true>(&blk, band_base, band, buffers, srcs, ctx, contacts);
+            } else {
+                update_block::<FLIP, false>(&blk, band_base, band, buffers, srcs, ctx, contacts);
+            }
+        }
+    }
+}
+
+/// Where a block sits: its column in the band, first node and
+/// whether the walls reach it.
+struct BlockAt {
+    bj: usize,
+    i0: usize,
+    j0: usize,
+    near_wall: bool,
+}
+
+/// The grid update of one active block. `NEAR`: an obstacle is within
+/// reach, so the contact law runs and contact nodes are recorded (a
+/// separate instance keeps the common loop free of it).
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+fn update_block<const FLIP: bool, const NEAR: bool>(
+    blk: &BlockAt,
+    band_base: usize,
+    band: &mut [Node],
+    buffers: &mut [BandSrc],
+    srcs: &[usize],
+    ctx: &BandCtx,
+    contacts: &mut Vec<ContactNode>,
+) {
+    let BandCtx {
+        geom,
+        dt,
+        ext,
+        wedges,
+        ..
+    } = *ctx;
+    let BlockAt {
+        bj,
+        i0,
+        j0,
+        near_wall,
+        ..
+    } = *blk;
+    let cells = ext.wall_cells;
+    let dx = geom.dx;
+    for r in 0..BLOCK {
+        let i = i0 + r;
+        let row = r * geom.stride + bj * BLOCK;
+        for c in 0..BLOCK {
+            let j = j0 + c;
+            let mut acc = [0.0; P2G_LANES];
+            for &k in srcs {
+                let n = &mut buffers[k].node[row + c];
+                for l in 0..P2G_LANES {
+                    acc[l] += n[l];
+                }
+                *n = [0.0; P2G_LANES];
+            }
+            let out = &mut band[row + c];
+            if acc[M] <= 0.0 {
+                *out = [0.0; 4];
+                continue;
+            }
+            let inv_m = 1.0 / acc[M];
+            let mut v = Vec2::new(acc[PX] * inv_m, acc[PY] * inv_m) + ext.gravity * dt;
+            if ext.attractor.is_some() || NEAR {
+                let xi = Vec2::new(i as f64, j as f64) * dx;
+                if let Some((pos, strength)) = ext.attractor {
+                    let d = pos - xi;
+                    v += d * (dt * strength / (d.norm() + 0.01));
+                }
+                if NEAR {
+                    let touching = acc[MC] * inv_m;
+                    for (oi, o) in ext.obstacles.iter().enumerate() {
+                        if let Some((share, normal, impulse)) =
+                            obstacle_normal(o, xi, &mut v, acc[M], touching)
+                        {
+                            contacts.push(ContactNode {
+                                index: band_base + row + c,
+                                ij: [i as u32, j as u32],
+                                wedge: wedges.wedge(oi, normal),
+                                share,
+                                mass: share * acc[M],
+                                impulse,
+                                normal,
+                            });
                         }
-                        *n = [0.0; P2G_LANES];
                     }
-                    let out = &mut band[row + c];
-                    if acc[M] <= 0.0 {
-                        *out = [0.0; 4];
-                        continue;
-                    }
-                    let inv_m = 1.0 / acc[M];
-                    let mut v = Vec2::new(acc[PX] * inv_m, acc[PY] * inv_m) + ext.gravity * dt;
-                    if ext.attractor.is_some() || near_obstacle {
-                        let xi = Vec2::new(i as f64, j as f64) * dx;
-                        if let Some((pos, strength)) = ext.attractor {
-                            let d = pos - xi;
-                            v += d * (dt * strength / (d.norm() + 0.01));
-                        }
-                        if near_obstacle {
-                            let touching = acc[MC] * inv_m;
-                            for (oi, o) in ext.obstacles.iter().enumerate() {
-                                if let Some((share, normal, impulse)) =
-                                    obstacle_normal(o, xi, &mut v, acc[M], touching)
-                                {
-                                    contacts.push(ContactNode {
-                                        index: band_base + row + c,
-                                        ij: [i as u32, j as u32],
-                                        wedge: wedges.wedge(oi, normal),
-                                        share,
-                                        mass: share * acc[M],
-                                        impulse,
-                                        normal,
-                                    });
-                                }
-                            }
-                        }
-                    }
-                    if near_wall {
-                        v = wall_velocity(ext.walls, cells, geom.n, i, j, v);
-                    }
-                    *out = if FLIP {
-                        let v_old = Vec2::new(
-                            (acc[PX] - acc[FX]) * inv_m,
-                            (acc[PY] - acc[FY]) * inv_m,
-                        );
-                        [v.x, v.y, v.x - v_old.x, v.y - v_old.y]
-                    } else {
-                        [v.x, v.y, 0.0, 0.0]
-                    };
                 }
             }
+            if near_wall {
+                v = wall_velocity(ext.walls, cells, geom.n, i, j, v);
+            }
+            *out = if FLIP {
+                let v_old = Vec2::new((acc[PX] - acc[FX]) * inv_m, (acc[PY] - acc[FY]) * inv_m);
+                [v.x, v.y, v.x - v_old.x, v.y - v_old.y]
+            } else {
+                [v.x, v.y, 0.0, 0.0]
+            };
         }
     }
 }
