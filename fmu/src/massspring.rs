@@ -13,7 +13,7 @@ use yarnsim::massspring::{Integrator, IntegratorOptions, MassSpringScene, Simula
 use crate::fmu_model::{
     refuse, Checkpoint, FmuModel, ModelResult, ModelState, ParamCheck, SetContext, StepFailure,
 };
-use crate::model::{input, output, parameter, Description, Start, VarSpec, VarType, Variable};
+use crate::model::{output, var, Causality::*, Description, Start, VarSpec, VarType, Variable};
 use crate::state_bytes::{Reader, Writer};
 
 /// The FMI model identifier of a mass-spring FMU.
@@ -54,11 +54,11 @@ pub fn num_particles(layout: &MassSpringScene) -> Result<usize, String> {
 /// ([`crate::model::COMMON_VARIABLES`]) and the per-particle outputs, in
 /// `ModelVariables` order; start values come from the layout.
 pub static MASS_SPRING_VARIABLES: [VarSpec<MassSpringScene>; 10] = [
-    input("gravity.x", VR_GRAVITY_X, VarType::Real, Some("m/s2"), Start::Real(|l| l.gravity[0]), "Gravity x, |g| at most 1e6"),
-    input("gravity.y", VR_GRAVITY_Y, VarType::Real, Some("m/s2"), Start::Real(|l| l.gravity[1]), "Gravity y, |g| at most 1e6"),
-    input("gravity.z", VR_GRAVITY_Z, VarType::Real, Some("m/s2"), Start::Real(|l| l.gravity[2]), "Gravity z, |g| at most 1e6"),
-    parameter("dt", VR_DT, VarType::Real, Some("s"), Start::Real(|_| 0.0), "Substep size; 0: the integrator's own (CFL-limited for the explicit schemes, the scene's time_step otherwise). A communication step runs an integer number of substeps"),
-    parameter("integrator", VR_INTEGRATOR, VarType::String, None, Start::Text(DEFAULT_INTEGRATOR_NAME), "Time integrator: one of forward-euler, symplectic-euler, trapezoidal, backward-euler, chebyshev-jacobi, pbd"),
+    var(Input, "gravity.x", VR_GRAVITY_X, Some("m/s2"), Start::Real(|l| l.gravity[0]), "Gravity x, |g| at most 1e6"),
+    var(Input, "gravity.y", VR_GRAVITY_Y, Some("m/s2"), Start::Real(|l| l.gravity[1]), "Gravity y, |g| at most 1e6"),
+    var(Input, "gravity.z", VR_GRAVITY_Z, Some("m/s2"), Start::Real(|l| l.gravity[2]), "Gravity z, |g| at most 1e6"),
+    var(Parameter, "dt", VR_DT, Some("s"), Start::Real(|_| 0.0), "Substep size; 0: the integrator's own (CFL-limited for the explicit schemes, the scene's time_step otherwise). A communication step runs an integer number of substeps"),
+    var(Parameter, "integrator", VR_INTEGRATOR, None, Start::Text(DEFAULT_INTEGRATOR_NAME), "Time integrator: one of forward-euler, symplectic-euler, trapezoidal, backward-euler, chebyshev-jacobi, pbd"),
     output("kinetic_energy", VR_KINETIC_ENERGY, Some("J"), "Kinetic energy"),
     output("elastic_energy", VR_ELASTIC_ENERGY, Some("J"), "Elastic energy of the springs"),
     output("gravity_energy", VR_GRAVITY_ENERGY, Some("J"), "Gravitational energy -sum m g.x"),

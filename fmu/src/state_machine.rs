@@ -79,19 +79,13 @@ impl Phase {
     pub fn code(self) -> u8 {
         self as u8
     }
+    /// The phase whose [`Self::code`] is `c`.
     pub fn from_code(c: u8) -> Option<Phase> {
-        use Phase::*;
-        [
-            Instantiated,
-            InitializationMode,
-            StepComplete,
-            StepFailed,
-            Terminated,
-            Error,
-            Fatal,
-        ]
-        .get(c as usize)
-        .copied()
+        NOT_FATAL
+            .iter()
+            .copied()
+            .chain([Phase::Fatal])
+            .find(|p| p.code() == c)
     }
 }
 
@@ -189,6 +183,14 @@ pub fn require(phase: Phase, func: &str) -> Res {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn every_phase_reads_back_from_its_code() {
+        for p in NOT_FATAL.iter().copied().chain([Fatal]) {
+            assert_eq!(Phase::from_code(p.code()), Some(p));
+        }
+        assert_eq!(Phase::from_code(Fatal.code() + 1), None);
+    }
 
     #[test]
     fn one_row_per_function_and_no_function_in_the_fatal_state() {

@@ -27,12 +27,7 @@ fn model_description_structure() {
     let xml = model_description(&scene);
     let yarns = num_yarns(&scene);
     assert_eq!(yarns, 3);
-    let outputs: Vec<usize> = vars
-        .iter()
-        .enumerate()
-        .filter(|(_, v)| v.causality == "output")
-        .map(|(i, _)| i + 1)
-        .collect();
+    let outputs = YarnBundle::model::output_indices(&vars);
     assert_eq!(outputs.len(), 4 * yarns + 4);
     for i in &outputs {
         // Listed in <Outputs> and <InitialUnknowns>, always with dependencies.

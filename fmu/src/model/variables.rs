@@ -49,13 +49,6 @@ pub struct SceneField<S> {
     pub max: f64,
 }
 
-impl<S> Clone for SceneField<S> {
-    fn clone(&self) -> Self {
-        *self
-    }
-}
-impl<S> Copy for SceneField<S> {}
-
 /// Where a variable's start value comes from (a scene of type `S`).
 pub enum Start<S> {
     /// Outputs have none.
@@ -72,13 +65,6 @@ pub enum Start<S> {
     Name(fn(&S) -> &'static str),
 }
 
-impl<S> Clone for Start<S> {
-    fn clone(&self) -> Self {
-        *self
-    }
-}
-impl<S> Copy for Start<S> {}
-
 /// One row of a model's variable table; `S` is the scene type its start
 /// values are read from (the yarn scene, or the mass-spring layout).
 pub struct VarSpec<S> {
@@ -92,12 +78,32 @@ pub struct VarSpec<S> {
     pub description: &'static str,
 }
 
-impl<S> Clone for VarSpec<S> {
-    fn clone(&self) -> Self {
-        *self
+/// `Clone` and `Copy` for a table type over any scene type `S` (the
+/// derives would ask `S: Copy`; these types hold only function pointers and
+/// static data).
+macro_rules! copy_for_any_scene {
+    ($($t:ident),*) => {$(
+        impl<S> Clone for $t<S> {
+            fn clone(&self) -> Self {
+                *self
+            }
+        }
+        impl<S> Copy for $t<S> {}
+    )*};
+}
+copy_for_any_scene!(SceneField, Start, VarSpec);
+
+impl<S> Start<S> {
+    /// The base type of a variable with this start value (outputs, which
+    /// have none, are Real).
+    pub const fn var_type(&self) -> VarType {
+        match self {
+            Start::None | Start::Scene(_) | Start::Real(_) => VarType::Real,
+            Start::Bool(_) => VarType::Boolean,
+            Start::Text(_) | Start::Name(_) => VarType::String,
+        }
     }
 }
-impl<S> Copy for VarSpec<S> {}
 
 impl<S> VarSpec<S> {
     /// The variable as written in `modelDescription.xml`, for this scene.
@@ -122,45 +128,38 @@ impl<S> VarSpec<S> {
     }
 }
 
-/// An input row (Real inputs continuous, others discrete).
-pub const fn input<S>(
-    name: &'static str,
-    vr: u32,
-    ty: VarType,
-    unit: Option<&'static str>,
-    start: Start<S>,
-    description: &'static str,
-) -> VarSpec<S> {
-    VarSpec {
-        name,
-        vr,
-        ty,
-        causality: "input",
-        variability: match ty {
-            VarType::Real => "continuous",
-            _ => "discrete",
-        },
-        unit,
-        start,
-        description,
-    }
+/// What an input or parameter row of a table is.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Causality {
+    /// An input: continuous if Real, else discrete.
+    Input,
+    /// A fixed parameter: set before the end of initialization only.
+    Parameter,
 }
 
-/// A fixed parameter row.
-pub const fn parameter<S>(
+/// An input or fixed-parameter row; its type follows from its start value.
+pub const fn var<S>(
+    causality: Causality,
     name: &'static str,
     vr: u32,
-    ty: VarType,
     unit: Option<&'static str>,
     start: Start<S>,
     description: &'static str,
 ) -> VarSpec<S> {
+    let ty = start.var_type();
     VarSpec {
         name,
         vr,
         ty,
-        causality: "parameter",
-        variability: "fixed",
+        causality: match causality {
+            Causality::Input => "input",
+            Causality::Parameter => "parameter",
+        },
+        variability: match (causality, ty) {
+            (Causality::Parameter, _) => "fixed",
+            (Causality::Input, VarType::Real) => "continuous",
+            (Causality::Input, _) => "discrete",
+        },
         unit,
         start,
         description,

@@ -114,6 +114,16 @@ pub fn utc_date_time(secs: i64) -> String {
     )
 }
 
+/// The 1-based indices (positions in `<ModelVariables>`) of the outputs, in
+/// order: how `<ModelStructure>` names them.
+pub fn output_indices(vars: &[Variable]) -> Vec<usize> {
+    vars.iter()
+        .enumerate()
+        .filter(|(_, v)| v.causality == "output")
+        .map(|(i, _)| i + 1)
+        .collect()
+}
+
 /// Writes `modelDescription.xml`; only the units the variables use are defined.
 pub fn write_model_description(d: &Description) -> String {
     let vars = &d.variables;
@@ -188,12 +198,7 @@ pub fn write_model_description(d: &Description) -> String {
         x.push_str("/>\n    </ScalarVariable>\n");
     }
     x.push_str("  </ModelVariables>\n  <ModelStructure>\n    <Outputs>\n");
-    let outputs: Vec<usize> = vars
-        .iter()
-        .enumerate()
-        .filter(|(_, v)| v.causality == "output")
-        .map(|(i, _)| i + 1)
-        .collect();
+    let outputs = output_indices(vars);
     // 1-based indices of value references, ascending.
     let indices = |vrs: &[u32]| -> String {
         let mut ix: Vec<usize> = vrs

@@ -9,6 +9,7 @@
 use yarnsim::scene::{PinMotionKind, StepSize, TransferScheme, YarnScene};
 
 use crate::model::*;
+use Causality::{Input, Parameter};
 
 /// The FMI model identifier: the shared library's and the C symbols' name.
 pub const MODEL_IDENTIFIER: &str = "YarnBundle";
@@ -85,8 +86,6 @@ pub fn parse_scheme(s: &str) -> Option<TransferScheme> {
     }
 }
 
-use VarType::{Boolean, Real};
-
 /// Sets the scene's `time.dt` from the `dt` parameter: 0 is `"auto"` (the
 /// scene's `safety` and `dt_max` kept), a positive value a fixed substep
 /// (`safety` and `dt_max`, which only `"auto"` takes, dropped).
@@ -105,23 +104,23 @@ fn set_dt(s: &mut YarnScene, v: f64) {
 /// `ModelVariables` order. The Real parameters read and override the scene
 /// through their [`SceneField`].
 pub static YARN_VARIABLES: [VarSpec<YarnScene>; 20] = [
-    input("attractor.x", VR_ATTRACTOR_X, Real, Some("m"), Start::Real(|s| s.attractor.position[0]), "Attractor position x"),
-    input("attractor.y", VR_ATTRACTOR_Y, Real, Some("m"), Start::Real(|s| s.attractor.position[1]), "Attractor position y"),
-    input("attractor.strength", VR_ATTRACTOR_STRENGTH, Real, Some("m/s2"), Start::Real(|s| s.attractor.strength), "Attractor acceleration magnitude, 0 to 1e6"),
-    input("attractor.active", VR_ATTRACTOR_ACTIVE, Boolean, None, Start::Bool(|s| s.attractor.active), "Whether the attractor acts"),
-    input("gravity.x", VR_GRAVITY_X, Real, Some("m/s2"), Start::Real(|s| s.gravity[0]), "Gravity x, |g| at most 1e6"),
-    input("gravity.y", VR_GRAVITY_Y, Real, Some("m/s2"), Start::Real(|s| s.gravity[1]), "Gravity y, |g| at most 1e6"),
-    parameter("material.k", VR_K, Real, Some("Pa"), material(|s| s.material.k, |s, v| s.material.k = v, false), "Fiber stretch stiffness"),
-    parameter("material.gamma", VR_GAMMA, Real, Some("Pa"), material(|s| s.material.gamma, |s, v| s.material.gamma = v, false), "Fiber shear stiffness"),
-    parameter("material.youngs_modulus", VR_YOUNGS_MODULUS, Real, Some("Pa"), material(|s| s.material.youngs_modulus, |s, v| s.material.youngs_modulus = v, false), "Young's modulus of the cross-section"),
-    parameter("material.friction", VR_FRICTION, Real, None, material(|s| s.material.friction, |s, v| s.material.friction = v, false), "Mohr-Coulomb friction coefficient"),
-    parameter("material.bending", VR_BENDING, Real, Some("Pa"), material(|s| s.material.bending, |s, v| s.material.bending = v, false), "Bending modulus (0 disables bending)"),
-    parameter("material.density", VR_DENSITY, Real, Some("kg/m"), material(|s| s.material.density, |s, v| s.material.density = v, true), "Line density"),
-    parameter("dt", VR_DT, Real, Some("s"), Start::Scene(SceneField { get: |s| s.time.dt.fixed().unwrap_or(0.0), set: set_dt, positive: false, max: 1e12 }), "Substep size; 0: adaptive (the scene's dt = \"auto\": each substep is the safety factor times the stability bound of the current state, the last one before a communication point shortened to land on it). A fixed dt runs an integer number of substeps per communication step"),
-    parameter("material.plasticity", VR_PLASTICITY, Boolean, None, Start::Bool(|s| s.material.plasticity), "Mohr-Coulomb return mapping on or off"),
-    parameter("transfer.scheme", VR_TRANSFER_SCHEME, VarType::String, None, Start::Name(|s| scheme_name(s.transfer.scheme)), "Particle velocity update of grid-to-particle: flip (FLIP/APIC blend by transfer.flip_ratio) or apic"),
-    parameter("transfer.flip_ratio", VR_FLIP_RATIO, Real, None, Start::Scene(SceneField { get: |s| s.transfer.flip_ratio, set: |s, v| s.transfer.flip_ratio = v, positive: false, max: 1.0 }), "FLIP ratio in [0, 1] of the flip scheme (1: pure FLIP; ignored by apic)"),
-    parameter("scene", VR_SCENE, VarType::String, None, Start::Text(SCENE_FILE), "Scene file: a path relative to the FMU's resources folder, or absolute; it must create as many yarns as the bundled scene and have its pins (same number, same input pins)"),
+    var(Input, "attractor.x", VR_ATTRACTOR_X, Some("m"), Start::Real(|s| s.attractor.position[0]), "Attractor position x"),
+    var(Input, "attractor.y", VR_ATTRACTOR_Y, Some("m"), Start::Real(|s| s.attractor.position[1]), "Attractor position y"),
+    var(Input, "attractor.strength", VR_ATTRACTOR_STRENGTH, Some("m/s2"), Start::Real(|s| s.attractor.strength), "Attractor acceleration magnitude, 0 to 1e6"),
+    var(Input, "attractor.active", VR_ATTRACTOR_ACTIVE, None, Start::Bool(|s| s.attractor.active), "Whether the attractor acts"),
+    var(Input, "gravity.x", VR_GRAVITY_X, Some("m/s2"), Start::Real(|s| s.gravity[0]), "Gravity x, |g| at most 1e6"),
+    var(Input, "gravity.y", VR_GRAVITY_Y, Some("m/s2"), Start::Real(|s| s.gravity[1]), "Gravity y, |g| at most 1e6"),
+    var(Parameter, "material.k", VR_K, Some("Pa"), material(|s| s.material.k, |s, v| s.material.k = v, false), "Fiber stretch stiffness"),
+    var(Parameter, "material.gamma", VR_GAMMA, Some("Pa"), material(|s| s.material.gamma, |s, v| s.material.gamma = v, false), "Fiber shear stiffness"),
+    var(Parameter, "material.youngs_modulus", VR_YOUNGS_MODULUS, Some("Pa"), material(|s| s.material.youngs_modulus, |s, v| s.material.youngs_modulus = v, false), "Young's modulus of the cross-section"),
+    var(Parameter, "material.friction", VR_FRICTION, None, material(|s| s.material.friction, |s, v| s.material.friction = v, false), "Mohr-Coulomb friction coefficient"),
+    var(Parameter, "material.bending", VR_BENDING, Some("Pa"), material(|s| s.material.bending, |s, v| s.material.bending = v, false), "Bending modulus (0 disables bending)"),
+    var(Parameter, "material.density", VR_DENSITY, Some("kg/m"), material(|s| s.material.density, |s, v| s.material.density = v, true), "Line density"),
+    var(Parameter, "dt", VR_DT, Some("s"), Start::Scene(SceneField { get: |s| s.time.dt.fixed().unwrap_or(0.0), set: set_dt, positive: false, max: 1e12 }), "Substep size; 0: adaptive (the scene's dt = \"auto\": each substep is the safety factor times the stability bound of the current state, the last one before a communication point shortened to land on it). A fixed dt runs an integer number of substeps per communication step"),
+    var(Parameter, "material.plasticity", VR_PLASTICITY, None, Start::Bool(|s| s.material.plasticity), "Mohr-Coulomb return mapping on or off"),
+    var(Parameter, "transfer.scheme", VR_TRANSFER_SCHEME, None, Start::Name(|s| scheme_name(s.transfer.scheme)), "Particle velocity update of grid-to-particle: flip (FLIP/APIC blend by transfer.flip_ratio) or apic"),
+    var(Parameter, "transfer.flip_ratio", VR_FLIP_RATIO, None, Start::Scene(SceneField { get: |s| s.transfer.flip_ratio, set: |s, v| s.transfer.flip_ratio = v, positive: false, max: 1.0 }), "FLIP ratio in [0, 1] of the flip scheme (1: pure FLIP; ignored by apic)"),
+    var(Parameter, "scene", VR_SCENE, None, Start::Text(SCENE_FILE), "Scene file: a path relative to the FMU's resources folder, or absolute; it must create as many yarns as the bundled scene and have its pins (same number, same input pins)"),
     output("kinetic_energy", VR_KINETIC_ENERGY, Some("J"), "Kinetic energy (per unit depth)"),
     output("elastic_energy", VR_ELASTIC_ENERGY, Some("J"), "Elastic energy (per unit depth)"),
     output("max_stretch", VR_MAX_STRETCH, None, "Largest segment stretch |x_r - x_l| / l0"),
