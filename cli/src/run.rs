@@ -9,7 +9,7 @@ use yarnsim::mpm::Diagnostics;
 use yarnsim::scene::Scene;
 use yarnsim::YarnSim;
 
-use crate::driver::{interrupt_flag, progress_bar, run_frames, FrameRun};
+use crate::driver::{interrupt_flag, progress_bar, run_frames};
 use crate::error::CliError;
 use crate::massspring::{IntegratorArgs, MassSpringRun, MsDiagnostics};
 use crate::schedule::Schedule;
@@ -51,7 +51,7 @@ pub fn run_massspring(
     let initial = run.diagnostics();
     let mut last = initial;
     let progress = progress_bar(schedule.total_steps, &run.name);
-    let FrameRun { outcome, failure } = run_frames(
+    let frames = run_frames(
         run,
         &schedule,
         &interrupt_flag(),
@@ -74,13 +74,8 @@ pub fn run_massspring(
         particles_detail: format!("{fixed} pinned or driven, {springs} springs, {spheres} spheres"),
         dt: run.h,
         adaptive_dt: None,
-        substeps: outcome.substeps,
-        frames: outcome.last_frame,
-        sim_time: last.time - initial.time,
-        wall_seconds: outcome.step_seconds,
-        interrupted: outcome.interrupted,
-        failure: failure.map(|e| e.to_string()),
         diagnostics: ms_rows(&initial, &last),
+        ..Summary::of_run(frames, last.time - initial.time)
     })
 }
 
@@ -160,7 +155,7 @@ pub fn run_yarn(sim: &mut YarnSim, duration: f64, csv: Option<&Path>) -> Result<
     let progress = progress_bar(schedule.total_steps, &sc.name);
     let dt = sim.dt();
     sim.reset_dt_stats();
-    let FrameRun { outcome, failure } = run_frames(
+    let frames = run_frames(
         sim,
         &schedule,
         &interrupt_flag(),
@@ -193,13 +188,8 @@ pub fn run_yarn(sim: &mut YarnSim, duration: f64, csv: Option<&Path>) -> Result<
             .then(|| sim.dt_stats())
             .filter(|s| s.substeps > 0)
             .map(|s| dt_range(&s)),
-        substeps: outcome.substeps,
-        frames: outcome.last_frame,
-        sim_time: last.time - initial.time,
-        wall_seconds: outcome.step_seconds,
-        interrupted: outcome.interrupted,
-        failure: failure.map(|e| e.to_string()),
         diagnostics: yarn_rows(&initial, &last),
+        ..Summary::of_run(frames, last.time - initial.time)
     })
 }
 

@@ -4,11 +4,13 @@ use std::fmt::Write as _;
 
 use yarnsim::mpm::Diagnostics;
 
+use crate::driver::FrameRun;
+
 /// One diagnostic row of the summary: name, value at the start, value at the end.
 pub type DiagRow = (&'static str, f64, f64);
 
 /// Everything the summary table shows.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, Default, PartialEq)]
 pub struct Summary {
     pub scene: String,
     /// The model and its solver, e.g. `yarn (MPM)` or `mass-spring, backward-euler`.
@@ -34,6 +36,21 @@ pub struct Summary {
 }
 
 impl Summary {
+    /// The summary of a run of frames that simulated `sim_time` seconds:
+    /// its substeps, frames, wall time and how it ended; the caller fills in
+    /// what was run.
+    pub fn of_run(run: FrameRun, sim_time: f64) -> Self {
+        Summary {
+            substeps: run.outcome.substeps,
+            frames: run.outcome.last_frame,
+            sim_time,
+            wall_seconds: run.outcome.step_seconds,
+            interrupted: run.outcome.interrupted,
+            failure: run.failure.map(|e| e.to_string()),
+            ..Default::default()
+        }
+    }
+
     /// Particle-substeps per wall-clock second; 0 when nothing was timed.
     pub fn throughput(&self) -> f64 {
         if self.wall_seconds > 0.0 {

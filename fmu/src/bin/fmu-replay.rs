@@ -121,6 +121,14 @@ fn input_pins(scene: &YarnScene) -> Vec<usize> {
         .collect()
 }
 
+/// Appends `,value` for each value, in the shortest form that reads back
+/// to the same `f64` (`{:?}`).
+fn push_values(csv: &mut String, values: impl IntoIterator<Item = f64>) {
+    for v in values {
+        let _ = write!(csv, ",{v:?}");
+    }
+}
+
 fn replay_yarn(scene: &YarnScene, rows: &[Vec<f64>], h: f64, stop: f64) -> Result<String, String> {
     let mut sim = YarnSim::new(scene).map_err(|e| e.to_string())?;
     let yarns = sim.num_yarns();
@@ -140,22 +148,17 @@ fn replay_yarn(scene: &YarnScene, rows: &[Vec<f64>], h: f64, stop: f64) -> Resul
     csv.push('\n');
     let record = |csv: &mut String, t: f64, sim: &YarnSim, force: &[Vec2]| {
         let _ = write!(csv, "{t:?}");
-        for i in 0..yarns {
-            let (l, r) = sim.yarn_endpoints(i);
-            let _ = write!(csv, ",{:?},{:?},{:?},{:?}", l.x, l.y, r.x, r.y);
-        }
-        let d = sim.diagnostics();
-        let _ = write!(
+        push_values(
             csv,
-            ",{:?},{:?},{:?},{}",
-            d.kinetic_energy,
-            d.elastic_energy,
-            d.max_stretch,
-            sim.steps()
+            (0..yarns).flat_map(|i| {
+                let (l, r) = sim.yarn_endpoints(i);
+                [l.x, l.y, r.x, r.y]
+            }),
         );
-        for f in force {
-            let _ = write!(csv, ",{:?},{:?}", f.x, f.y);
-        }
+        let d = sim.diagnostics();
+        push_values(csv, [d.kinetic_energy, d.elastic_energy, d.max_stretch]);
+        let _ = write!(csv, ",{}", sim.steps());
+        push_values(csv, force.iter().flat_map(|f| [f.x, f.y]));
         csv.push('\n');
     };
     record(&mut csv, 0.0, &sim, &force);
@@ -238,18 +241,13 @@ fn replay_mass_spring(
     csv.push('\n');
     let record = |csv: &mut String, t: f64, sim: &Simulation, steps: u64| {
         let e = sim.energies();
-        let _ = write!(
+        let _ = write!(csv, "{t:?}");
+        push_values(
             csv,
-            "{t:?},{:?},{:?},{:?},{:?},{:?},{steps}",
-            e.kinetic,
-            e.elastic,
-            e.gravity,
-            e.total(),
-            sim.max_strain()
+            [e.kinetic, e.elastic, e.gravity, e.total(), sim.max_strain()],
         );
-        for p in sim.positions() {
-            let _ = write!(csv, ",{:?},{:?},{:?}", p.x, p.y, p.z);
-        }
+        let _ = write!(csv, ",{steps}");
+        push_values(csv, sim.positions().iter().flat_map(|p| [p.x, p.y, p.z]));
         csv.push('\n');
     };
     // fmpy sets the inputs of t = 0 in initialization mode, before it reads
