@@ -2,23 +2,10 @@
 
 use yarnsim::scene::{builtin, builtin_names, Scene, SceneError, YarnScene};
 
-const GOOD: &str = r#"
-name = "t"
-[grid]
-resolution = 64
-[time]
-dt = 1e-4
-[material]
-k = 1000
-gamma = 500.0
-youngs_modulus = 1000.0
-friction = 0.05
-[[yarns]]
-start = [0.2, 0.5]
-direction = [1.0, 0.0]
-length = 0.5
-vertices = 20
-"#;
+mod common;
+
+/// The smallest complete yarn scene file.
+const GOOD: &str = common::MINIMAL_TOML;
 
 fn err(text: &str) -> SceneError {
     YarnScene::from_toml_str(text).expect_err("must be rejected")

@@ -9,7 +9,11 @@ mod common;
 use common::scene;
 use yarnsim::math::{perp, Mat2, Vec2};
 use yarnsim::scene::{SceneError, TransferScheme, WallMode, YarnScene};
-use yarnsim::testing::{bessel_j0, small_yarn_scene};
+use yarnsim::testing::{
+    cantilever_setup, cantilever_toml, capstan_toml, hanging_chain_period, hanging_chain_toml,
+    small_yarn_scene, two_periods_about_mean, Capstan, ZeroCrossings, CAPSTAN_PURE_STRING,
+    CHAIN_GRAVITY,
+};
 use yarnsim::YarnSim;
 
 // ---- capstan ---------------------------------------------------------------
@@ -52,35 +56,6 @@ fn capstan_threshold(r: f64, l1: f64, l2: f64) -> f64 {
     0.5 * (lo + hi)
 }
 
-/// Resolution, time step, gravity and material of a capstan scene.
-#[derive(Clone, Copy, Debug)]
-struct Capstan {
-    res: u32,
-    dt: f64,
-    /// Gravity (the threshold does not depend on it).
-    g: f64,
-    gamma: f64,
-    youngs_modulus: f64,
-    friction: f64,
-    bending: f64,
-    plasticity: bool,
-}
-
-/// Material: a pure string at 128^2, dt 1e-4. Bending 0 (all the
-/// resistance is friction), k = 1000 (strain below 0.1 %), plasticity off,
-/// and no cross-section energy (gamma = 0, E = 0); a small gravity keeps the
-/// elastic stretch small.
-const PURE_STRING: Capstan = Capstan {
-    res: 128,
-    dt: 1e-4,
-    g: 2.0,
-    gamma: 0.0,
-    youngs_modulus: 0.0,
-    friction: 0.0,
-    bending: 0.0,
-    plasticity: false,
-};
-
 /// The material of every built-in scene (`reference_material`) without its
 /// bending: k = 1000, gamma = 500, E = 1000, fibre friction 0.05,
 /// plasticity on; at the test resolution 128^2, dt 1e-4, and g = 2 m/s^2
@@ -106,52 +81,9 @@ const BUILTIN_256: Capstan = Capstan {
     ..BUILTIN
 };
 
-/// A yarn over a half circle of radius `r` centred at (0.5, 0.75), hanging
-/// `l1` on the left and `l2` on the right, on a circle with friction `mu`.
+/// The capstan scene of [`capstan_toml`] as a validated scene.
 fn capstan_scene(r: f64, l1: f64, l2: f64, mu: f64, c: &Capstan) -> YarnScene {
-    let (cx, cy) = (0.5, 0.75);
-    let mut pts = vec![[cx - r, cy - l1]];
-    let arc = 64;
-    for i in 0..=arc {
-        let psi = std::f64::consts::PI * (1.0 - i as f64 / arc as f64);
-        pts.push([cx + r * psi.cos(), cy + r * psi.sin()]);
-    }
-    pts.push([cx + r, cy - l2]);
-    let length = l1 + l2 + std::f64::consts::PI * r;
-    let dx = 1.0 / c.res as f64;
-    // vertex spacing about dx / 2
-    let vertices = (length / (0.5 * dx)).round() as u32 + 1;
-    let points = pts
-        .iter()
-        .map(|p| format!("[{:.12}, {:.12}]", p[0], p[1]))
-        .collect::<Vec<_>>()
-        .join(", ");
-    scene(&format!(
-        r#"
-gravity = [0.0, -{}]
-[grid]
-resolution = {}
-[time]
-dt = {}
-[material]
-k = 1000.0
-gamma = {}
-youngs_modulus = {}
-friction = {}
-bending = {}
-plasticity = {}
-[walls]
-mode = "none"
-[[obstacles]]
-center = [{cx}, {cy}]
-radius = {r}
-friction = {mu}
-[[yarns]]
-points = [{points}]
-vertices = {vertices}
-"#,
-        c.g, c.res, c.dt, c.gamma, c.youngs_modulus, c.friction, c.bending, c.plasticity
-    ))
+    scene(&capstan_toml(r, l1, l2, mu, c))
 }
 
 /// Time the capstan runs load before the slip is measured: the yarn starts
@@ -281,7 +213,7 @@ const CAPSTAN_ALL: [(f64, f64, bool); 6] = [
 #[test]
 #[cfg_attr(debug_assertions, ignore = "release-mode test (cargo test --release)")]
 fn capstan_yarn_slides_below_and_holds_above_the_heavy_rope_threshold() {
-    capstan_suite(&PURE_STRING, &CAPSTAN_ALL);
+    capstan_suite(&CAPSTAN_PURE_STRING, &CAPSTAN_ALL);
 }
 
 /// The same oracle with the material of the built-in scenes (cross-section
@@ -378,36 +310,8 @@ fn frictionless_drape_slides_at_the_rigid_string_rate() {
 /// Returns (tip deflection averaged over two periods of the first mode,
 /// Euler-Bernoulli q L_f^4 / (8 B), the same with the full length L).
 fn cantilever(vertices: u32) -> (f64, f64, f64) {
-    let (len, b, rho): (f64, f64, f64) = (0.5, 1.0, 1.0);
-    let g = 0.08 * b / (rho * len * len * len);
-    let s = scene(&format!(
-        r#"
-gravity = [0.0, -{g}]
-[grid]
-resolution = 64
-[time]
-dt = 5e-5
-[material]
-k = 1e4
-gamma = 0.0
-youngs_modulus = 0.0
-friction = 0.0
-bending = {b}
-density = {rho}
-plasticity = false
-[walls]
-mode = "none"
-[[yarns]]
-start = [0.25, 0.5]
-end = [{}, 0.5]
-vertices = {vertices}
-[[pins]]
-yarn = 0
-end = "start"
-count = 2
-"#,
-        0.25 + len
-    ));
+    let (len, b, rho, g) = cantilever_setup();
+    let s = scene(&cantilever_toml(vertices));
     let mut sim = YarnSim::new(&s).unwrap();
     let q = rho * g;
     let free = len - 0.5 * len / (vertices - 1) as f64;
@@ -430,12 +334,8 @@ count = 2
         sim.step().unwrap();
         d.push(y0 - sim.yarn_endpoints(0).1.y);
     }
-    let m0 = d.iter().sum::<f64>() / d.len() as f64;
-    let up: Vec<usize> = (1..d.len())
-        .filter(|&k| d[k - 1] < m0 && d[k] >= m0)
-        .collect();
-    assert!(up.len() >= 3, "{vertices} vertices: crossings {up:?}");
-    let (a, e) = (up[0], up[2]);
+    let (a, e) = two_periods_about_mean(&d)
+        .unwrap_or_else(|| panic!("{vertices} vertices: fewer than 3 upward crossings"));
     let measured_period = (e - a) as f64 * sim.dt() / 2.0;
     eprintln!(
         "cantilever {vertices} vertices: first-mode period {measured_period:.4} s (Euler-Bernoulli {period:.4} s)"
@@ -501,68 +401,28 @@ fn hanging_chain_oracle_holds_under_adaptive_substeps() {
 /// TOML value); returns the substeps run. The crossing times interpolate
 /// within the substep that crossed, the pin force is the time average.
 fn hanging_chain(dt: &str) -> u64 {
-    // L = 0.8 m pinned at (0.5, 0.9), 100 vertices, 64^2 grid, dt 1e-4,
-    // bending 0, k = 2000 (static strain at the top g L rho / k = 0.4 %),
-    // no cross-section energy; default FLIP.
-    let (len, g, j01) = (0.8, 9.8, 2.404825557695773);
-    assert!(bessel_j0(j01).abs() < 1e-12);
-    let amp = 0.02;
-    let n = 200;
-    let points = (0..=n)
-        .map(|i| {
-            let z = len * (n - i) as f64 / n as f64; // from the top down
-            let u = amp * bessel_j0(j01 * (z / len).sqrt());
-            format!("[{:.12}, {:.12}]", 0.5 + u, 0.1 + z)
-        })
-        .collect::<Vec<_>>()
-        .join(", ");
-    let s = scene(&format!(
-        r#"
-gravity = [0.0, -{g}]
-[grid]
-resolution = 64
-[time]
-dt = {dt}
-[material]
-k = 2000.0
-gamma = 0.0
-youngs_modulus = 0.0
-friction = 0.0
-bending = 0.0
-plasticity = false
-[walls]
-mode = "none"
-[[yarns]]
-points = [{points}]
-vertices = 100
-[[pins]]
-yarn = 0
-end = "start"
-"#
-    ));
+    // L = 0.8 m pinned at (0.5, 0.9), 100 vertices, 64^2 grid, bending 0,
+    // k = 2000, no cross-section energy; default FLIP (hanging_chain_toml).
+    let s = scene(&hanging_chain_toml(100, 64, dt));
     let mut sim = YarnSim::new(&s).unwrap();
-    let omega = j01 / 2.0 * (g / len).sqrt();
-    let period = 2.0 * std::f64::consts::PI / omega;
-    let weight = sim.diagnostics().total_mass * g;
-    let mut crossings = Vec::new();
-    let mut prev = sim.yarn_endpoints(0).1.x - 0.5;
+    let period = hanging_chain_period();
+    let weight = sim.diagnostics().total_mass * CHAIN_GRAVITY;
+    let mut crossings = ZeroCrossings::new(sim.yarn_endpoints(0).1.x - 0.5);
+    // the substep count at each crossing
+    let mut at = Vec::new();
     let mut reaction = Vec::new();
-    while crossings.len() < 5 {
+    while crossings.times.len() < 5 {
         let before = sim.time();
         sim.step().unwrap();
         let h = sim.time() - before;
-        let u = sim.yarn_endpoints(0).1.x - 0.5;
         reaction.push((sim.pin_reactions()[0], h));
-        if prev * u < 0.0 {
-            let t = sim.time() - h * u / (u - prev);
-            crossings.push((t, reaction.len()));
+        if crossings.push(sim.time(), h, sim.yarn_endpoints(0).1.x - 0.5) {
+            at.push(reaction.len());
         }
-        prev = u;
         assert!(sim.time() < 4.0 * period, "no 5 zero crossings");
     }
-    let (t0, k0) = crossings[0];
-    let (t4, k4) = crossings[4];
-    let measured = 2.0 * (t4 - t0) / 4.0;
+    let (k0, k4) = (at[0], at[4]);
+    let measured = crossings.period();
     let err = (measured - period) / period;
     eprintln!(
         "hanging chain (100 vertices, 64^2, dt {dt}, FLIP, {} substeps): period {measured:.5} s, \
@@ -781,24 +641,11 @@ fn line_and_circle_pins_hold_their_path_bitwise_every_substep() {
 
 #[test]
 fn bad_pins_name_their_field() {
-    let base = r#"
-[grid]
-resolution = 64
-[time]
-dt = 1e-4
-[material]
-k = 1000.0
-gamma = 500.0
-youngs_modulus = 1000.0
-friction = 0.05
-[[yarns]]
-start = [0.2, 0.7]
-end = [0.6, 0.7]
-vertices = 20
-[[pins]]
-yarn = 0
-end = "end"
-"#;
+    // a pin at the end of the 20-vertex yarn, then the pin under test
+    let base = format!(
+        "{}[[pins]]\nyarn = 0\nend = \"end\"\n",
+        common::MINIMAL_TOML
+    );
     let cases = [
         ("[[pins]]\nyarn = 3\nend = \"start\"\n", "does not exist"),
         ("[[pins]]\nyarn = 0\nvertex = 18\ncount = 2\n", "overlap"),

@@ -3,31 +3,11 @@
 //! and exit codes.
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::process::Output;
 
-fn yarnsim(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_yarnsim"))
-        .args(args)
-        .env_remove("COLUMNS")
-        .output()
-        .expect("run yarnsim")
-}
+mod common;
 
-fn stdout(out: &Output) -> String {
-    String::from_utf8(out.stdout.clone()).expect("utf-8 stdout")
-}
-
-fn stderr(out: &Output) -> String {
-    String::from_utf8(out.stderr.clone()).expect("utf-8 stderr")
-}
-
-fn small_scene() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/small.toml")
-}
-
-fn tmp(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_TARGET_TMPDIR")).join(name)
-}
+use common::{record_ok, small_scene, stderr, stdout, tmp, yarnsim};
 
 /// `yarnsim run SCENE --duration 2ms --csv CSV` (CSV named `csv` in the
 /// test folder), which must succeed: its output and the CSV text.
@@ -388,15 +368,7 @@ fn adaptive_substeps_are_reported_and_hit_every_frame() {
     assert_eq!(rows.last().unwrap()[2], n.to_string());
 
     let rrd = tmp("record-auto.rrd");
-    let out = yarnsim(&[
-        "record",
-        scene.to_str().unwrap(),
-        "--duration",
-        "2ms",
-        "-o",
-        rrd.to_str().unwrap(),
-    ]);
-    assert!(out.status.success(), "{}", stderr(&out));
+    let out = record_ok(&scene, "2ms", &rrd);
     let s = stdout(&out);
     assert!(
         s.contains(&format!(
@@ -550,32 +522,24 @@ fn bad_set_arguments_are_named_with_exit_code_3() {
         3,
         "scene error in --set argument 1 (`material.friction=0.1`): unknown field `material`",
     );
-    assert_fails(
-        &["run", small, "--set", "material.frction=0.1"],
-        3,
-        "scene error in --set argument 1 (`material.frction=0.1`): unknown field `frction`",
-    );
-    assert_fails(
-        &["run", small, "--set", "material.friction=-1"],
-        3,
-        "scene error in --set argument 1 (`material.friction=-1`): must be >= 0, got -1",
-    );
-    assert_fails(
-        &["run", small, "--set", "yarns.1.count=1"],
-        3,
-        "scene error in --set argument 1 (`yarns.1.count=1`): index 1 is out of range: \
+    // One bad `--set` on a yarn scene: the argument and what is wrong.
+    for (set, what) in [
+        ("material.frction=0.1", "unknown field `frction`"),
+        ("material.friction=-1", "must be >= 0, got -1"),
+        (
+            "yarns.1.count=1",
+            "index 1 is out of range: \
          `yarns` has 1 entries (0 to 0)",
-    );
-    assert_fails(
-        &["run", small, "--set", "material.friction"],
-        3,
-        "scene error in --set argument 1 (`material.friction`): expected KEY=VALUE",
-    );
-    assert_fails(
-        &["run", small, "--set", "gravity=[0,"],
-        3,
-        "scene error in --set argument 1 (`gravity=[0,`): `[0,` is not a TOML value",
-    );
+        ),
+        ("material.friction", "expected KEY=VALUE"),
+        ("gravity=[0,", "`[0,` is not a TOML value"),
+    ] {
+        assert_fails(
+            &["run", small, "--set", set],
+            3,
+            &format!("scene error in --set argument 1 (`{set}`): {what}"),
+        );
+    }
     // The file's own errors keep their line.
     let bad = tmp("bad-friction.toml");
     let text = std::fs::read_to_string(small_scene()).unwrap();

@@ -4,7 +4,7 @@
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::io::BufReader;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::Command;
 
 use rerun::components::{Position2D, Position3D};
@@ -20,22 +20,9 @@ use yarnsim::YarnSim;
 /// 10 substeps, with walls, an obstacle and an active attractor.
 const SCENE: &str = include_str!("data/small.toml");
 
-fn tmp(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_TARGET_TMPDIR")).join(name)
-}
+mod common;
 
-fn yarnsim(args: &[&str]) -> std::process::Output {
-    let out = Command::new(env!("CARGO_BIN_EXE_yarnsim"))
-        .args(args)
-        .output()
-        .expect("run yarnsim");
-    assert!(
-        out.status.success(),
-        "yarnsim {args:?} failed: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    out
-}
+use common::{record_ok, tmp, yarnsim_ok as yarnsim};
 
 /// The recording's data chunks (blueprint store left out), by entity path.
 fn decode(path: &Path) -> BTreeMap<String, Vec<Chunk>> {
@@ -98,14 +85,7 @@ fn yarn_recording_holds_the_library_state_at_every_frame() {
     let rrd = tmp("record-test.rrd");
     let _ = std::fs::remove_file(&rrd);
     // 2 ms = 50 substeps of 40 us = 5 frames of 10 substeps, plus frame 0.
-    let out = yarnsim(&[
-        "record",
-        scene_file.to_str().unwrap(),
-        "--duration",
-        "2ms",
-        "-o",
-        rrd.to_str().unwrap(),
-    ]);
+    let out = record_ok(&scene_file, "2ms", &rrd);
     let stdout = String::from_utf8_lossy(&out.stdout);
     assert!(
         stdout.contains("recorded 6 frames (50 substeps"),
@@ -310,11 +290,7 @@ fn sigterm_finishes_the_recording_like_ctrl_c() {
 }
 
 fn small_scene() -> String {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("tests/data/small.toml")
-        .to_str()
-        .unwrap()
-        .to_string()
+    common::small_scene().to_str().unwrap().to_string()
 }
 
 /// Frames at which `world/vertices` was logged.
@@ -393,83 +369,89 @@ fn fails(args: &[&str], env: &[(&str, &str)]) -> (i32, String) {
     )
 }
 
+/// [`fails`] with the exit code `code` and `what` in its standard error.
+fn fails_with(args: &[&str], env: &[(&str, &str)], code: i32, what: &str) {
+    let (got, err) = fails(args, env);
+    assert_eq!(got, code, "{args:?}: {err}");
+    assert!(err.contains(what), "{args:?}: {what:?} not in {err}");
+}
+
 #[test]
 fn sinks_refuse_clearly() {
     let small = small_scene();
     // Not an .rrd name: refused before anything runs.
-    let (code, err) = fails(&["record", &small, "-d", "1ms", "-o", "x.txt"], &[]);
-    assert_eq!(code, 2, "{err}");
-    assert!(err.contains("`x.txt` does not end in .rrd"), "{err}");
-    assert!(!Path::new("x.txt").exists());
-    // One sink at a time.
-    let (code, err) = fails(&["record", &small, "--spawn", "-o", "a.rrd"], &[]);
-    assert_eq!(code, 2, "{err}");
-    // --serve goes with --save FILE, not with another live sink or stdout.
-    let (code, err) = fails(&["record", &small, "--serve", "--spawn"], &[]);
-    assert_eq!(code, 2, "{err}");
-    let (code, err) = fails(&["record", &small, "--serve", "-o", "-"], &[]);
-    assert_eq!(code, 2, "{err}");
-    assert!(
-        err.contains("--serve does not write to standard output"),
-        "{err}"
-    );
-    // The server options need --serve, and a limit Rerun understands.
-    let (code, err) = fails(&["record", &small, "--port", "9000"], &[]);
-    assert_eq!(code, 2, "{err}");
-    let (code, err) = fails(
-        &["record", &small, "--serve", "--server-memory-limit", "lots"],
+    fails_with(
+        &["record", &small, "-d", "1ms", "-o", "x.txt"],
         &[],
+        2,
+        "`x.txt` does not end in .rrd",
     );
-    assert_eq!(code, 2, "{err}");
+    assert!(!Path::new("x.txt").exists());
+    // --serve goes with --save FILE, not with standard output.
+    fails_with(
+        &["record", &small, "--serve", "-o", "-"],
+        &[],
+        2,
+        "--serve does not write to standard output",
+    );
+    // One sink at a time (--serve goes with --save FILE, not with another
+    // live sink); the server options need --serve, and a limit Rerun
+    // understands: usage errors.
+    let usage: [&[&str]; 4] = [
+        &["--spawn", "-o", "a.rrd"],
+        &["--serve", "--spawn"],
+        &["--port", "9000"],
+        &["--serve", "--server-memory-limit", "lots"],
+    ];
+    for extra in usage {
+        let args: Vec<&str> = ["record", &small]
+            .into_iter()
+            .chain(extra.iter().copied())
+            .collect();
+        let (code, err) = fails(&args, &[]);
+        assert_eq!(code, 2, "{args:?}: {err}");
+    }
     // A port in use (e.g. by a viewer): refused before anything runs.
     let taken = std::net::TcpListener::bind("127.0.0.1:0").unwrap();
     let port = taken.local_addr().unwrap().port().to_string();
-    let (code, err) = fails(
-        &[
-            "record",
-            &small,
-            "-d",
-            "1ms",
-            "--serve",
-            "--bind",
-            "127.0.0.1",
-            "--port",
-            &port,
-        ],
-        &[],
-    );
-    assert_eq!(code, 4, "{err}");
-    assert!(
-        err.contains(&format!("cannot serve on 127.0.0.1:{port}")),
-        "{err}"
-    );
+    let serve = [
+        "record",
+        &small,
+        "-d",
+        "1ms",
+        "--serve",
+        "--bind",
+        "127.0.0.1",
+        "--port",
+        &port,
+    ];
+    fails_with(&serve, &[], 4, &format!("cannot serve on 127.0.0.1:{port}"));
     // --spawn without a viewer on PATH.
-    let (code, err) = fails(
+    fails_with(
         &["record", &small, "-d", "1ms", "--spawn"],
         &[("PATH", "/nonexistent")],
+        4,
+        "cannot start a Rerun viewer",
     );
-    assert_eq!(code, 4, "{err}");
-    assert!(err.contains("cannot start a Rerun viewer"), "{err}");
-    // A bad --connect URL.
-    let (code, err) = fails(
-        &["record", &small, "-d", "1ms", "--connect", "ftp://nowhere"],
-        &[],
-    );
-    assert_eq!(code, 4, "{err}");
-    assert!(
-        err.contains("cannot stream to the viewer at ftp://nowhere"),
-        "{err}"
-    );
-    // No viewer listening: Rerun gives up after 5 s, and the run says so.
-    let (code, err) = fails(
-        &["record", &small, "-d", "1ms", "--connect", "127.0.0.1:1"],
-        &[],
-    );
-    assert_eq!(code, 4, "{err}");
-    assert!(
-        err.contains("cannot stream to the viewer at rerun+http://127.0.0.1:1/proxy"),
-        "{err}"
-    );
+    // A bad --connect URL; no viewer listening: Rerun gives up after 5 s,
+    // and the run says so.
+    for (url, what) in [
+        (
+            "ftp://nowhere",
+            "cannot stream to the viewer at ftp://nowhere",
+        ),
+        (
+            "127.0.0.1:1",
+            "cannot stream to the viewer at rerun+http://127.0.0.1:1/proxy",
+        ),
+    ] {
+        fails_with(
+            &["record", &small, "-d", "1ms", "--connect", url],
+            &[],
+            4,
+            what,
+        );
+    }
 }
 
 /// Every value of component type `C` logged on these chunks, whatever its
@@ -502,14 +484,7 @@ fn recordings_read_at_a_glance() {
     // stretch and centre of mass logged.
     let rrd = tmp("record-look.rrd");
     let _ = std::fs::remove_file(&rrd);
-    yarnsim(&[
-        "record",
-        &small_scene(),
-        "-d",
-        "2ms",
-        "-o",
-        rrd.to_str().unwrap(),
-    ]);
+    record_ok(&common::small_scene(), "2ms", &rrd);
     let chunks = decode(&rrd);
     let strips = by_frame::<rerun::components::LineStrip2D>(
         &chunks["world/yarns"],

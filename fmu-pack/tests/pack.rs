@@ -2,25 +2,17 @@
 //! detected), the zip CRC and the ELF check of the FMU's shared library
 //! (all 34 `fmi2*` exports, only libc/libm/libgcc_s/loader needed).
 
-use std::path::PathBuf;
-
 use yarnsim::massspring::scenes::wire;
 use yarnsim::scene::{Scene, YarnScene};
 use yarnsim_fmu_pack::*;
+
+// The FMU crate's test master, for `cdylib_path` (the library cargo built
+// next to this test as a dependency).
+#[path = "../../fmu/tests/common/mod.rs"]
+mod common;
+use common::cdylib_path;
 use YarnBundle::yarn::variables::*;
 use YarnBundle::SceneFmu;
-
-/// The FMU library cargo built as this crate's dependency:
-/// `deps/libYarnBundle.so` next to the test executable (or one folder up).
-fn cdylib_path() -> PathBuf {
-    let exe = std::env::current_exe().unwrap();
-    let deps = exe.parent().unwrap();
-    let name = format!("lib{}.so", YarnBundle::MODEL_IDENTIFIER);
-    [deps.join(&name), deps.parent().unwrap().join(&name)]
-        .into_iter()
-        .find(|p| p.exists())
-        .unwrap_or_else(|| panic!("{name} was not built next to {}", deps.display()))
-}
 
 /// The bytes that stand in for the FMU's library in an archive.
 const STAND_IN: &[u8] = b"\x7fELF not really";

@@ -181,21 +181,13 @@ fn state_round_trip_gives_identical_bits() {
     fmu.free_state(s);
 
     // Restore the deserialized bytes, in this instance and in a new one.
-    let (st, d) = fmu.deserialize(&bytes);
-    assert_eq!(st, fmi2OK, "{:?}", fmu.lines());
-    // SAFETY: `fmu.c` came from `fmi2Instantiate` and lives until its `Fmu` drops; every pointer
-    // argument is a local that outlives the call.
-    assert_eq!(unsafe { fmi2SetFMUstate(fmu.c, d) }, fmi2OK);
+    let d = fmu.set_state_from(&bytes);
     assert_eq!(fmu.substeps(), 250);
     assert_eq!(run_on(&fmu, 0.05, 6), first);
     fmu.free_state(d);
 
     let other = Fmu::new(&scene);
-    let (st, d) = other.deserialize(&bytes);
-    assert_eq!(st, fmi2OK, "{:?}", other.lines());
-    // SAFETY: `other.c` came from `fmi2Instantiate` and lives until its `Fmu` drops; every
-    // pointer argument is a local that outlives the call.
-    assert_eq!(unsafe { fmi2SetFMUstate(other.c, d) }, fmi2OK);
+    let d = other.set_state_from(&bytes);
     let restored = other.get_state();
     assert_eq!(other.serialize(restored), bytes);
     other.free_state(restored);
@@ -286,11 +278,7 @@ fn illegal_call_order_is_an_error_with_a_log_line() {
     // DoStep before initialization.
     let fmu = Fmu::new(&scene);
     assert_eq!(fmu.do_step(0.0, H), fmi2Error);
-    assert!(
-        fmu.last_error().contains("fmi2DoStep is not allowed"),
-        "{:?}",
-        fmu.lines()
-    );
+    fmu.assert_error_contains("fmi2DoStep is not allowed");
     // The instance is now in the error state: only reset / set state / free.
     assert_eq!(fmu.setup(0.0, None), fmi2Error);
     // SAFETY: `fmu.c` came from `fmi2Instantiate` and lives until its `Fmu` drops; every pointer
@@ -313,11 +301,7 @@ fn illegal_call_order_is_an_error_with_a_log_line() {
     let f = Fmu::new(&scene);
     f.init();
     assert_eq!(f.set_real(&[VR_DT], &[1e-4]), fmi2Error);
-    assert!(
-        f.last_error().contains("fixed parameter"),
-        "{:?}",
-        f.lines()
-    );
+    f.assert_error_contains("fixed parameter");
 
     // Terminate, then no more steps.
     let f = Fmu::new(&scene);
@@ -672,12 +656,7 @@ fn independent_run(scene: &YarnScene, gx: f64) -> Vec<u64> {
     let f = Fmu::new(scene);
     f.init();
     assert_eq!(f.set_real(&[VR_GRAVITY_X], &[gx]), fmi2OK);
-    let mut bits = Vec::new();
-    for k in 0..6 {
-        assert_eq!(f.do_step(k as f64 * H, H), fmi2OK);
-        bits.extend(f.outputs().iter().map(|v| v.to_bits()));
-    }
-    bits
+    f.output_bits(0..6, H)
 }
 
 /// Instances share nothing: interleaved in one thread and concurrent in
@@ -732,11 +711,7 @@ fn parameters_and_scene_parameter() {
     // SAFETY: `f.c` came from `fmi2Instantiate` and lives until its `Fmu` drops; every pointer
     // argument is a local that outlives the call.
     unsafe { assert_eq!(fmi2ExitInitializationMode(f.c), fmi2OK) };
-    let mut bits = Vec::new();
-    for k in 0..6 {
-        assert_eq!(f.do_step(k as f64 * H, H), fmi2OK);
-        bits.extend(f.outputs().iter().map(|v| v.to_bits()));
-    }
+    let bits = f.output_bits(0..6, H);
     assert_ne!(bits, base);
     assert_eq!(f.substeps(), 600);
     // The same parameter change through a scene file.
@@ -756,11 +731,7 @@ fn parameters_and_scene_parameter() {
         g.lines()
     );
     g.init();
-    let mut bits2 = Vec::new();
-    for k in 0..6 {
-        assert_eq!(g.do_step(k as f64 * H, H), fmi2OK);
-        bits2.extend(g.outputs().iter().map(|v| v.to_bits()));
-    }
+    let bits2 = g.output_bits(0..6, H);
     assert_eq!(bits2, bits);
     // Out-of-range parameters are rejected (dt = 0 is adaptive substeps,
     // tests/auto_dt.rs).

@@ -170,9 +170,7 @@ fn gravity_inputs_act_and_bad_values_are_refused() {
                 fmi2OK
             );
         }
-        for k in 0..10 {
-            assert_eq!(f.do_step(k as f64 * H, H), fmi2OK);
-        }
+        f.steps_ok(0..10, H);
         outputs(&f)
     };
     let down = run(None);
@@ -270,9 +268,7 @@ fn fmu_state_round_trip_gives_identical_bits() {
     let f = Fmu::mass_spring(&wire());
     assert_eq!(f.set_string(VR_INTEGRATOR, "trapezoidal"), fmi2OK);
     f.init();
-    for k in 0..5 {
-        assert_eq!(f.do_step(k as f64 * H, H), fmi2OK);
-    }
+    f.steps_ok(0..5, H);
     let s = f.get_state();
     let bytes = f.serialize(s);
     assert_eq!(&bytes[..8], b"MSFMUST\0");
@@ -285,11 +281,7 @@ fn fmu_state_round_trip_gives_identical_bits() {
             .collect()
     };
     let first = run_on(&f);
-    let (st, restored) = f.deserialize(&bytes);
-    assert_eq!(st, fmi2OK, "{:?}", f.lines());
-    // SAFETY: `f.c` came from `fmi2Instantiate` and lives until its `Fmu` drops; every pointer
-    // argument is a local that outlives the call.
-    assert_eq!(unsafe { fmi2SetFMUstate(f.c, restored) }, fmi2OK);
+    let restored = f.set_state_from(&bytes);
     // 5 frames of 10 substeps (the scene's time_step 0.005 s).
     assert_eq!(f.substeps(), 50);
     assert_eq!(f.get_string(VR_INTEGRATOR), "trapezoidal");
@@ -298,11 +290,7 @@ fn fmu_state_round_trip_gives_identical_bits() {
     // parameters.
     let g = Fmu::mass_spring(&wire());
     g.init();
-    let (st, s2) = g.deserialize(&bytes);
-    assert_eq!(st, fmi2OK, "{:?}", g.lines());
-    // SAFETY: `g.c` came from `fmi2Instantiate` and lives until its `Fmu` drops; every pointer
-    // argument is a local that outlives the call.
-    assert_eq!(unsafe { fmi2SetFMUstate(g.c, s2) }, fmi2OK);
+    let s2 = g.set_state_from(&bytes);
     assert_eq!(run_on(&g), first);
     g.free_state(s2);
     f.free_state(restored);

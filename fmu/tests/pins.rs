@@ -9,7 +9,8 @@ mod common;
 use common::*;
 use yarnsim::math::Vec2;
 use yarnsim::mpm::YarnSim;
-use yarnsim::scene::{TransferScheme, YarnScene};
+use yarnsim::scene::{PinMotionKind, TransferScheme, YarnScene, YarnSpec};
+use yarnsim::testing::{hanging_chain_toml, CHAIN_GRAVITY};
 use YarnBundle::ffi::*;
 use YarnBundle::yarn::variables::*;
 
@@ -21,9 +22,7 @@ fn bits(v: &[f64]) -> Vec<u64> {
 
 /// The FMU's yarn ends and energies after 8 steps of `H`.
 fn fmu_run(f: &Fmu) -> Vec<f64> {
-    for k in 0..8 {
-        assert_eq!(f.do_step(k as f64 * H, H), fmi2OK, "{:?}", f.lines());
-    }
+    f.steps_ok(0..8, H);
     f.outputs()
 }
 
@@ -122,29 +121,19 @@ fn transfer_parameters_travel_in_the_fmu_state() {
     let f = Fmu::new(&scene);
     assert_eq!(f.set_string(VR_TRANSFER_SCHEME, "apic"), fmi2OK);
     f.init();
-    for k in 0..3 {
-        assert_eq!(f.do_step(k as f64 * H, H), fmi2OK);
-    }
+    f.steps_ok(0..3, H);
     let s = f.get_state();
     let bytes = f.serialize(s);
     f.free_state(s);
-    for k in 3..6 {
-        assert_eq!(f.do_step(k as f64 * H, H), fmi2OK);
-    }
+    f.steps_ok(3..6, H);
     let end = f.outputs();
     // A fresh instance with the default scheme takes the state's.
     let g = Fmu::new(&scene);
     g.init();
-    let (st, d) = g.deserialize(&bytes);
-    assert_eq!(st, fmi2OK, "{:?}", g.lines());
-    // SAFETY: `g.c` came from `fmi2Instantiate` and lives until its `Fmu` drops; every pointer
-    // argument is a local that outlives the call.
-    assert_eq!(unsafe { fmi2SetFMUstate(g.c, d) }, fmi2OK);
+    let d = g.set_state_from(&bytes);
     g.free_state(d);
     assert_eq!(g.get_string(VR_TRANSFER_SCHEME), "apic");
-    for k in 3..6 {
-        assert_eq!(g.do_step(k as f64 * H, H), fmi2OK);
-    }
+    g.steps_ok(3..6, H);
     assert_eq!(bits(&g.outputs()), bits(&end));
 }
 
@@ -256,11 +245,7 @@ fn pin_variables_follow_the_scene() {
         .all(|v| !(VR_PIN_BASE..VR_PIN_BASE + 4).contains(&v.vr)));
     let g = Fmu::new(&fixed);
     assert_eq!(g.set_real(&[VR_PIN_BASE], &[0.3]), fmi2Error);
-    assert!(
-        g.last_error().contains("not a motion"),
-        "{}",
-        g.last_error()
-    );
+    g.assert_error_contains("not a motion");
     // SAFETY: `g.c` came from `fmi2Instantiate` and lives until its `Fmu` drops; every pointer
     // argument is a local that outlives the call.
     unsafe { assert_eq!(fmi2Reset(g.c), fmi2OK) };
@@ -349,11 +334,7 @@ fn driven_pin_state_round_trip_gives_identical_bits() {
 
     let g = Fmu::new(&s);
     g.init();
-    let (status, d) = g.deserialize(&bytes);
-    assert_eq!(status, fmi2OK, "{:?}", g.lines());
-    // SAFETY: `g.c` came from `fmi2Instantiate` and lives until its `Fmu` drops; every pointer
-    // argument is a local that outlives the call.
-    assert_eq!(unsafe { fmi2SetFMUstate(g.c, d) }, fmi2OK);
+    let d = g.set_state_from(&bytes);
     g.free_state(d);
     assert_eq!(g.get_string(VR_TRANSFER_SCHEME), "flip");
     assert_eq!(drive(&g, 4, 6), first);
@@ -429,35 +410,18 @@ fn input_pin_on_the_substep_grid_reproduces_line_and_circle_pins() {
 /// is the yarn's weight, pointing down.
 #[test]
 fn hanging_yarn_pulls_its_input_pin_with_its_weight() {
-    let g = 9.8;
-    let s = YarnScene::from_toml_str(&format!(
-        r#"
-kind = "yarn"
-gravity = [0.0, -{g}]
-[grid]
-resolution = 64
-[time]
-dt = 1e-4
-[material]
-k = 2000.0
-gamma = 0.0
-youngs_modulus = 0.0
-friction = 0.0
-bending = 0.0
-plasticity = false
-[walls]
-mode = "none"
-[[yarns]]
-start = [0.5, 0.9]
-end = [0.5, 0.4]
-vertices = 50
-[[pins]]
-yarn = 0
-end = "start"
-motion = "input"
-"#
-    ))
-    .unwrap();
+    // the hanging chain's material, grid and substep (k 2000, no
+    // cross-section energy, 64^2, dt 1e-4), on a straight yarn 0.5 m long
+    let g = CHAIN_GRAVITY;
+    let mut s = YarnScene::from_toml_str(&hanging_chain_toml(50, 64, "1e-4")).unwrap();
+    s.yarns[0] = YarnSpec {
+        points: None,
+        start: Some([0.5, 0.9]),
+        end: Some([0.5, 0.4]),
+        ..s.yarns[0].clone()
+    };
+    s.pins[0].motion = PinMotionKind::Input;
+    s.validate().unwrap();
     let weight = YarnSim::new(&s).unwrap().diagnostics().total_mass * g;
     let f = Fmu::new(&s);
     f.init();

@@ -78,22 +78,14 @@ fn a_step_beyond_the_substep_budget_is_refused_before_it_runs() {
     assert_eq!(g.do_step(0.0, 50.0 * 2e-4), fmi2OK);
     assert_eq!(g.substeps(), 50);
     assert_eq!(g.do_step(50.0 * 2e-4, 51.0 * 2e-4), fmi2Error);
-    assert!(
-        g.last_error().contains("needs 51 substeps"),
-        "{}",
-        g.last_error()
-    );
+    g.assert_error_contains("needs 51 substeps");
     // Fixed after initialization, at least 1, Integer only.
     let k = Fmu::new(&scene);
     assert_eq!(set_int(&k, VR_MAX_SUBSTEPS, 0), fmi2Error);
     let k = Fmu::new(&scene);
     k.init();
     assert_eq!(set_int(&k, VR_MAX_SUBSTEPS, 100), fmi2Error);
-    assert!(
-        k.last_error().contains("fixed parameter"),
-        "{}",
-        k.last_error()
-    );
+    k.assert_error_contains("fixed parameter");
     let k = Fmu::new(&scene);
     assert_eq!(set_int(&k, VR_SUBSTEPS, 1), fmi2Error);
 
@@ -105,11 +97,7 @@ fn a_step_beyond_the_substep_budget_is_refused_before_it_runs() {
     );
     assert_eq!(exit_init(&m), fmi2OK, "{:?}", m.lines());
     assert_eq!(m.do_step(0.0, 1.0), fmi2Error);
-    assert!(
-        m.last_error().contains("needs 1000000000 substeps"),
-        "{}",
-        m.last_error()
-    );
+    m.assert_error_contains("needs 1000000000 substeps");
 }
 
 /// fmi2ExitInitializationMode warns (fmi2Warning, a log line in
@@ -184,12 +172,7 @@ fn threaded_run(threads: c_int, scene: &yarnsim::scene::YarnScene) -> Vec<u64> {
     f.init();
     assert_eq!(get_int(&f, VR_THREADS), threads);
     assert_eq!(f.set_real(&[VR_GRAVITY_X], &[3.0]), fmi2OK);
-    let mut bits = Vec::new();
-    for k in 0..8 {
-        assert_eq!(f.do_step(k as f64 * H, H), fmi2OK);
-        bits.extend(f.outputs().iter().map(|v| v.to_bits()));
-    }
-    bits
+    f.output_bits(0..8, H)
 }
 
 /// `threads` = 1, 2 and 0 (the global pool) give the same bits, on the
@@ -265,9 +248,5 @@ fn scene_parameter_refuses_devices_directories_and_huge_files() {
     // A missing file names the path.
     let f = Fmu::new(&scene);
     assert_eq!(set_scene(&f, "missing.toml"), fmi2Error);
-    assert!(
-        f.last_error().contains("missing.toml"),
-        "{}",
-        f.last_error()
-    );
+    f.assert_error_contains("missing.toml");
 }

@@ -171,6 +171,17 @@ impl Fmu {
             .unwrap_or_default()
     }
 
+    /// Asserts that the last error logged contains `what` (the whole log
+    /// in the panic message otherwise).
+    pub fn assert_error_contains(&self, what: &str) {
+        let e = self.last_error();
+        assert!(
+            e.contains(what),
+            "{what:?} not in the last error; log {:?}",
+            self.lines()
+        );
+    }
+
     pub fn setup(&self, start: f64, stop: Option<f64>) -> fmi2Status {
         // SAFETY: `self.c` came from `fmi2Instantiate` and lives until its `Fmu` drops; every
         // pointer argument is a local that outlives the call.
@@ -291,6 +302,25 @@ impl Fmu {
         unsafe { fmi2DoStep(self.c, t, h, fmi2True) }
     }
 
+    /// Communication steps `steps` of `h` each (step k from t = k h), every
+    /// one fmi2OK (the log in the panic message otherwise).
+    pub fn steps_ok(&self, steps: std::ops::Range<u32>, h: f64) {
+        for k in steps {
+            assert_eq!(self.do_step(k as f64 * h, h), fmi2OK, "{:?}", self.lines());
+        }
+    }
+
+    /// The bits of [`Self::outputs`] after each of the communication steps
+    /// `steps` of `h` (each one fmi2OK), concatenated.
+    pub fn output_bits(&self, steps: std::ops::Range<u32>, h: f64) -> Vec<u64> {
+        let mut bits = Vec::new();
+        for k in steps {
+            self.steps_ok(k..k + 1, h);
+            bits.extend(self.outputs().iter().map(|v| v.to_bits()));
+        }
+        bits
+    }
+
     /// Value references of every yarn end coordinate.
     pub fn yarn_vrs(&self) -> Vec<u32> {
         (0..4 * self.yarns as u32)
@@ -342,6 +372,17 @@ impl Fmu {
             fmi2DeSerializeFMUstate(self.c, bytes.as_ptr() as *const c_char, bytes.len(), &mut s)
         };
         (st, s)
+    }
+
+    /// Deserializes `bytes` and sets the instance to that state (both
+    /// fmi2OK); returns the state, for the caller to free.
+    pub fn set_state_from(&self, bytes: &[u8]) -> fmi2FMUstate {
+        let (st, d) = self.deserialize(bytes);
+        assert_eq!(st, fmi2OK, "{:?}", self.lines());
+        // SAFETY: `self.c` came from `fmi2Instantiate` and lives until its `Fmu` drops; `d`
+        // is the state fmi2DeSerializeFMUstate just made for it.
+        assert_eq!(unsafe { fmi2SetFMUstate(self.c, d) }, fmi2OK);
+        d
     }
 
     pub fn free_state(&self, mut s: fmi2FMUstate) {

@@ -375,23 +375,8 @@ damping = 100.0
 
     #[test]
     fn sheet_has_the_cloth_scripts_edge_count() {
-        let text = r#"
-[time]
-frame_time = 0.0333
-frames = 10
-[[sheets]]
-origin = [5.0, 0.0, 5.0]
-edge_u = [-10.0, 0.0, 0.0]
-edge_v = [0.0, 0.0, -10.0]
-nu = 21
-nv = 21
-mass = 1.0
-stiffness = 8000.0
-"#;
-        let s = MassSpringScene::from_toml_str(text)
-            .unwrap()
-            .build()
-            .unwrap();
+        // the built-in cloth: the cloth scripts' 21 x 21 sheet over 10 m
+        let s = super::builtin::cloth().build().unwrap();
         assert_eq!(s.len(), 441);
         // 20*21 horizontal + 20*21 vertical + 20*20 diagonals.
         assert_eq!(s.springs.len(), 1240);
