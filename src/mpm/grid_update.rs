@@ -197,7 +197,6 @@ fn update_block<const FLIP: bool, const NEAR: bool>(
         i0,
         j0,
         near_wall,
-        ..
     } = *blk;
     let cells = ext.wall_cells;
     let dx = geom.dx;
