@@ -136,6 +136,18 @@ pub fn spinner(label: &str) -> ProgressBar {
     bar
 }
 
+/// [`run_frames`] with a progress bar labelled `label` and the process's
+/// interrupt flag ([`interrupt_flag`]): how the commands run a schedule.
+pub fn run_frames_shown<S: Stepper + Send>(
+    sim: &mut S,
+    schedule: &Schedule,
+    label: &str,
+    on_frame: impl FnMut(&S, FrameInfo) -> Result<(), CliError>,
+) -> Result<FrameRun, CliError> {
+    let progress = progress_bar(schedule.total_steps, label);
+    run_frames(sim, schedule, &interrupt_flag(), &progress, on_frame)
+}
+
 /// Runs `schedule` frame by frame: calls `on_frame` with the initial state
 /// (frame 0), then after each frame's substeps. Stops after the current
 /// substep when `interrupt` is set, and then calls `on_frame` once more for
@@ -253,20 +265,26 @@ mod tests {
         }
     }
 
+    /// [`run_frames`] without a progress bar, interrupted from the start
+    /// or not.
+    fn quiet(
+        sim: &mut Counter,
+        schedule: &Schedule,
+        interrupted: bool,
+        on_frame: impl FnMut(&Counter, FrameInfo) -> Result<(), CliError>,
+    ) -> Result<FrameRun, CliError> {
+        let flag = AtomicBool::new(interrupted);
+        run_frames(sim, schedule, &flag, &ProgressBar::hidden(), on_frame)
+    }
+
     #[test]
     fn calls_every_frame_with_its_substeps() {
         let schedule = Schedule::new(0.025, 1e-3, 0.01).unwrap();
         let mut seen = Vec::new();
-        let out = run_frames(
-            &mut Counter(0, None),
-            &schedule,
-            &AtomicBool::new(false),
-            &ProgressBar::hidden(),
-            |s, f| {
-                seen.push((f.frame, f.substeps, s.0, f.last));
-                Ok(())
-            },
-        )
+        let out = quiet(&mut Counter(0, None), &schedule, false, |s, f| {
+            seen.push((f.frame, f.substeps, s.0, f.last));
+            Ok(())
+        })
         .unwrap()
         .outcome;
         assert_eq!(
@@ -287,16 +305,10 @@ mod tests {
     fn interrupt_stops_after_the_initial_frame() {
         let schedule = Schedule::new(1.0, 1e-3, 0.01).unwrap();
         let mut frames = 0;
-        let out = run_frames(
-            &mut Counter(0, None),
-            &schedule,
-            &AtomicBool::new(true),
-            &ProgressBar::hidden(),
-            |_, _| {
-                frames += 1;
-                Ok(())
-            },
-        )
+        let out = quiet(&mut Counter(0, None), &schedule, true, |_, _| {
+            frames += 1;
+            Ok(())
+        })
         .unwrap()
         .outcome;
         assert!(out.interrupted);
@@ -307,16 +319,10 @@ mod tests {
     fn a_failing_substep_keeps_the_frames_before_it() {
         let schedule = Schedule::new(0.025, 1e-3, 0.01).unwrap();
         let mut seen = Vec::new();
-        let run = run_frames(
-            &mut Counter(0, Some(14)),
-            &schedule,
-            &AtomicBool::new(false),
-            &ProgressBar::hidden(),
-            |s, f| {
-                seen.push((f.frame, s.0));
-                Ok(())
-            },
-        )
+        let run = quiet(&mut Counter(0, Some(14)), &schedule, false, |s, f| {
+            seen.push((f.frame, s.0));
+            Ok(())
+        })
         .unwrap();
         assert_eq!(seen, vec![(0, 0), (1, 10)]);
         assert_eq!(run.outcome.last_frame, 1);

@@ -9,7 +9,7 @@ use yarnsim::mpm::Diagnostics;
 use yarnsim::scene::Scene;
 use yarnsim::YarnSim;
 
-use crate::driver::{interrupt_flag, progress_bar, run_frames};
+use crate::driver::run_frames_shown;
 use crate::error::CliError;
 use crate::massspring::{IntegratorArgs, MassSpringRun, MsDiagnostics};
 use crate::schedule::Schedule;
@@ -42,31 +42,17 @@ pub fn run_massspring(
 ) -> Result<Summary, CliError> {
     let sys = run.sim.system();
     let schedule = Schedule::new(duration, run.h, sys.frame_time)?;
-    let mut writer = match csv {
-        Some(path) => Some(CsvWriter::create_with(path, &ms_csv_header())?),
-        None => None,
-    };
+    let mut csv = CsvWriter::create_with(csv, &ms_csv_header())?;
     let (particles, springs, spheres) = (sys.len(), sys.springs.len(), sys.spheres.len());
     let fixed = sys.len() - sys.free_count();
     let initial = run.diagnostics();
     let mut last = initial;
-    let progress = progress_bar(schedule.total_steps, &run.name);
-    let frames = run_frames(
-        run,
-        &schedule,
-        &interrupt_flag(),
-        &progress,
-        |run, frame| {
-            last = run.diagnostics();
-            if let Some(w) = writer.as_mut() {
-                w.ms_row(frame.frame, &last)?;
-            }
-            Ok(())
-        },
-    )?;
-    if let Some(w) = writer {
-        w.finish()?;
-    }
+    let name = run.name.clone();
+    let frames = run_frames_shown(run, &schedule, &name, |run, frame| {
+        last = run.diagnostics();
+        csv.ms_row(frame.frame, &last)
+    })?;
+    csv.finish()?;
     Ok(Summary {
         scene: run.name.clone(),
         model: format!("mass-spring, {}", run.sim.integrator()),
@@ -146,31 +132,17 @@ pub fn dt_range(stats: &yarnsim::mpm::DtStats) -> String {
 pub fn run_yarn(sim: &mut YarnSim, duration: f64, csv: Option<&Path>) -> Result<Summary, CliError> {
     let sc = sim.scene();
     let schedule = yarn_schedule(sim, duration)?;
-    let mut writer = match csv {
-        Some(path) => Some(CsvWriter::create(path, sim.num_yarns())?),
-        None => None,
-    };
+    let mut csv = CsvWriter::create(csv, sim.num_yarns())?;
     let initial = sim.diagnostics();
     let mut last = initial;
-    let progress = progress_bar(schedule.total_steps, &sc.name);
+    let name = sc.name.clone();
     let dt = sim.dt();
     sim.reset_dt_stats();
-    let frames = run_frames(
-        sim,
-        &schedule,
-        &interrupt_flag(),
-        &progress,
-        |sim, frame| {
-            last = sim.diagnostics();
-            if let Some(w) = writer.as_mut() {
-                w.row(frame.frame, sim, &last, dt)?;
-            }
-            Ok(())
-        },
-    )?;
-    if let Some(w) = writer {
-        w.finish()?;
-    }
+    let frames = run_frames_shown(sim, &schedule, &name, |sim, frame| {
+        last = sim.diagnostics();
+        csv.row(frame.frame, sim, &last, dt)
+    })?;
+    csv.finish()?;
     let p = sim.particles();
     Ok(Summary {
         scene: sim.scene().name.clone(),
@@ -210,9 +182,10 @@ pub fn csv_time(t: f64) -> String {
     csv_num(tidy)
 }
 
-/// The per-frame CSV: frame, time, diagnostics, then both endpoints of every yarn.
+/// The per-frame CSV: frame, time, diagnostics, then both endpoints of every
+/// yarn; made without a path, it writes nothing (a run without `--csv`).
 pub struct CsvWriter {
-    out: BufWriter<File>,
+    out: Option<BufWriter<File>>,
     path: String,
 }
 
@@ -272,16 +245,22 @@ pub fn csv_header(yarns: usize) -> Vec<String> {
 }
 
 impl CsvWriter {
-    /// Creates the file and writes the header.
-    pub fn create(path: &Path, yarns: usize) -> Result<Self, CliError> {
+    /// Creates the file (if a path is given) and writes the header.
+    pub fn create(path: Option<&Path>, yarns: usize) -> Result<Self, CliError> {
         Self::create_with(path, &csv_header(yarns))
     }
 
-    /// Creates the file and writes the given header.
-    pub fn create_with(path: &Path, header: &[String]) -> Result<Self, CliError> {
+    /// Creates the file (if a path is given) and writes the given header.
+    pub fn create_with(path: Option<&Path>, header: &[String]) -> Result<Self, CliError> {
+        let Some(path) = path else {
+            return Ok(CsvWriter {
+                out: None,
+                path: String::new(),
+            });
+        };
         let file = File::create(path).map_err(|e| CliError::output(path, e))?;
         let mut w = CsvWriter {
-            out: BufWriter::new(file),
+            out: Some(BufWriter::new(file)),
             path: path.display().to_string(),
         };
         w.line(&header.join(","))?;
@@ -289,7 +268,10 @@ impl CsvWriter {
     }
 
     fn line(&mut self, text: &str) -> Result<(), CliError> {
-        writeln!(self.out, "{text}").map_err(|e| CliError::Output {
+        let Some(out) = self.out.as_mut() else {
+            return Ok(());
+        };
+        writeln!(out, "{text}").map_err(|e| CliError::Output {
             path: self.path.clone(),
             message: e.to_string(),
         })
@@ -304,6 +286,9 @@ impl CsvWriter {
         d: &Diagnostics,
         dt: f64,
     ) -> Result<(), CliError> {
+        if self.out.is_none() {
+            return Ok(());
+        }
         // Fixed substeps: steps * dt; adaptive ones land on the frame
         // times, so the clock itself.
         let time = if sim.is_auto() {
@@ -338,6 +323,9 @@ impl CsvWriter {
 
     /// Writes one mass-spring frame.
     pub fn ms_row(&mut self, frame: u64, d: &MsDiagnostics) -> Result<(), CliError> {
+        if self.out.is_none() {
+            return Ok(());
+        }
         let mut cols: Vec<String> = vec![frame.to_string(), csv_time(d.time), d.steps.to_string()];
         cols.extend(
             [
@@ -362,8 +350,11 @@ impl CsvWriter {
     }
 
     /// Flushes the file.
-    pub fn finish(mut self) -> Result<(), CliError> {
-        self.out.flush().map_err(|e| CliError::Output {
+    pub fn finish(self) -> Result<(), CliError> {
+        let Some(mut out) = self.out else {
+            return Ok(());
+        };
+        out.flush().map_err(|e| CliError::Output {
             path: self.path.clone(),
             message: e.to_string(),
         })

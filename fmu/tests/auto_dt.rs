@@ -39,8 +39,7 @@ fn dt_zero_runs_the_library_adaptive_substeps() {
     assert_eq!(by_parameter.set_real(&[VR_DT], &[0.0]), fmi2OK);
     by_parameter.init();
     assert_eq!(by_parameter.get_real(&[VR_DT]).unwrap(), vec![0.0]);
-    let by_scene = Fmu::new(&auto_scene());
-    by_scene.init();
+    let by_scene = Fmu::initialized(&auto_scene());
     assert_eq!(by_scene.get_real(&[VR_DT]).unwrap(), vec![0.0]);
     let mut sim = YarnSim::new(&auto_scene()).unwrap();
     let steps = 10;
@@ -136,8 +135,7 @@ fn pin_force_is_the_time_average_of_the_adaptive_substeps() {
         .replace("dt = 2e-4", "dt = \"auto\"");
     let scene = YarnScene::from_toml_str(&text).unwrap();
     assert!(scene.time.dt.is_auto() && scene.pins.len() == 1);
-    let f = Fmu::new(&scene);
-    f.init();
+    let f = Fmu::initialized(&scene);
     let mut sim = YarnSim::new(&scene).unwrap();
     let force = [VR_PIN_BASE + PIN_FORCE, VR_PIN_BASE + PIN_FORCE + 1];
     for k in 0..5 {

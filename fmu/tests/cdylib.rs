@@ -116,8 +116,7 @@ fn shared_library_loads_and_runs_like_the_rlib() {
         // The library stays loaded: its rayon worker threads may still run.
 
         // The same run through the rlib.
-        let fmu = Fmu::new(&scene);
-        fmu.init();
+        let fmu = Fmu::initialized(&scene);
         let mut rlib = Vec::new();
         for k in 0..5 {
             assert_eq!(fmu.set_real(&gvr, &inputs(k)), fmi2OK);

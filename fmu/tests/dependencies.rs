@@ -112,9 +112,7 @@ fn check_outputs(new: &dyn Fn() -> Fmu, d: &neutral::Description, h: f64) -> usi
             );
             checked += 1;
         }
-        // SAFETY: `f.c` came from `fmi2Instantiate` and lives until its `Fmu` drops; every
-        // pointer argument is a local that outlives the call.
-        assert_eq!(unsafe { fmi2SetFMUstate(f.c, state) }, fmi2OK);
+        f.set_state(state);
         assert_eq!(f.get_real(&outs).unwrap(), base);
     }
     checked

@@ -17,8 +17,7 @@ const H: f64 = 0.01;
 /// gravity off: the yarns are pulled around.
 #[test]
 fn attractor_on_a_circle_trajectory() {
-    let fmu = Fmu::new(&small_scene());
-    fmu.init();
+    let fmu = Fmu::initialized(&small_scene());
     assert_eq!(
         fmu.set_real(
             &[VR_GRAVITY_X, VR_GRAVITY_Y, VR_ATTRACTOR_STRENGTH],
@@ -58,8 +57,7 @@ fn attractor_on_a_circle_trajectory() {
 /// Gravity down, then sideways to +x, then up: the yarn ends follow.
 #[test]
 fn gravity_switching_direction_trajectory() {
-    let fmu = Fmu::new(&small_scene());
-    fmu.init();
+    let fmu = Fmu::initialized(&small_scene());
     let mut snap = Vec::new();
     let mut mean_x = Vec::new();
     let mut mean_y = Vec::new();
@@ -95,8 +93,7 @@ fn gravity_switching_direction_trajectory() {
 fn results_do_not_depend_on_the_step_partition() {
     let scene = small_scene();
     let run = |steps: &[f64]| {
-        let fmu = Fmu::new(&scene);
-        fmu.init();
+        let fmu = Fmu::initialized(&scene);
         let mut t = 0.0;
         for &h in steps {
             assert_eq!(fmu.do_step(t, h), fmi2OK, "{:?}", fmu.lines());
@@ -119,8 +116,7 @@ fn results_do_not_depend_on_the_step_partition() {
 #[test]
 fn fmu_matches_the_library() {
     let scene = small_scene();
-    let fmu = Fmu::new(&scene);
-    fmu.init();
+    let fmu = Fmu::initialized(&scene);
     let mut sim = yarnsim::mpm::YarnSim::new(&scene).unwrap();
     for k in 0..8 {
         let g = [0.5 * k as f64, -9.8];
@@ -151,14 +147,20 @@ fn run_on(fmu: &Fmu, t0: f64, n: usize) -> Vec<u64> {
     bits
 }
 
+/// The small scene and its FMU, initialized and run for `n` steps of
+/// [`run_on`] from t = 0.
+fn small_fmu_after(n: usize) -> (YarnScene, Fmu) {
+    let scene = small_scene();
+    let fmu = Fmu::initialized(&scene);
+    run_on(&fmu, 0.0, n);
+    (scene, fmu)
+}
+
 /// Get and serialize the state at t1, run on, deserialize, restore, run on
 /// again: identical bits, also in another instance.
 #[test]
 fn state_round_trip_gives_identical_bits() {
-    let scene = small_scene();
-    let fmu = Fmu::new(&scene);
-    fmu.init();
-    run_on(&fmu, 0.0, 5);
+    let (scene, fmu) = small_fmu_after(5);
     let s = fmu.get_state();
     let bytes = fmu.serialize(s);
     assert_eq!(&bytes[..8], b"YBFMUST\0");
@@ -166,15 +168,11 @@ fn state_round_trip_gives_identical_bits() {
 
     // Restore the in-memory state (twice: a state survives being set).
     for _ in 0..2 {
-        // SAFETY: `fmu.c` came from `fmi2Instantiate` and lives until its `Fmu` drops; every
-        // pointer argument is a local that outlives the call.
-        assert_eq!(unsafe { fmi2SetFMUstate(fmu.c, s) }, fmi2OK);
+        fmu.set_state(s);
         assert_eq!(run_on(&fmu, 0.05, 6), first);
     }
     // A state taken right after a restore serializes to the same bytes.
-    // SAFETY: `fmu.c` came from `fmi2Instantiate` and lives until its `Fmu` drops; every pointer
-    // argument is a local that outlives the call.
-    assert_eq!(unsafe { fmi2SetFMUstate(fmu.c, s) }, fmi2OK);
+    fmu.set_state(s);
     let s2 = fmu.get_state();
     assert_eq!(fmu.serialize(s2), bytes);
     fmu.free_state(s2);
@@ -206,8 +204,7 @@ fn state_round_trip_gives_identical_bits() {
 /// fmi2GetFMUstate into an existing state overwrites it.
 #[test]
 fn get_fmu_state_reuses_an_existing_state() {
-    let fmu = Fmu::new(&small_scene());
-    fmu.init();
+    let fmu = Fmu::initialized(&small_scene());
     let mut s = fmu.get_state();
     run_on(&fmu, 0.0, 3);
     let before = s;
@@ -216,9 +213,7 @@ fn get_fmu_state_reuses_an_existing_state() {
     assert_eq!(unsafe { fmi2GetFMUstate(fmu.c, &mut s) }, fmi2OK);
     assert_eq!(s, before);
     let later = run_on(&fmu, 0.03, 2);
-    // SAFETY: `fmu.c` came from `fmi2Instantiate` and lives until its `Fmu` drops; every pointer
-    // argument is a local that outlives the call.
-    assert_eq!(unsafe { fmi2SetFMUstate(fmu.c, s) }, fmi2OK);
+    fmu.set_state(s);
     assert_eq!(fmu.substeps(), 150);
     assert_eq!(run_on(&fmu, 0.03, 2), later);
     fmu.free_state(s);
@@ -228,10 +223,7 @@ fn get_fmu_state_reuses_an_existing_state() {
 /// log line, and never a state.
 #[test]
 fn corrupt_or_truncated_state_is_rejected() {
-    let scene = small_scene();
-    let fmu = Fmu::new(&scene);
-    fmu.init();
-    run_on(&fmu, 0.0, 2);
+    let (scene, fmu) = small_fmu_after(2);
     let s = fmu.get_state();
     let bytes = fmu.serialize(s);
     fmu.free_state(s);
@@ -292,28 +284,24 @@ fn illegal_call_order_is_an_error_with_a_log_line() {
     // SAFETY: `f.c` came from `fmi2Instantiate` and lives until its `Fmu` drops; every pointer
     // argument is a local that outlives the call.
     assert_eq!(unsafe { fmi2ExitInitializationMode(f.c) }, fmi2Error);
-    let f = Fmu::new(&scene);
-    f.init();
+    let f = Fmu::initialized(&scene);
     assert_eq!(f.setup(0.0, None), fmi2Error);
     assert!(f.last_error().contains("fmi2SetupExperiment"));
 
     // Fixed parameters cannot change after initialization.
-    let f = Fmu::new(&scene);
-    f.init();
+    let f = Fmu::initialized(&scene);
     assert_eq!(f.set_real(&[VR_DT], &[1e-4]), fmi2Error);
     f.assert_error_contains("fixed parameter");
 
     // Terminate, then no more steps.
-    let f = Fmu::new(&scene);
-    f.init();
+    let f = Fmu::initialized(&scene);
     // SAFETY: `f.c` came from `fmi2Instantiate` and lives until its `Fmu` drops; every pointer
     // argument is a local that outlives the call.
     assert_eq!(unsafe { fmi2Terminate(f.c) }, fmi2OK);
     assert_eq!(f.do_step(0.0, H), fmi2Error);
 
     // Unsupported optional functions answer fmi2Error, not a crash.
-    let f = Fmu::new(&scene);
-    f.init();
+    let f = Fmu::initialized(&scene);
     let mut v = 0.0;
     let order = 1;
     assert_eq!(
@@ -382,8 +370,7 @@ fn do_step_checks_time_step_and_stop_time() {
 #[test]
 fn reset_returns_to_the_instantiated_state() {
     let scene = small_scene();
-    let fresh = Fmu::new(&scene);
-    fresh.init();
+    let fresh = Fmu::initialized(&scene);
     let expected = run_on(&fresh, 0.0, 4);
 
     let f = Fmu::new(&scene);
@@ -493,8 +480,7 @@ fn guid_mismatch_and_bad_arguments_fail_instantiation() {
 #[test]
 fn null_pointers_and_bad_value_references_are_errors() {
     let scene = small_scene();
-    let f = Fmu::new(&scene);
-    f.init();
+    let f = Fmu::initialized(&scene);
     // SAFETY: null arrays with a non-zero count: the FMU checks every pointer for null before
     // reading it, which is what is checked.
     unsafe {
@@ -504,8 +490,7 @@ fn null_pointers_and_bad_value_references_are_errors() {
         );
         assert!(f.last_error().contains("null pointer"));
     }
-    let f = Fmu::new(&scene);
-    f.init();
+    let f = Fmu::initialized(&scene);
     assert_eq!(
         f.get_real(&[VR_YARN_BASE + 4 * f.yarns as u32]),
         Err(fmi2Error)
@@ -523,8 +508,7 @@ fn null_pointers_and_bad_value_references_are_errors() {
         );
     }
     // Zero-length calls with null arrays are fine.
-    let f = Fmu::new(&scene);
-    f.init();
+    let f = Fmu::initialized(&scene);
     // SAFETY: a zero-length call reads and writes nothing through its null arrays.
     unsafe {
         assert_eq!(
@@ -544,8 +528,7 @@ fn non_finite_and_absurd_inputs_are_rejected_with_a_log_line() {
         (VR_ATTRACTOR_STRENGTH, -1.0),
         (VR_GRAVITY_X, 1e7),
     ] {
-        let f = Fmu::new(&scene);
-        f.init();
+        let f = Fmu::initialized(&scene);
         assert_eq!(f.set_real(&[vr], &[v]), fmi2Error, "{vr} = {v}");
         assert!(f.last_error().contains("fmi2SetReal"), "{:?}", f.lines());
         // The instance is unusable until reset, then runs normally.
@@ -653,8 +636,7 @@ fn diverging_run_is_discarded_never_ok_with_nan() {
 }
 
 fn independent_run(scene: &YarnScene, gx: f64) -> Vec<u64> {
-    let f = Fmu::new(scene);
-    f.init();
+    let f = Fmu::initialized(scene);
     assert_eq!(f.set_real(&[VR_GRAVITY_X], &[gx]), fmi2OK);
     f.output_bits(0..6, H)
 }

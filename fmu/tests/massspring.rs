@@ -307,8 +307,7 @@ fn fmu_state_round_trip_gives_identical_bits() {
     bad[n - 3] ^= 0x40;
     assert_eq!(h.deserialize(&bad).0, fmi2Error);
     assert!(h.last_error().contains("checksum"), "{}", h.last_error());
-    let y = Fmu::new(&small_scene());
-    y.init();
+    let y = Fmu::initialized(&small_scene());
     assert_eq!(y.deserialize(&bytes).0, fmi2Error);
     assert!(y.last_error().contains("other kind"), "{}", y.last_error());
 }

@@ -45,8 +45,7 @@ fn transfer_parameters_give_the_library_bits() {
     let scene = small_scene();
     assert_eq!(scene.transfer.scheme, TransferScheme::Flip);
     let default = {
-        let f = Fmu::new(&scene);
-        f.init();
+        let f = Fmu::initialized(&scene);
         assert_eq!(f.get_string(VR_TRANSFER_SCHEME), "flip");
         assert_eq!(f.get_real(&[VR_FLIP_RATIO]), Ok(vec![1.0]));
         fmu_run(&f)
@@ -128,8 +127,7 @@ fn transfer_parameters_travel_in_the_fmu_state() {
     f.steps_ok(3..6, H);
     let end = f.outputs();
     // A fresh instance with the default scheme takes the state's.
-    let g = Fmu::new(&scene);
-    g.init();
+    let g = Fmu::initialized(&scene);
     let d = g.set_state_from(&bytes);
     g.free_state(d);
     assert_eq!(g.get_string(VR_TRANSFER_SCHEME), "apic");
@@ -271,8 +269,7 @@ fn input_pin_driven_on_a_circle_gives_the_library_bits() {
         let r = Vec2::new(cs * r0.x - sn * r0.y, sn * r0.x + cs * r0.y);
         (c + r, Vec2::new(-r.y, r.x) * w)
     };
-    let f = Fmu::new(&s);
-    f.init();
+    let f = Fmu::initialized(&s);
     let mut sim = YarnSim::new(&s).unwrap();
     let mut worst_pin: f64 = 0.0;
     for k in 0..20 {
@@ -326,14 +323,11 @@ fn driven_pin_state_round_trip_gives_identical_bits() {
     let st = f.get_state();
     let bytes = f.serialize(st);
     let first = drive(&f, 4, 6);
-    // SAFETY: `f.c` came from `fmi2Instantiate` and lives until its `Fmu` drops; every pointer
-    // argument is a local that outlives the call.
-    assert_eq!(unsafe { fmi2SetFMUstate(f.c, st) }, fmi2OK);
+    f.set_state(st);
     assert_eq!(drive(&f, 4, 6), first);
     f.free_state(st);
 
-    let g = Fmu::new(&s);
-    g.init();
+    let g = Fmu::initialized(&s);
     let d = g.set_state_from(&bytes);
     g.free_state(d);
     assert_eq!(g.get_string(VR_TRANSFER_SCHEME), "flip");
@@ -352,8 +346,7 @@ fn input_pin_on_the_substep_grid_reproduces_line_and_circle_pins() {
     let dt = input.time.dt.fixed().unwrap();
     let steps = 250; // 0.05 s
     let run_fmu = |target: &dyn Fn(f64) -> (Vec2, Vec2)| {
-        let f = Fmu::new(&input);
-        f.init();
+        let f = Fmu::initialized(&input);
         let mut rows = Vec::new();
         for k in 0..steps {
             let t = k as f64 * dt;
@@ -423,8 +416,7 @@ fn hanging_yarn_pulls_its_input_pin_with_its_weight() {
     s.pins[0].motion = PinMotionKind::Input;
     s.validate().unwrap();
     let weight = YarnSim::new(&s).unwrap().diagnostics().total_mass * g;
-    let f = Fmu::new(&s);
-    f.init();
+    let f = Fmu::initialized(&s);
     let h = 0.01;
     let mut sum = Vec2::zeros();
     let mut n = 0;

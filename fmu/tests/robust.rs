@@ -82,8 +82,7 @@ fn a_step_beyond_the_substep_budget_is_refused_before_it_runs() {
     // Fixed after initialization, at least 1, Integer only.
     let k = Fmu::new(&scene);
     assert_eq!(set_int(&k, VR_MAX_SUBSTEPS, 0), fmi2Error);
-    let k = Fmu::new(&scene);
-    k.init();
+    let k = Fmu::initialized(&scene);
     assert_eq!(set_int(&k, VR_MAX_SUBSTEPS, 100), fmi2Error);
     k.assert_error_contains("fixed parameter");
     let k = Fmu::new(&scene);
@@ -211,8 +210,7 @@ fn threads_parameter_gives_identical_bits() {
     assert_eq!(set_int(&f, VR_THREADS, -1), fmi2Error);
     let f = Fmu::new(&small_scene());
     assert_eq!(set_int(&f, VR_THREADS, 100_000), fmi2Error);
-    let f = Fmu::new(&small_scene());
-    f.init();
+    let f = Fmu::initialized(&small_scene());
     assert_eq!(set_int(&f, VR_THREADS, 2), fmi2Error);
 }
 

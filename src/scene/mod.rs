@@ -39,17 +39,13 @@ impl Scene {
             Some(k) if massspring::KINDS.contains(&k) => {
                 MassSpringScene::from_toml_str(text).map(Scene::MassSpring)
             }
-            Some(other) => Err(SceneError::Invalid {
-                field: "kind".into(),
-                line: text
-                    .lines()
-                    .position(|l| l.trim_start().starts_with("kind"))
-                    .map(|i| i + 1),
-                message: format!(
+            Some(other) => Err(kind_error(
+                text,
+                format!(
                     "unknown scene kind {other:?}; known kinds: \"yarn\", {}",
                     massspring::KINDS.map(|k| format!("{k:?}")).join(", ")
                 ),
-            }),
+            )),
         }
     }
 
@@ -113,14 +109,19 @@ fn toml_kind(text: &str) -> Result<Option<String>, SceneError> {
     match value.get("kind") {
         None => Ok(None),
         Some(toml::Value::String(s)) => Ok(Some(s.clone())),
-        Some(_) => Err(SceneError::Invalid {
-            field: "kind".into(),
-            line: text
-                .lines()
-                .position(|l| l.trim_start().starts_with("kind"))
-                .map(|i| i + 1),
-            message: "kind must be a string".into(),
-        }),
+        Some(_) => Err(kind_error(text, "kind must be a string".into())),
+    }
+}
+
+/// An error in the scene's `kind` field, on the line that sets it.
+fn kind_error(text: &str, message: String) -> SceneError {
+    SceneError::Invalid {
+        field: "kind".into(),
+        line: text
+            .lines()
+            .position(|l| l.trim_start().starts_with("kind"))
+            .map(|i| i + 1),
+        message,
     }
 }
 

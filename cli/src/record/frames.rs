@@ -6,9 +6,7 @@ use std::path::Path;
 use rerun::RecordingStream;
 
 use super::sink::{Server, Sink};
-use crate::driver::{
-    interrupt_flag, progress_bar, run_frames, FrameInfo, FrameRun, Outcome, Stepper,
-};
+use crate::driver::{run_frames_shown, FrameInfo, FrameRun, Outcome, Stepper};
 use crate::error::CliError;
 use crate::schedule::Schedule;
 
@@ -61,9 +59,8 @@ pub(super) fn record_frames<S: Stepper + Send>(
     opts: &RecordOptions,
     mut log: impl FnMut(&RecordingStream, &S, FrameInfo) -> rerun::RecordingStreamResult<()>,
 ) -> Result<RecordOutcome, CliError> {
-    let progress = progress_bar(schedule.total_steps, label);
     let mut frames_logged = 0;
-    let result = run_frames(sim, schedule, &interrupt_flag(), &progress, |sim, frame| {
+    let result = run_frames_shown(sim, schedule, label, |sim, frame| {
         if opts.logs(&frame) {
             log(&rec, sim, frame).map_err(|e| opts.sink.error(e))?;
             frames_logged += 1;
@@ -93,4 +90,23 @@ pub(super) fn record_frames<S: Stepper + Send>(
         failure,
         server,
     })
+}
+
+/// Logs a frame's plotted scalars (entity path, value) and, when the frame
+/// ran substeps, the wall time per substep (`plots/step_time`).
+pub fn log_scalars(
+    rec: &RecordingStream,
+    scalars: &[(&str, f64)],
+    frame: &FrameInfo,
+) -> rerun::RecordingStreamResult<()> {
+    for &(path, value) in scalars {
+        rec.log(path, &rerun::Scalars::single(value))?;
+    }
+    if frame.substeps > 0 {
+        rec.log(
+            super::paths::STEP_TIME,
+            &rerun::Scalars::single(frame.step_seconds / frame.substeps as f64),
+        )?;
+    }
+    Ok(())
 }

@@ -8,7 +8,7 @@ use rerun::{
 };
 
 use super::blueprint::massspring_blueprint;
-use super::frames::{record_frames, RecordOptions, RecordOutcome};
+use super::frames::{log_scalars, record_frames, RecordOptions, RecordOutcome};
 use super::sink::open;
 use super::style::{legend, p3, series_color, stretch_color};
 use super::{paths, values, TIMELINE_FRAME, TIMELINE_SIM_TIME};
@@ -141,18 +141,11 @@ fn log_massspring_frame(
         (paths::COM_Y, d.center_of_mass.y),
         (paths::COM_Z, d.center_of_mass.z),
     ];
-    for (path, value) in scalars {
-        rec.log(path, &Scalars::single(value))?;
-    }
     if frame.substeps > 0 {
         rec.log(
             paths::CG_ITERATIONS,
             &Scalars::single(sim.last_step().cg_iterations as f64),
         )?;
-        rec.log(
-            paths::STEP_TIME,
-            &Scalars::single(frame.step_seconds / frame.substeps as f64),
-        )?;
     }
-    Ok(())
+    log_scalars(rec, &scalars, &frame)
 }

@@ -3,7 +3,7 @@
 
 use rerun::components::{Color, Scalar, Vector2D};
 use rerun::{
-    AnyValues, Boxes2D, Ellipses2D, LineStrips2D, Points2D, RecordingStream, Scalars, SeriesLines,
+    AnyValues, Boxes2D, Ellipses2D, LineStrips2D, Points2D, RecordingStream, SeriesLines,
     TextDocument,
 };
 use yarnsim::math::qr::qr;
@@ -11,7 +11,7 @@ use yarnsim::scene::WallMode;
 use yarnsim::YarnSim;
 
 use super::blueprint::yarn_blueprint;
-use super::frames::{record_frames, RecordOptions, RecordOutcome};
+use super::frames::{log_scalars, record_frames, RecordOptions, RecordOutcome};
 use super::sink::open;
 use super::style::{
     legend, p2, series_color, stretch_color, view2, yarn_color, QUADRATURE_RADIUS, STRIP_RADIUS,
@@ -220,14 +220,5 @@ fn log_yarn_frame(
         (paths::COM_X, d.center_of_mass.x),
         (paths::COM_Y, d.center_of_mass.y),
     ];
-    for (path, value) in scalars {
-        rec.log(path, &Scalars::single(value))?;
-    }
-    if frame.substeps > 0 {
-        rec.log(
-            paths::STEP_TIME,
-            &Scalars::single(frame.step_seconds / frame.substeps as f64),
-        )?;
-    }
-    Ok(())
+    log_scalars(rec, &scalars, &frame)
 }

@@ -107,6 +107,13 @@ impl Fmu {
         Self::try_new(scene, &guid(scene), "test").expect("fmi2Instantiate failed")
     }
 
+    /// [`Self::new`], set up and through initialization ([`Self::init`]).
+    pub fn initialized(scene: &YarnScene) -> Fmu {
+        let f = Fmu::new(scene);
+        f.init();
+        f
+    }
+
     pub fn try_new(scene: &YarnScene, guid: &str, name: &str) -> Result<Fmu, Vec<Line>> {
         Self::try_with(&scene.to_toml_string(), num_yarns(scene), guid, name)
     }
@@ -374,14 +381,21 @@ impl Fmu {
         (st, s)
     }
 
+    /// Sets the instance to the state `s` (a state of this FMU that has not
+    /// been freed), which must give fmi2OK.
+    pub fn set_state(&self, s: fmi2FMUstate) {
+        // SAFETY: `self.c` came from `fmi2Instantiate` and lives until its `Fmu` drops; the
+        // caller passes a state this FMU made and has not freed.
+        let status = unsafe { fmi2SetFMUstate(self.c, s) };
+        assert_eq!(status, fmi2OK, "{:?}", self.lines());
+    }
+
     /// Deserializes `bytes` and sets the instance to that state (both
     /// fmi2OK); returns the state, for the caller to free.
     pub fn set_state_from(&self, bytes: &[u8]) -> fmi2FMUstate {
         let (st, d) = self.deserialize(bytes);
         assert_eq!(st, fmi2OK, "{:?}", self.lines());
-        // SAFETY: `self.c` came from `fmi2Instantiate` and lives until its `Fmu` drops; `d`
-        // is the state fmi2DeSerializeFMUstate just made for it.
-        assert_eq!(unsafe { fmi2SetFMUstate(self.c, d) }, fmi2OK);
+        self.set_state(d);
         d
     }
 
