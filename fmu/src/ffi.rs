@@ -16,8 +16,8 @@ use std::panic::{catch_unwind, AssertUnwindSafe};
 use libc::size_t;
 
 use crate::instance::{
-    error, Instance, Logger, Phase, Res, Snapshot, Status, LOG_ALL, LOG_DISCARD, LOG_ERROR,
-    LOG_FATAL,
+    error, message_in, Instance, Logger, Phase, Res, Snapshot, Status, LOG_ALL, LOG_DISCARD,
+    LOG_ERROR, LOG_FATAL,
 };
 
 pub type fmi2Component = *mut c_void;
@@ -61,7 +61,7 @@ pub struct fmi2CallbackFunctions {
     pub componentEnvironment: fmi2ComponentEnvironment,
 }
 
-fn panic_message(p: &(dyn std::any::Any + Send)) -> String {
+pub(crate) fn panic_message(p: &(dyn std::any::Any + Send)) -> String {
     if let Some(s) = p.downcast_ref::<&str>() {
         s.to_string()
     } else if let Some(s) = p.downcast_ref::<String>() {
@@ -74,7 +74,11 @@ fn panic_message(p: &(dyn std::any::Any + Send)) -> String {
 /// Runs `f` on the instance behind `c`: null or foreign pointers give
 /// fmi2Error, failures are logged (fmi2Error moves the instance to the error
 /// state), panics are caught and give fmi2Fatal.
-fn call(c: fmi2Component, func: &str, f: impl FnOnce(&mut Instance) -> Res<Status>) -> fmi2Status {
+pub(crate) fn call(
+    c: fmi2Component,
+    func: &str,
+    f: impl FnOnce(&mut Instance) -> Res<Status>,
+) -> fmi2Status {
     // SAFETY: `c` is null or a component this FMU handed out (FMI contract);
     // the magic number rejects freed or foreign pointers in most cases.
     let Some(inst) = (unsafe { Instance::from_ptr(c) }) else {
@@ -106,10 +110,12 @@ fn call(c: fmi2Component, func: &str, f: impl FnOnce(&mut Instance) -> Res<Statu
                 Status::Fatal => LOG_FATAL,
                 _ => LOG_ERROR,
             };
-            let msg = if fail.msg.starts_with(func) {
-                fail.msg
+            // An FMI 3.0 instance's messages in FMI 3.0 words (FMI 2.0: unchanged).
+            let shown = message_in(inst.api, &fail.msg);
+            let msg = if shown.starts_with(func) {
+                shown
             } else {
-                format!("{func}: {}", fail.msg)
+                format!("{func}: {shown}")
             };
             inst.log(fail.status, cat, &msg);
             match fail.status {
@@ -131,7 +137,7 @@ fn call(c: fmi2Component, func: &str, f: impl FnOnce(&mut Instance) -> Res<Statu
     }
 }
 
-fn ok(r: Res) -> Res<Status> {
+pub(crate) fn ok(r: Res) -> Res<Status> {
     r.map(|_| Status::Ok)
 }
 
@@ -140,7 +146,7 @@ fn ok(r: Res) -> Res<Status> {
 /// # Safety
 /// `p` must be null or point to `n` initialized, aligned elements that stay
 /// valid and unchanged for `'a` (the FMI contract for the arrays it passes).
-unsafe fn slice<'a, T>(p: *const T, n: size_t) -> Option<&'a [T]> {
+pub(crate) unsafe fn slice<'a, T>(p: *const T, n: size_t) -> Option<&'a [T]> {
     if n == 0 {
         Some(&[])
     } else if p.is_null() {
@@ -157,7 +163,7 @@ unsafe fn slice<'a, T>(p: *const T, n: size_t) -> Option<&'a [T]> {
 /// # Safety
 /// `p` must be null or point to `n` aligned elements, writable and not
 /// aliased for `'a`.
-unsafe fn slice_mut<'a, T>(p: *mut T, n: size_t) -> Option<&'a mut [T]> {
+pub(crate) unsafe fn slice_mut<'a, T>(p: *mut T, n: size_t) -> Option<&'a mut [T]> {
     if n == 0 {
         Some(&mut [])
     } else if p.is_null() {
@@ -172,12 +178,12 @@ unsafe fn slice_mut<'a, T>(p: *mut T, n: size_t) -> Option<&'a mut [T]> {
 ///
 /// # Safety
 /// `p` must be null or point to a NUL-terminated string valid for the call.
-unsafe fn string(p: fmi2String) -> Option<String> {
+pub(crate) unsafe fn string(p: fmi2String) -> Option<String> {
     // SAFETY: non-null and NUL-terminated (the caller's contract).
     (!p.is_null()).then(|| unsafe { CStr::from_ptr(p) }.to_string_lossy().into_owned())
 }
 
-fn null(func: &str, what: &str) -> Res<Status> {
+pub(crate) fn null(func: &str, what: &str) -> Res<Status> {
     error(format!("{func}: {what} is a null pointer"))
 }
 
@@ -536,35 +542,16 @@ pub unsafe extern "C" fn fmi2GetFMUstate(
     FMUstate: *mut fmi2FMUstate,
 ) -> fmi2Status {
     call(c, "fmi2GetFMUstate", |inst| {
-        // SAFETY: `FMUstate` is null or points to the environment's state slot.
-        let Some(slot) = (unsafe { FMUstate.as_mut() }) else {
-            return null("fmi2GetFMUstate", "FMUstate");
-        };
-        let existing = if slot.is_null() {
-            None
-        } else {
-            // SAFETY: a non-null slot holds a state this FMU handed out
-            // (FMI contract); the magic number rejects others.
-            match unsafe { Snapshot::from_ptr(*slot) } {
-                Some(s) => Some(s),
-                None => return error("*FMUstate is not an FMU state of this FMU"),
-            }
-        };
-        if let Some(new) = inst.get_fmu_state(existing)? {
-            *slot = Box::into_raw(new) as fmi2FMUstate;
-        }
-        Ok(Status::Ok)
+        // SAFETY: forwarded from the caller (FMI contract).
+        unsafe { get_state(inst, "fmi2GetFMUstate", FMUstate) }
     })
 }
 
 #[no_mangle]
 pub unsafe extern "C" fn fmi2SetFMUstate(c: fmi2Component, FMUstate: fmi2FMUstate) -> fmi2Status {
-    call(c, "fmi2SetFMUstate", |inst| {
-        // SAFETY: null or a state this FMU handed out (checked by its magic).
-        let Some(s) = (unsafe { Snapshot::from_ptr(FMUstate) }) else {
-            return error("FMUstate is null or not an FMU state of this FMU");
-        };
-        ok(inst.set_fmu_state(s))
+    // SAFETY: forwarded from the caller (FMI contract).
+    call(c, "fmi2SetFMUstate", |inst| unsafe {
+        set_state(inst, FMUstate)
     })
 }
 
@@ -573,24 +560,8 @@ pub unsafe extern "C" fn fmi2FreeFMUstate(
     c: fmi2Component,
     FMUstate: *mut fmi2FMUstate,
 ) -> fmi2Status {
-    call(c, "fmi2FreeFMUstate", |_inst| {
-        // SAFETY: `FMUstate` is null or points to the environment's state slot.
-        let Some(slot) = (unsafe { FMUstate.as_mut() }) else {
-            return Ok(Status::Ok);
-        };
-        if slot.is_null() {
-            return Ok(Status::Ok);
-        }
-        // SAFETY: a non-null slot holds a state this FMU handed out.
-        let Some(s) = (unsafe { Snapshot::from_ptr(*slot) }) else {
-            return error("*FMUstate is not an FMU state of this FMU");
-        };
-        // SAFETY: states are made by `Box::into_raw`; the slot is cleared
-        // below, so it is freed once.
-        drop(unsafe { Box::from_raw(s as *mut Snapshot) });
-        *slot = std::ptr::null_mut();
-        Ok(Status::Ok)
-    })
+    // SAFETY: forwarded from the caller (FMI contract).
+    call(c, "fmi2FreeFMUstate", |_| unsafe { free_state(FMUstate) })
 }
 
 #[no_mangle]
@@ -600,16 +571,8 @@ pub unsafe extern "C" fn fmi2SerializedFMUstateSize(
     size: *mut size_t,
 ) -> fmi2Status {
     call(c, "fmi2SerializedFMUstateSize", |inst| {
-        // SAFETY: null or a state this FMU handed out (checked by its magic).
-        let Some(s) = (unsafe { Snapshot::from_ptr(FMUstate) }) else {
-            return error("FMUstate is null or not an FMU state of this FMU");
-        };
-        // SAFETY: `size` is null or points to a writable size_t.
-        let Some(size) = (unsafe { size.as_mut() }) else {
-            return null("fmi2SerializedFMUstateSize", "size");
-        };
-        *size = inst.serialize("fmi2SerializedFMUstateSize", s)?.len();
-        Ok(Status::Ok)
+        // SAFETY: forwarded from the caller (FMI contract).
+        unsafe { state_size(inst, "fmi2SerializedFMUstateSize", FMUstate, size) }
     })
 }
 
@@ -621,26 +584,17 @@ pub unsafe extern "C" fn fmi2SerializeFMUstate(
     size: size_t,
 ) -> fmi2Status {
     call(c, "fmi2SerializeFMUstate", |inst| {
-        // SAFETY: null or a state this FMU handed out (checked by its magic).
-        let Some(s) = (unsafe { Snapshot::from_ptr(FMUstate) }) else {
-            return error("FMUstate is null or not an FMU state of this FMU");
-        };
-        let bytes = inst.serialize("fmi2SerializeFMUstate", s)?;
-        if size < bytes.len() {
-            return error(format!(
-                "buffer of {size} bytes is smaller than the state's {} (fmi2SerializedFMUstateSize)",
-                bytes.len()
-            ));
-        }
-        if serializedState.is_null() {
-            return null("fmi2SerializeFMUstate", "serializedState");
-        }
-        // SAFETY: the buffer is non-null and holds `size` >= len bytes
-        // (FMI contract); it does not overlap the snapshot's own bytes.
+        // SAFETY: forwarded from the caller (FMI contract).
         unsafe {
-            std::ptr::copy_nonoverlapping(bytes.as_ptr(), serializedState as *mut u8, bytes.len())
-        };
-        Ok(Status::Ok)
+            serialize_state(
+                inst,
+                "fmi2SerializeFMUstate",
+                "fmi2SerializedFMUstateSize",
+                FMUstate,
+                serializedState as *mut u8,
+                size,
+            )
+        }
     })
 }
 
@@ -652,31 +606,16 @@ pub unsafe extern "C" fn fmi2DeSerializeFMUstate(
     FMUstate: *mut fmi2FMUstate,
 ) -> fmi2Status {
     call(c, "fmi2DeSerializeFMUstate", |inst| {
-        // SAFETY: FMI passes `size` bytes of a serialized state.
-        let Some(bytes) = (unsafe { slice(serializedState as *const u8, size) }) else {
-            return null("fmi2DeSerializeFMUstate", "serializedState");
-        };
-        // SAFETY: `FMUstate` is null or points to the environment's state slot.
-        let Some(slot) = (unsafe { FMUstate.as_mut() }) else {
-            return null("fmi2DeSerializeFMUstate", "FMUstate");
-        };
-        let old = if slot.is_null() {
-            None
-        } else {
-            // SAFETY: a non-null slot holds a state this FMU handed out.
-            match unsafe { Snapshot::from_ptr(*slot) } {
-                Some(s) => Some(s as *mut Snapshot),
-                None => return error("*FMUstate is not an FMU state of this FMU"),
-            }
-        };
-        let new = inst.deserialize(bytes)?;
-        if let Some(old) = old {
-            // SAFETY: made by `Box::into_raw`; the slot is overwritten
-            // below, so the old state is freed once.
-            drop(unsafe { Box::from_raw(old) });
+        // SAFETY: forwarded from the caller (FMI contract).
+        unsafe {
+            deserialize_state(
+                inst,
+                "fmi2DeSerializeFMUstate",
+                serializedState as *const u8,
+                size,
+                FMUstate,
+            )
         }
-        *slot = Box::into_raw(new) as fmi2FMUstate;
-        Ok(Status::Ok)
     })
 }
 
@@ -851,4 +790,170 @@ pub unsafe extern "C" fn fmi2GetStringStatus(
             "status kind {s} has no String value: fmi2DoStep never returns fmi2Pending"
         ))
     })
+}
+
+// ------------------------------------------- FMU states (FMI 2.0 and 3.0)
+
+/// `fmi2GetFMUstate` / `fmi3GetFMUState`: a new state into `*FMUstate`, or
+/// the state already there overwritten.
+///
+/// # Safety
+/// `FMUstate` is null or points to the environment's state slot, which is
+/// null or holds a state this FMU handed out.
+pub(crate) unsafe fn get_state(
+    inst: &mut Instance,
+    func: &str,
+    FMUstate: *mut *mut c_void,
+) -> Res<Status> {
+    // SAFETY: `FMUstate` is null or points to the environment's state slot.
+    let Some(slot) = (unsafe { FMUstate.as_mut() }) else {
+        return null(func, "FMUstate");
+    };
+    let existing = if slot.is_null() {
+        None
+    } else {
+        // SAFETY: a non-null slot holds a state this FMU handed out
+        // (FMI contract); the magic number rejects others.
+        match unsafe { Snapshot::from_ptr(*slot) } {
+            Some(s) => Some(s),
+            None => return error("*FMUstate is not an FMU state of this FMU"),
+        }
+    };
+    if let Some(new) = inst.get_fmu_state(existing)? {
+        *slot = Box::into_raw(new) as fmi2FMUstate;
+    }
+    Ok(Status::Ok)
+}
+
+/// `fmi2SetFMUstate` / `fmi3SetFMUState`.
+///
+/// # Safety
+/// `FMUstate` is null or a state this FMU handed out.
+pub(crate) unsafe fn set_state(inst: &mut Instance, FMUstate: *mut c_void) -> Res<Status> {
+    // SAFETY: null or a state this FMU handed out (checked by its magic).
+    let Some(s) = (unsafe { Snapshot::from_ptr(FMUstate) }) else {
+        return error("FMUstate is null or not an FMU state of this FMU");
+    };
+    ok(inst.set_fmu_state(s))
+}
+
+/// `fmi2FreeFMUstate` / `fmi3FreeFMUState`: frees `*FMUstate` and clears
+/// the slot; a null slot or state is a no-op.
+///
+/// # Safety
+/// `FMUstate` is null or points to the environment's state slot.
+pub(crate) unsafe fn free_state(FMUstate: *mut *mut c_void) -> Res<Status> {
+    // SAFETY: `FMUstate` is null or points to the environment's state slot.
+    let Some(slot) = (unsafe { FMUstate.as_mut() }) else {
+        return Ok(Status::Ok);
+    };
+    if slot.is_null() {
+        return Ok(Status::Ok);
+    }
+    // SAFETY: a non-null slot holds a state this FMU handed out.
+    let Some(s) = (unsafe { Snapshot::from_ptr(*slot) }) else {
+        return error("*FMUstate is not an FMU state of this FMU");
+    };
+    // SAFETY: states are made by `Box::into_raw`; the slot is cleared
+    // below, so it is freed once.
+    drop(unsafe { Box::from_raw(s as *mut Snapshot) });
+    *slot = std::ptr::null_mut();
+    Ok(Status::Ok)
+}
+
+/// `fmi2SerializedFMUstateSize` / `fmi3SerializedFMUStateSize`.
+///
+/// # Safety
+/// `FMUstate` is null or a state this FMU handed out; `size` is null or
+/// points to a writable `size_t`.
+pub(crate) unsafe fn state_size(
+    inst: &mut Instance,
+    func: &str,
+    FMUstate: *mut c_void,
+    size: *mut size_t,
+) -> Res<Status> {
+    // SAFETY: null or a state this FMU handed out (checked by its magic).
+    let Some(s) = (unsafe { Snapshot::from_ptr(FMUstate) }) else {
+        return error("FMUstate is null or not an FMU state of this FMU");
+    };
+    // SAFETY: `size` is null or points to a writable size_t.
+    let Some(size) = (unsafe { size.as_mut() }) else {
+        return null(func, "size");
+    };
+    *size = inst.serialize(func, s)?.len();
+    Ok(Status::Ok)
+}
+
+/// `fmi2SerializeFMUstate` / `fmi3SerializeFMUState` into a buffer of
+/// `size` bytes (`size_func`: the function that tells the size).
+///
+/// # Safety
+/// `FMUstate` is null or a state this FMU handed out; `buf` is null or
+/// holds `size` writable bytes.
+pub(crate) unsafe fn serialize_state(
+    inst: &mut Instance,
+    func: &str,
+    size_func: &str,
+    FMUstate: *mut c_void,
+    buf: *mut u8,
+    size: size_t,
+) -> Res<Status> {
+    // SAFETY: null or a state this FMU handed out (checked by its magic).
+    let Some(s) = (unsafe { Snapshot::from_ptr(FMUstate) }) else {
+        return error("FMUstate is null or not an FMU state of this FMU");
+    };
+    let bytes = inst.serialize(func, s)?;
+    if size < bytes.len() {
+        return error(format!(
+            "buffer of {size} bytes is smaller than the state's {} ({size_func})",
+            bytes.len()
+        ));
+    }
+    if buf.is_null() {
+        return null(func, "serializedState");
+    }
+    // SAFETY: the buffer is non-null and holds `size` >= len bytes
+    // (FMI contract); it does not overlap the snapshot's own bytes.
+    unsafe { std::ptr::copy_nonoverlapping(bytes.as_ptr(), buf, bytes.len()) };
+    Ok(Status::Ok)
+}
+
+/// `fmi2DeSerializeFMUstate` / `fmi3DeserializeFMUState`: a new state from
+/// `size` bytes into `*FMUstate` (a state already there is freed).
+///
+/// # Safety
+/// `bytes` is null or holds `size` readable bytes; `FMUstate` is null or
+/// points to the environment's state slot.
+pub(crate) unsafe fn deserialize_state(
+    inst: &mut Instance,
+    func: &str,
+    bytes: *const u8,
+    size: size_t,
+    FMUstate: *mut *mut c_void,
+) -> Res<Status> {
+    // SAFETY: FMI passes `size` bytes of a serialized state.
+    let Some(bytes) = (unsafe { slice(bytes, size) }) else {
+        return null(func, "serializedState");
+    };
+    // SAFETY: `FMUstate` is null or points to the environment's state slot.
+    let Some(slot) = (unsafe { FMUstate.as_mut() }) else {
+        return null(func, "FMUstate");
+    };
+    let old = if slot.is_null() {
+        None
+    } else {
+        // SAFETY: a non-null slot holds a state this FMU handed out.
+        match unsafe { Snapshot::from_ptr(*slot) } {
+            Some(s) => Some(s as *mut Snapshot),
+            None => return error("*FMUstate is not an FMU state of this FMU"),
+        }
+    };
+    let new = inst.deserialize(bytes)?;
+    if let Some(old) = old {
+        // SAFETY: made by `Box::into_raw`; the slot is overwritten
+        // below, so the old state is freed once.
+        drop(unsafe { Box::from_raw(old) });
+    }
+    *slot = Box::into_raw(new) as *mut c_void;
+    Ok(Status::Ok)
 }

@@ -4,8 +4,9 @@
 //! ([`crate::massspring::MsModel`]). The models know nothing of FMI
 //! statuses, function names or C types: they answer with typed errors
 //! ([`ModelError`], [`StepFailure`]) and Rust values, and the front end turns
-//! them into fmi2 statuses and log lines. An FMI 3.0 front end could drive
-//! the same models.
+//! them into fmi2 and fmi3 statuses and log lines: the FMI 2.0 front end
+//! ([`crate::ffi`]) and the FMI 3.0 one ([`crate::fmi3`]) drive the same
+//! models.
 
 use std::any::Any;
 use std::fmt;
@@ -121,6 +122,23 @@ pub trait FmuModel: fmt::Debug + Send {
     fn is_state_output(&self, vr: u32) -> bool;
     /// The value of the Real variable `vr`, `None` if there is none.
     fn get_real(&mut self, vr: u32) -> Option<f64>;
+    /// FMI 3.0 Float64 arrays: the number of values of the array output
+    /// `vr` (`None`: `vr` is not an array of this model).
+    fn array_len(&self, vr: u32) -> Option<usize> {
+        let _ = vr;
+        None
+    }
+    /// Writes the array output `vr` ([`Self::array_len`] values, row-major)
+    /// into `out`; false (nothing written) if `vr` is not an array of this
+    /// model or `out` has another length.
+    fn get_real_array(&mut self, vr: u32, out: &mut [f64]) -> bool {
+        let _ = (vr, out);
+        false
+    }
+    /// Every value of every array output is finite.
+    fn arrays_finite(&self) -> bool {
+        true
+    }
     /// The value of the Boolean variable `vr`, `None` if there is none.
     fn get_boolean(&self, vr: u32) -> Option<bool>;
     /// The value of the String variable `vr`, `None` if there is none.

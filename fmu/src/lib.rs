@@ -44,6 +44,7 @@
 
 pub mod clock;
 pub mod ffi;
+pub mod fmi3;
 pub mod fmu_model;
 pub mod instance;
 pub mod logging;

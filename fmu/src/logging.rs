@@ -10,6 +10,11 @@ use crate::model::LOG_CATEGORIES;
 pub type Logger =
     unsafe extern "C" fn(*mut c_void, *const c_char, c_int, *const c_char, *const c_char, ...);
 
+/// The FMI 3.0 logger callback `fmi3LogMessageCallback`:
+/// `(instanceEnvironment, status, category, message)`, not variadic (the
+/// message is plain text, no printf format).
+pub type Logger3 = unsafe extern "C" fn(*mut c_void, c_int, *const c_char, *const c_char);
+
 /// Log category indices into [`LOG_CATEGORIES`].
 pub const LOG_EVENTS: usize = 0;
 pub const LOG_WARNING: usize = 1;

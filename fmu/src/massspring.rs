@@ -128,6 +128,24 @@ pub fn dependencies() -> Vec<crate::model::Dependency> {
         .collect()
 }
 
+/// `positions`, the FMI 3.0 array of all particle positions.
+pub const VR_POSITIONS: u32 = crate::model::VR_ARRAY_BASE;
+
+/// The FMI 3.0 array output `positions` (`[n, 3]`, row-major: x, y, z of
+/// particle 0, then of particle 1, ...) of `n` particles.
+pub fn positions_array(n: usize) -> crate::model::ArrayVariable {
+    crate::model::ArrayVariable {
+        name: "positions".into(),
+        vr: VR_POSITIONS,
+        dims: vec![n, 3],
+        unit: Some("m"),
+        description: format!(
+            "The positions of the {n} particles, x, y and z of each (row-major {n} x 3)"
+        ),
+        initial: Vec::new(),
+    }
+}
+
 /// The GUID of the FMU for this layout: a hash of the interface version and
 /// the layout's normalized TOML text.
 pub fn guid(layout: &MassSpringScene) -> String {
@@ -152,6 +170,7 @@ pub fn description(layout: &MassSpringScene) -> Result<Description, String> {
         stop_time: layout.time.frame_time * layout.time.frames as f64,
         step_size: layout.time.frame_time,
         dependencies: dependencies(),
+        arrays: vec![positions_array(num_particles(layout)?)],
     })
 }
 
@@ -344,6 +363,23 @@ impl FmuModel for MsModel {
             }
             _ => return None,
         })
+    }
+    fn array_len(&self, vr: u32) -> Option<usize> {
+        (vr == VR_POSITIONS).then(|| 3 * self.sim.positions().len())
+    }
+    fn get_real_array(&mut self, vr: u32, out: &mut [f64]) -> bool {
+        let p = self.sim.positions();
+        if vr != VR_POSITIONS || out.len() != 3 * p.len() {
+            return false;
+        }
+        for (o, x) in out.chunks_exact_mut(3).zip(p) {
+            o.copy_from_slice(&[x[0], x[1], x[2]]);
+        }
+        true
+    }
+    /// The only array, `positions`, is checked by [`Self::outputs_finite`].
+    fn arrays_finite(&self) -> bool {
+        true
     }
     fn get_boolean(&self, _vr: u32) -> Option<bool> {
         None

@@ -9,7 +9,7 @@ use yarnsim::scene::Scene;
 
 use crate::fmu_model::{FmuModel, ModelResult};
 use crate::massspring::MsModel;
-use crate::model::{write_model_description, Description};
+use crate::model::{write_model_description, write_model_description_fmi3, Description};
 use crate::yarn::variables::{
     check_value_references, description, guid, num_yarns, MODEL_IDENTIFIER,
 };
@@ -28,6 +28,10 @@ pub trait SceneFmu {
     /// `modelDescription.xml`.
     fn model_description(&self) -> Result<String, String> {
         self.description().map(|d| write_model_description(&d))
+    }
+    /// The FMI 3.0 `modelDescription.xml` (with the array outputs).
+    fn model_description_fmi3(&self) -> Result<String, String> {
+        self.description().map(|d| write_model_description_fmi3(&d))
     }
     /// What the outputs describe: `"yarns"` or `"particles"`.
     fn objects(&self) -> &'static str;

@@ -9,6 +9,7 @@
 use std::ffi::{c_int, c_void, CString};
 use std::path::PathBuf;
 
+mod fmi3;
 mod states;
 mod values;
 
@@ -24,7 +25,9 @@ use crate::resources::read_scene;
 pub use crate::resources::resource_path;
 pub use crate::snapshot::*;
 pub use crate::state_bytes::*;
-pub use crate::state_machine::{error, parameter_settable, phase_name, Fail, Phase, Res, Status};
+pub use crate::state_machine::{
+    error, message_in, name_in, parameter_settable, phase_name, Api, Fail, Phase, Res, Status,
+};
 
 use crate::model::{
     DEFAULT_MAX_SUBSTEPS, DEFAULT_THREADS, LOG_CATEGORIES, MAX_THREADS, SCENE_FILE,
@@ -97,6 +100,11 @@ pub struct Instance {
     magic: u64,
     pub name: CString,
     logger: Option<Logger>,
+    /// The FMI 3.0 logger (an [`Api::Fmi3`] instance has no FMI 2.0 one).
+    logger3: Option<Logger3>,
+    /// The FMI version of the front end that made the instance: the state
+    /// table rows and the names in its log messages.
+    pub api: Api,
     env: *mut c_void,
     logging_on: bool,
     categories: [bool; LOG_CATEGORIES.len()],
@@ -129,11 +137,56 @@ impl Instance {
         logging_on: bool,
     ) -> Result<Box<Instance>, String> {
         let resources = resource_path(resource_uri)?;
+        Self::create(
+            name,
+            guid_arg,
+            resources,
+            (Api::Fmi2, logger, None),
+            env,
+            logging_on,
+        )
+    }
+
+    /// Creates an FMI 3.0 instance ([`Api::Fmi3`]) for the scene in the
+    /// resource folder `resource_path` (an absolute path, FMI 3.0 section
+    /// 2.3.1, not a URI), checking the instantiation token (the FMI 2.0
+    /// FMU's GUID of the same scene).
+    pub fn new_fmi3(
+        name: &str,
+        token: &str,
+        resource_path: &str,
+        logger: Option<Logger3>,
+        env: *mut c_void,
+        logging_on: bool,
+    ) -> Result<Box<Instance>, String> {
+        let resources = PathBuf::from(resource_path);
+        Self::create(
+            name,
+            token,
+            resources,
+            (Api::Fmi3, None, logger),
+            env,
+            logging_on,
+        )
+    }
+
+    fn create(
+        name: &str,
+        guid_arg: &str,
+        resources: PathBuf,
+        (api, logger, logger3): (Api, Option<Logger>, Option<Logger3>),
+        env: *mut c_void,
+        logging_on: bool,
+    ) -> Result<Box<Instance>, String> {
         let bundled = read_scene(&resources.join(SCENE_FILE))?;
         let expected = bundled.guid();
         if guid_arg != expected {
+            let what = match api {
+                Api::Fmi2 => "GUID",
+                Api::Fmi3 => "instantiationToken",
+            };
             return Err(format!(
-                "GUID {guid_arg:?} does not match this FMU's {expected:?} (modelDescription.xml and binary/resources differ)"
+                "{what} {guid_arg:?} does not match this FMU's {expected:?} (modelDescription.xml and binary/resources differ)"
             ));
         }
         let model = Model::new(&bundled).map_err(|f| f.msg)?;
@@ -143,6 +196,8 @@ impl Instance {
             // The instance name is an argument, not the format: no escaping.
             name: escape_nul(name),
             logger,
+            logger3,
+            api,
             env,
             logging_on,
             categories: [true; LOG_CATEGORIES.len()],
@@ -193,7 +248,9 @@ impl Instance {
     /// Sends a message to the logger: warnings, discards, errors and fatal
     /// errors always, other messages when logging is on for their category.
     pub fn log(&self, status: Status, category: usize, msg: &str) {
-        let Some(logger) = self.logger else { return };
+        if !self.has_logger() {
+            return;
+        }
         let always = matches!(
             status,
             Status::Warning | Status::Error | Status::Fatal | Status::Discard
@@ -202,6 +259,14 @@ impl Instance {
             return;
         }
         let cat = CString::new(LOG_CATEGORIES[category].0).expect("no NUL");
+        if let Some(logger) = self.logger3 {
+            let text = escape_nul(&message_in(self.api, msg));
+            // SAFETY: the environment's fmi3LogMessageCallback, called with
+            // its instance environment and NUL-terminated strings.
+            unsafe { logger(self.env, status as c_int, cat.as_ptr(), text.as_ptr()) };
+            return;
+        }
+        let Some(logger) = self.logger else { return };
         let text = escape_log(msg);
         // SAFETY: the logger comes from the environment's callback struct;
         // the message is pre-formatted and escaped, so no varargs are read.
@@ -216,15 +281,21 @@ impl Instance {
         }
     }
 
+    fn has_logger(&self) -> bool {
+        self.logger.is_some() || self.logger3.is_some()
+    }
+
     /// Whether `logAll` messages would be shown (to skip formatting them).
     pub fn log_all(&self) -> bool {
-        self.logger.is_some() && self.logging_on && self.categories[LOG_ALL]
+        self.has_logger() && self.logging_on && self.categories[LOG_ALL]
     }
 
     /// Fails unless the state table allows `func` in the current state
     /// ([`crate::state_machine::ALLOWED`]).
+    /// `func` is the FMI 2.0 name; an [`Api::Fmi3`] instance checks the
+    /// FMI 3.0 function's row ([`name_in`]).
     pub fn require(&self, func: &str) -> Res {
-        crate::state_machine::require(self.phase, func)
+        crate::state_machine::require(self.phase, name_in(self.api, func))
     }
 
     pub fn set_debug_logging(&mut self, on: bool, cats: &[&str]) -> Res {
@@ -473,7 +544,11 @@ impl Instance {
         if m.clock.substeps > start_substeps {
             m.outputs_checked = false;
         }
-        if !m.outputs_checked && !m.physics.outputs_finite() {
+        // The FMI 3.0 FMU's arrays (every vertex) are outputs too.
+        let arrays = self.api == Api::Fmi3;
+        if !m.outputs_checked
+            && (!m.physics.outputs_finite() || (arrays && !m.physics.arrays_finite()))
+        {
             m.clock.terminated = true;
             restore(m);
             self.phase = Phase::StepFailed;

@@ -8,9 +8,11 @@
 
 pub mod variables;
 pub mod xml;
+pub mod xml3;
 
 pub use variables::*;
 pub use xml::*;
+pub use xml3::*;
 
 /// Name of the scene file inside the FMU's `resources/` folder.
 pub const SCENE_FILE: &str = "scene.toml";
@@ -21,6 +23,14 @@ pub const VR_SUBSTEPS: u32 = 200;
 pub const VR_MAX_SUBSTEPS: u32 = 201;
 /// `threads` (Integer parameter of every model).
 pub const VR_THREADS: u32 = 202;
+
+/// `time`, the independent variable of the FMI 3.0 FMU (FMI 3.0 asks for
+/// exactly one; the FMI 2.0 FMU has none).
+pub const VR_TIME: u32 = 0;
+
+/// The first value reference of the FMI 3.0 Float64 arrays
+/// ([`ArrayVariable`]), far above every scalar's.
+pub const VR_ARRAY_BASE: u32 = 1 << 30;
 
 /// Largest scene file the FMU reads (the bundled one and the `scene`
 /// parameter): 1 MiB. The built-in scenes are below 4 KiB.

@@ -29,6 +29,32 @@ pub struct Variable {
     pub description: String,
 }
 
+/// A Float64 array output of the FMI 3.0 FMU (FMI 2.0 has no arrays): its
+/// dimensions are fixed by the bundled scene when the FMU is generated.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ArrayVariable {
+    pub name: String,
+    pub vr: u32,
+    /// The size of each dimension, row-major (`[n, 2]`: n points x, y).
+    pub dims: Vec<usize>,
+    pub unit: Option<&'static str>,
+    pub description: String,
+    /// Inputs and parameters its value after initialization depends on
+    /// (`<InitialUnknown>`); it depends on no input at the same instant.
+    pub initial: Vec<u32>,
+}
+
+impl ArrayVariable {
+    /// The number of values (the product of the dimensions).
+    pub fn len(&self) -> usize {
+        self.dims.iter().product()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+}
+
 /// Formats an `f64` so that it reads back to the same bits (shortest round trip).
 pub fn real(v: f64) -> String {
     format!("{v:?}")

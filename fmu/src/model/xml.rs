@@ -5,7 +5,7 @@ use std::fmt::Write as _;
 
 use yarnsim::mpm::state::fnv1a;
 
-use super::{real, VarType, Variable, LOG_CATEGORIES};
+use super::{real, ArrayVariable, VarType, Variable, LOG_CATEGORIES};
 
 /// A GUID-formatted 128-bit hash of `text`.
 pub fn guid_of(text: &str) -> String {
@@ -39,7 +39,7 @@ pub fn xml_escape(s: &str) -> String {
 }
 
 /// Units used by the variables with their SI base-unit exponents.
-const UNITS: [(&str, &str); 8] = [
+pub const UNITS: [(&str, &str); 8] = [
     ("J", r#"kg="1" m="2" s="-2""#),
     ("N/m", r#"kg="1" s="-2""#),
     ("m/s", r#"m="1" s="-1""#),
@@ -63,6 +63,9 @@ pub struct Description {
     /// What each output depends on ([`Dependency`]); an output without an
     /// entry depends on nothing (`dependencies=""`).
     pub dependencies: Vec<Dependency>,
+    /// The Float64 array outputs of the FMI 3.0 FMU (not written by the
+    /// FMI 2.0 writer).
+    pub arrays: Vec<ArrayVariable>,
 }
 
 /// The `ModelStructure` dependencies of one output, by value reference.
@@ -124,6 +127,41 @@ pub fn output_indices(vars: &[Variable]) -> Vec<usize> {
         .collect()
 }
 
+/// Writes the elements between `<CoSimulation>` and `<ModelVariables>` of
+/// either FMI version: `UnitDefinitions` (the units for which `used` is
+/// true), `LogCategories` (descriptions passed through `words`) and
+/// `DefaultExperiment`.
+pub fn write_units_to_experiment(
+    x: &mut String,
+    d: &Description,
+    used: impl Fn(&str) -> bool,
+    words: impl Fn(&str) -> String,
+) {
+    x.push_str("  <UnitDefinitions>\n");
+    for (name, base) in UNITS.iter().filter(|(u, _)| used(u)) {
+        let _ = writeln!(
+            x,
+            "    <Unit name=\"{}\"><BaseUnit {base}/></Unit>",
+            xml_escape(name)
+        );
+    }
+    x.push_str("  </UnitDefinitions>\n  <LogCategories>\n");
+    for (name, what) in LOG_CATEGORIES {
+        let _ = writeln!(
+            x,
+            "    <Category name=\"{name}\" description=\"{}\"/>",
+            xml_escape(&words(what))
+        );
+    }
+    x.push_str("  </LogCategories>\n");
+    let _ = writeln!(
+        x,
+        "  <DefaultExperiment startTime=\"0.0\" stopTime=\"{}\" stepSize=\"{}\"/>",
+        real(d.stop_time),
+        real(d.step_size)
+    );
+}
+
 /// Writes `modelDescription.xml`; only the units the variables use are defined.
 pub fn write_model_description(d: &Description) -> String {
     let vars = &d.variables;
@@ -142,31 +180,11 @@ pub fn write_model_description(d: &Description) -> String {
         x,
         "  <CoSimulation modelIdentifier=\"{ident}\" canHandleVariableCommunicationStepSize=\"true\" canInterpolateInputs=\"false\" maxOutputDerivativeOrder=\"0\" canRunAsynchronuously=\"false\" canBeInstantiatedOnlyOncePerProcess=\"false\" canNotUseMemoryManagementFunctions=\"true\" canGetAndSetFMUstate=\"true\" canSerializeFMUstate=\"true\" providesDirectionalDerivative=\"false\"/>"
     );
-    x.push_str("  <UnitDefinitions>\n");
-    for (name, base) in UNITS
-        .iter()
-        .filter(|(u, _)| vars.iter().any(|v| v.unit == Some(*u)))
-    {
-        let _ = writeln!(
-            x,
-            "    <Unit name=\"{}\"><BaseUnit {base}/></Unit>",
-            xml_escape(name)
-        );
-    }
-    x.push_str("  </UnitDefinitions>\n  <LogCategories>\n");
-    for (name, what) in LOG_CATEGORIES {
-        let _ = writeln!(
-            x,
-            "    <Category name=\"{name}\" description=\"{}\"/>",
-            xml_escape(what)
-        );
-    }
-    x.push_str("  </LogCategories>\n");
-    let _ = writeln!(
-        x,
-        "  <DefaultExperiment startTime=\"0.0\" stopTime=\"{}\" stepSize=\"{}\"/>",
-        real(d.stop_time),
-        real(d.step_size)
+    write_units_to_experiment(
+        &mut x,
+        d,
+        |u| vars.iter().any(|v| v.unit == Some(u)),
+        |w| w.to_string(),
     );
     x.push_str("  <ModelVariables>\n");
     for (i, v) in vars.iter().enumerate() {

@@ -17,9 +17,12 @@ use crate::fmu_model::{
 use crate::model::*;
 use crate::state_bytes::{Reader, Writer};
 
+pub mod arrays;
+mod forces;
 mod inputs;
 pub mod variables;
 
+pub use forces::PinForces;
 pub use inputs::{Inputs, PinInput};
 use variables::*;
 
@@ -90,38 +93,6 @@ pub struct YarnModel {
     /// current (or last) communication step (time-weighted under
     /// `dt = "auto"`), and their number.
     pub forces: PinForces,
-}
-
-/// The pins' forces on the yarn summed over the substeps of a
-/// communication step: with a fixed `dt` plainly (weight 1 per substep),
-/// under `dt = "auto"` weighted by each substep's length, so the mean is
-/// the time average over the step either way.
-#[derive(Clone, Debug, PartialEq)]
-pub struct PinForces {
-    /// Per pin, the weighted sum of the yarn's force on it.
-    pub sum: Vec<Vec2>,
-    pub substeps: u64,
-    /// Sum of the weights (the substep count, or the time under "auto").
-    pub weight: f64,
-}
-
-impl PinForces {
-    fn new(pins: usize) -> Self {
-        PinForces {
-            sum: vec![Vec2::zeros(); pins],
-            substeps: 0,
-            weight: 0.0,
-        }
-    }
-
-    /// The mean force on pin `i` (0 before any substep).
-    pub fn mean(&self, i: usize) -> Vec2 {
-        if self.substeps == 0 {
-            Vec2::zeros()
-        } else {
-            self.sum[i] / self.weight
-        }
-    }
 }
 
 /// The yarn bundle's part of an FMU state ([`YarnModel::save`]): the
@@ -525,6 +496,15 @@ impl FmuModel for YarnModel {
             }
             _ => return None,
         })
+    }
+    fn array_len(&self, vr: u32) -> Option<usize> {
+        YarnModel::array_len(self, vr)
+    }
+    fn get_real_array(&mut self, vr: u32, out: &mut [f64]) -> bool {
+        self.write_array(vr, out)
+    }
+    fn arrays_finite(&self) -> bool {
+        self.vertices_finite()
     }
     fn get_boolean(&self, vr: u32) -> Option<bool> {
         match vr {

@@ -310,6 +310,7 @@ pub fn description(scene: &YarnScene) -> Description {
         stop_time: default_stop_time(scene),
         step_size: scene.time.frame_dt,
         dependencies: yarn_dependencies(scene),
+        arrays: super::arrays::yarn_arrays(scene, &[VR_SCENE]),
     }
 }
 

@@ -1,0 +1,200 @@
+//! The common FMI 3.0 functions of Co-Simulation: version, debug logging,
+//! instantiation (Co-Simulation only), freeing, initialization,
+//! termination and reset.
+
+use std::ffi::c_char;
+use std::panic::{catch_unwind, AssertUnwindSafe};
+
+use libc::size_t;
+
+use super::*;
+use crate::ffi::{null, ok, panic_message, slice, string};
+use crate::instance::{escape_nul, LOG_ERROR};
+use crate::model::LOG_CATEGORIES;
+
+#[no_mangle]
+pub extern "C" fn fmi3GetVersion() -> *const c_char {
+    c"3.0".as_ptr()
+}
+
+#[no_mangle]
+pub unsafe extern "C" fn fmi3SetDebugLogging(
+    instance: fmi3Instance,
+    loggingOn: fmi3Boolean,
+    nCategories: size_t,
+    categories: *const fmi3String,
+) -> fmi3Status {
+    call3(instance, "fmi3SetDebugLogging", |inst| {
+        // SAFETY: FMI passes `nCategories` category strings.
+        let Some(cats) = (unsafe { slice(categories, nCategories) }) else {
+            return null("fmi3SetDebugLogging", "categories");
+        };
+        let mut names = Vec::with_capacity(cats.len());
+        for &p in cats {
+            // SAFETY: each category is null or a NUL-terminated string.
+            match unsafe { string(p) } {
+                Some(s) => names.push(s),
+                None => return null("fmi3SetDebugLogging", "a category"),
+            }
+        }
+        let refs: Vec<&str> = names.iter().map(|s| s.as_str()).collect();
+        ok(inst.set_debug_logging(loggingOn, &refs))
+    })
+}
+
+/// Logs a refused instantiation through the environment's callback.
+fn refuse_instance(
+    logger: Option<fmi3LogMessageCallback>,
+    env: fmi3InstanceEnvironment,
+    func: &str,
+    msg: &str,
+) -> fmi3Instance {
+    if let Some(logger) = logger {
+        let cat = escape_nul(LOG_CATEGORIES[LOG_ERROR].0);
+        let m = escape_nul(&format!("{func}: {msg}"));
+        // SAFETY: the environment's fmi3LogMessageCallback with its
+        // instance environment and NUL-terminated strings.
+        unsafe { logger(env, fmi3Error, cat.as_ptr(), m.as_ptr()) };
+    }
+    std::ptr::null_mut()
+}
+
+#[no_mangle]
+pub unsafe extern "C" fn fmi3InstantiateModelExchange(
+    _instanceName: fmi3String,
+    _instantiationToken: fmi3String,
+    _resourcePath: fmi3String,
+    _visible: fmi3Boolean,
+    _loggingOn: fmi3Boolean,
+    instanceEnvironment: fmi3InstanceEnvironment,
+    logMessage: Option<fmi3LogMessageCallback>,
+) -> fmi3Instance {
+    refuse_instance(
+        logMessage,
+        instanceEnvironment,
+        "fmi3InstantiateModelExchange",
+        "this FMU supports Co-Simulation only (no <ModelExchange> in modelDescription.xml)",
+    )
+}
+
+#[no_mangle]
+pub unsafe extern "C" fn fmi3InstantiateScheduledExecution(
+    _instanceName: fmi3String,
+    _instantiationToken: fmi3String,
+    _resourcePath: fmi3String,
+    _visible: fmi3Boolean,
+    _loggingOn: fmi3Boolean,
+    instanceEnvironment: fmi3InstanceEnvironment,
+    logMessage: Option<fmi3LogMessageCallback>,
+    _clockUpdate: fmi3ClockUpdateCallback,
+    _lockPreemption: fmi3PreemptionCallback,
+    _unlockPreemption: fmi3PreemptionCallback,
+) -> fmi3Instance {
+    refuse_instance(
+        logMessage,
+        instanceEnvironment,
+        "fmi3InstantiateScheduledExecution",
+        "this FMU supports Co-Simulation only (no <ScheduledExecution> in modelDescription.xml)",
+    )
+}
+
+#[no_mangle]
+pub unsafe extern "C" fn fmi3InstantiateCoSimulation(
+    instanceName: fmi3String,
+    instantiationToken: fmi3String,
+    resourcePath: fmi3String,
+    _visible: fmi3Boolean,
+    loggingOn: fmi3Boolean,
+    eventModeUsed: fmi3Boolean,
+    earlyReturnAllowed: fmi3Boolean,
+    requiredIntermediateVariables: *const fmi3ValueReference,
+    nRequiredIntermediateVariables: size_t,
+    instanceEnvironment: fmi3InstanceEnvironment,
+    logMessage: Option<fmi3LogMessageCallback>,
+    _intermediateUpdate: fmi3IntermediateUpdateCallback,
+) -> fmi3Instance {
+    let func = "fmi3InstantiateCoSimulation";
+    let result = catch_unwind(AssertUnwindSafe(|| {
+        // SAFETY: null or a NUL-terminated string (FMI contract).
+        let name = unsafe { string(instanceName) };
+        let Some(name) = name.as_deref().filter(|n| !n.is_empty()) else {
+            return Err("the instance name is null or empty".to_string());
+        };
+        if eventModeUsed {
+            return Err(
+                "eventModeUsed = true, but this FMU has no event mode (hasEventMode=\"false\")"
+                    .into(),
+            );
+        }
+        // earlyReturnAllowed: the FMU never returns early, so either value
+        // is fine; the variables for intermediate update are refused.
+        let _ = earlyReturnAllowed;
+        if nRequiredIntermediateVariables > 0 {
+            let _ = requiredIntermediateVariables;
+            return Err(format!(
+                "{nRequiredIntermediateVariables} required intermediate variables, but this FMU has no intermediate update (providesIntermediateUpdate=\"false\")"
+            ));
+        }
+        // SAFETY: null or NUL-terminated strings (FMI contract).
+        let Some(token) = (unsafe { string(instantiationToken) }) else {
+            return Err("the instantiationToken is a null pointer".into());
+        };
+        // SAFETY: as above.
+        let Some(res) = (unsafe { string(resourcePath) }) else {
+            return Err("the resourcePath is a null pointer".into());
+        };
+        Instance::new_fmi3(
+            name,
+            &token,
+            &res,
+            logMessage,
+            instanceEnvironment,
+            loggingOn,
+        )
+    }));
+    let fail = |msg: &str| refuse_instance(logMessage, instanceEnvironment, func, msg);
+    match result {
+        Ok(Ok(inst)) => Box::into_raw(inst) as fmi3Instance,
+        Ok(Err(msg)) => fail(&msg),
+        Err(p) => fail(&format!("internal error: {}", panic_message(&*p))),
+    }
+}
+
+#[no_mangle]
+pub unsafe extern "C" fn fmi3FreeInstance(instance: fmi3Instance) {
+    // SAFETY: the same contract as fmi2FreeInstance: null (a no-op) or an
+    // instance this FMU handed out and the environment has not freed.
+    unsafe { crate::ffi::fmi2FreeInstance(instance) }
+}
+
+#[no_mangle]
+pub unsafe extern "C" fn fmi3EnterInitializationMode(
+    instance: fmi3Instance,
+    _toleranceDefined: fmi3Boolean,
+    _tolerance: fmi3Float64,
+    startTime: fmi3Float64,
+    stopTimeDefined: fmi3Boolean,
+    stopTime: fmi3Float64,
+) -> fmi3Status {
+    call3(instance, "fmi3EnterInitializationMode", |inst| {
+        inst.setup_experiment(startTime, stopTimeDefined.then_some(stopTime))?;
+        ok(inst.enter_initialization_mode())
+    })
+}
+
+#[no_mangle]
+pub unsafe extern "C" fn fmi3ExitInitializationMode(instance: fmi3Instance) -> fmi3Status {
+    call3(instance, "fmi3ExitInitializationMode", |inst| {
+        inst.exit_initialization_mode()
+    })
+}
+
+#[no_mangle]
+pub unsafe extern "C" fn fmi3Terminate(instance: fmi3Instance) -> fmi3Status {
+    call3(instance, "fmi3Terminate", |inst| ok(inst.terminate()))
+}
+
+#[no_mangle]
+pub unsafe extern "C" fn fmi3Reset(instance: fmi3Instance) -> fmi3Status {
+    call3(instance, "fmi3Reset", |inst| ok(inst.reset()))
+}

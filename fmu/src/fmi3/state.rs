@@ -1,0 +1,161 @@
+//! FMI 3.0 FMU states (get, set, free, serialize, deserialize; the bytes
+//! are the FMI 2.0 FMU's framing, [`crate::state_bytes`]) and the variable
+//! dependencies of the outputs.
+
+use libc::size_t;
+
+use super::*;
+use crate::ffi::{
+    deserialize_state, free_state, get_state, null, serialize_state, set_state, slice_mut,
+    state_size,
+};
+
+#[no_mangle]
+pub unsafe extern "C" fn fmi3GetFMUState(
+    instance: fmi3Instance,
+    FMUState: *mut fmi3FMUState,
+) -> fmi3Status {
+    call3(instance, "fmi3GetFMUState", |inst| {
+        // SAFETY: forwarded from the caller (FMI contract).
+        unsafe { get_state(inst, "fmi3GetFMUState", FMUState) }
+    })
+}
+
+#[no_mangle]
+pub unsafe extern "C" fn fmi3SetFMUState(
+    instance: fmi3Instance,
+    FMUState: fmi3FMUState,
+) -> fmi3Status {
+    // SAFETY: forwarded from the caller (FMI contract).
+    call3(instance, "fmi3SetFMUState", |inst| unsafe {
+        set_state(inst, FMUState)
+    })
+}
+
+#[no_mangle]
+pub unsafe extern "C" fn fmi3FreeFMUState(
+    instance: fmi3Instance,
+    FMUState: *mut fmi3FMUState,
+) -> fmi3Status {
+    // SAFETY: forwarded from the caller (FMI contract).
+    call3(instance, "fmi3FreeFMUState", |_| unsafe {
+        free_state(FMUState)
+    })
+}
+
+#[no_mangle]
+pub unsafe extern "C" fn fmi3SerializedFMUStateSize(
+    instance: fmi3Instance,
+    FMUState: fmi3FMUState,
+    size: *mut size_t,
+) -> fmi3Status {
+    call3(instance, "fmi3SerializedFMUStateSize", |inst| {
+        // SAFETY: forwarded from the caller (FMI contract).
+        unsafe { state_size(inst, "fmi3SerializedFMUStateSize", FMUState, size) }
+    })
+}
+
+#[no_mangle]
+pub unsafe extern "C" fn fmi3SerializeFMUState(
+    instance: fmi3Instance,
+    FMUState: fmi3FMUState,
+    serializedState: *mut fmi3Byte,
+    size: size_t,
+) -> fmi3Status {
+    call3(instance, "fmi3SerializeFMUState", |inst| {
+        // SAFETY: forwarded from the caller (FMI contract).
+        unsafe {
+            serialize_state(
+                inst,
+                "fmi3SerializeFMUState",
+                "fmi3SerializedFMUStateSize",
+                FMUState,
+                serializedState,
+                size,
+            )
+        }
+    })
+}
+
+#[no_mangle]
+pub unsafe extern "C" fn fmi3DeserializeFMUState(
+    instance: fmi3Instance,
+    serializedState: *const fmi3Byte,
+    size: size_t,
+    FMUState: *mut fmi3FMUState,
+) -> fmi3Status {
+    call3(instance, "fmi3DeserializeFMUState", |inst| {
+        // SAFETY: forwarded from the caller (FMI contract).
+        unsafe {
+            deserialize_state(
+                inst,
+                "fmi3DeserializeFMUState",
+                serializedState,
+                size,
+                FMUState,
+            )
+        }
+    })
+}
+
+#[no_mangle]
+pub unsafe extern "C" fn fmi3GetNumberOfVariableDependencies(
+    instance: fmi3Instance,
+    valueReference: fmi3ValueReference,
+    nDependencies: *mut size_t,
+) -> fmi3Status {
+    let func = "fmi3GetNumberOfVariableDependencies";
+    call3(instance, func, |inst| {
+        inst.require(func)?;
+        // SAFETY: null or a writable size_t (FMI contract).
+        let Some(n) = (unsafe { nDependencies.as_mut() }) else {
+            return null(func, "nDependencies");
+        };
+        *n = inst.variable_dependencies(valueReference)?.len();
+        Ok(Status::Ok)
+    })
+}
+
+#[no_mangle]
+pub unsafe extern "C" fn fmi3GetVariableDependencies(
+    instance: fmi3Instance,
+    dependent: fmi3ValueReference,
+    elementIndicesOfDependent: *mut size_t,
+    independents: *mut fmi3ValueReference,
+    elementIndicesOfIndependents: *mut size_t,
+    dependencyKinds: *mut fmi3DependencyKind,
+    nDependencies: size_t,
+) -> fmi3Status {
+    let func = "fmi3GetVariableDependencies";
+    call3(instance, func, |inst| {
+        inst.require(func)?;
+        let deps = inst.variable_dependencies(dependent)?;
+        if deps.len() != nDependencies {
+            return crate::instance::error(format!(
+                "{func}: nDependencies = {nDependencies}, but value reference {dependent} has {} (fmi3GetNumberOfVariableDependencies)",
+                deps.len()
+            ));
+        }
+        // SAFETY: FMI passes four writable arrays of `nDependencies`
+        // elements (null only when it is 0, else refused).
+        let arrays = unsafe {
+            (
+                slice_mut(elementIndicesOfDependent, nDependencies),
+                slice_mut(independents, nDependencies),
+                slice_mut(elementIndicesOfIndependents, nDependencies),
+                slice_mut(dependencyKinds, nDependencies),
+            )
+        };
+        let (Some(ed), Some(ind), Some(ei), Some(kinds)) = arrays else {
+            return null(func, "an output array");
+        };
+        // Element index 0: the whole variable (no per-element dependencies).
+        for (k, vr) in deps.into_iter().enumerate() {
+            ed[k] = 0;
+            ind[k] = vr;
+            ei[k] = 0;
+            kinds[k] = fmi3Dependent;
+        }
+        Ok(Status::Ok)
+    })
+}
