@@ -1,7 +1,10 @@
 //! The 34 exported FMI 2.0 functions (25 common, 9 co-simulation): a
 //! hand-written C ABI over [`Instance`]. Every export checks its pointers,
 //! catches panics (a panic becomes `fmi2Fatal` for that instance and never
-//! unwinds into the host) and logs every failure through the callback.
+//! unwinds into the host) and logs every failure through the callback
+//! ([`shell`]: the wrapper and the pointer helpers, shared with the FMI 3.0
+//! front end [`crate::fmi3`]; [`states`]: the FMU-state functions, their
+//! bodies shared with FMI 3.0).
 
 #![allow(
     non_snake_case,
@@ -10,15 +13,18 @@
     clippy::missing_safety_doc
 )]
 
-use std::ffi::{c_char, c_int, c_uint, c_void, CStr};
+use std::ffi::{c_char, c_int, c_uint, c_void};
 use std::panic::{catch_unwind, AssertUnwindSafe};
 
 use libc::size_t;
 
-use crate::instance::{
-    error, message_in, Instance, Logger, Phase, Res, Snapshot, Status, LOG_ALL, LOG_DISCARD,
-    LOG_ERROR, LOG_FATAL,
-};
+use crate::instance::{error, Instance, Logger, Res, Status, LOG_ALL};
+
+mod shell;
+mod states;
+
+pub(crate) use shell::*;
+pub use states::*;
 
 pub type fmi2Component = *mut c_void;
 pub type fmi2ComponentEnvironment = *mut c_void;
@@ -59,132 +65,6 @@ pub struct fmi2CallbackFunctions {
     pub freeMemory: Option<unsafe extern "C" fn(*mut c_void)>,
     pub stepFinished: Option<unsafe extern "C" fn(fmi2ComponentEnvironment, fmi2Status)>,
     pub componentEnvironment: fmi2ComponentEnvironment,
-}
-
-pub(crate) fn panic_message(p: &(dyn std::any::Any + Send)) -> String {
-    if let Some(s) = p.downcast_ref::<&str>() {
-        s.to_string()
-    } else if let Some(s) = p.downcast_ref::<String>() {
-        s.clone()
-    } else {
-        "unknown panic".to_string()
-    }
-}
-
-/// Runs `f` on the instance behind `c`: null or foreign pointers give
-/// fmi2Error, failures are logged (fmi2Error moves the instance to the error
-/// state), panics are caught and give fmi2Fatal.
-pub(crate) fn call(
-    c: fmi2Component,
-    func: &str,
-    f: impl FnOnce(&mut Instance) -> Res<Status>,
-) -> fmi2Status {
-    // SAFETY: `c` is null or a component this FMU handed out (FMI contract);
-    // the magic number rejects freed or foreign pointers in most cases.
-    let Some(inst) = (unsafe { Instance::from_ptr(c) }) else {
-        return fmi2Error;
-    };
-    if inst.phase == Phase::Fatal {
-        inst.log(
-            Status::Fatal,
-            LOG_FATAL,
-            &format!(
-                "{func}: the instance is in the fatal state; only fmi2FreeInstance is allowed"
-            ),
-        );
-        return fmi2Fatal;
-    }
-    if inst.log_all() {
-        inst.log(Status::Ok, LOG_ALL, func);
-    }
-    let ptr: *mut Instance = inst;
-    // SAFETY: `ptr` stays valid for the whole call; the closure is the only user.
-    let result = catch_unwind(AssertUnwindSafe(|| f(unsafe { &mut *ptr })));
-    // SAFETY: as above; the closure has returned.
-    let inst = unsafe { &mut *ptr };
-    match result {
-        Ok(Ok(s)) => s as fmi2Status,
-        Ok(Err(fail)) => {
-            let cat = match fail.status {
-                Status::Discard => LOG_DISCARD,
-                Status::Fatal => LOG_FATAL,
-                _ => LOG_ERROR,
-            };
-            // An FMI 3.0 instance's messages in FMI 3.0 words (FMI 2.0: unchanged).
-            let shown = message_in(inst.api, &fail.msg);
-            let msg = if shown.starts_with(func) {
-                shown
-            } else {
-                format!("{func}: {shown}")
-            };
-            inst.log(fail.status, cat, &msg);
-            match fail.status {
-                Status::Error => inst.phase = Phase::Error,
-                Status::Fatal => inst.phase = Phase::Fatal,
-                _ => {}
-            }
-            fail.status as fmi2Status
-        }
-        Err(p) => {
-            inst.phase = Phase::Fatal;
-            inst.log(
-                Status::Fatal,
-                LOG_FATAL,
-                &format!("{func}: internal error: {}", panic_message(&*p)),
-            );
-            fmi2Fatal
-        }
-    }
-}
-
-pub(crate) fn ok(r: Res) -> Res<Status> {
-    r.map(|_| Status::Ok)
-}
-
-/// A slice from a C array; `None` for a null pointer with a nonzero length.
-///
-/// # Safety
-/// `p` must be null or point to `n` initialized, aligned elements that stay
-/// valid and unchanged for `'a` (the FMI contract for the arrays it passes).
-pub(crate) unsafe fn slice<'a, T>(p: *const T, n: size_t) -> Option<&'a [T]> {
-    if n == 0 {
-        Some(&[])
-    } else if p.is_null() {
-        None
-    } else {
-        // SAFETY: non-null, `n` elements valid for `'a` (the caller's contract).
-        Some(unsafe { std::slice::from_raw_parts(p, n) })
-    }
-}
-
-/// A mutable slice from a C array; `None` for a null pointer with a nonzero
-/// length.
-///
-/// # Safety
-/// `p` must be null or point to `n` aligned elements, writable and not
-/// aliased for `'a`.
-pub(crate) unsafe fn slice_mut<'a, T>(p: *mut T, n: size_t) -> Option<&'a mut [T]> {
-    if n == 0 {
-        Some(&mut [])
-    } else if p.is_null() {
-        None
-    } else {
-        // SAFETY: non-null, `n` writable unaliased elements (the caller's contract).
-        Some(unsafe { std::slice::from_raw_parts_mut(p, n) })
-    }
-}
-
-/// A C string as an owned Rust string (invalid UTF-8 replaced); `None` for null.
-///
-/// # Safety
-/// `p` must be null or point to a NUL-terminated string valid for the call.
-pub(crate) unsafe fn string(p: fmi2String) -> Option<String> {
-    // SAFETY: non-null and NUL-terminated (the caller's contract).
-    (!p.is_null()).then(|| unsafe { CStr::from_ptr(p) }.to_string_lossy().into_owned())
-}
-
-pub(crate) fn null(func: &str, what: &str) -> Res<Status> {
-    error(format!("{func}: {what} is a null pointer"))
 }
 
 /// The 34 functions of FMI 2.0 Co-Simulation (25 common, 9 co-simulation).
@@ -537,89 +417,6 @@ pub unsafe extern "C" fn fmi2SetString(
 }
 
 #[no_mangle]
-pub unsafe extern "C" fn fmi2GetFMUstate(
-    c: fmi2Component,
-    FMUstate: *mut fmi2FMUstate,
-) -> fmi2Status {
-    call(c, "fmi2GetFMUstate", |inst| {
-        // SAFETY: forwarded from the caller (FMI contract).
-        unsafe { get_state(inst, "fmi2GetFMUstate", FMUstate) }
-    })
-}
-
-#[no_mangle]
-pub unsafe extern "C" fn fmi2SetFMUstate(c: fmi2Component, FMUstate: fmi2FMUstate) -> fmi2Status {
-    // SAFETY: forwarded from the caller (FMI contract).
-    call(c, "fmi2SetFMUstate", |inst| unsafe {
-        set_state(inst, FMUstate)
-    })
-}
-
-#[no_mangle]
-pub unsafe extern "C" fn fmi2FreeFMUstate(
-    c: fmi2Component,
-    FMUstate: *mut fmi2FMUstate,
-) -> fmi2Status {
-    // SAFETY: forwarded from the caller (FMI contract).
-    call(c, "fmi2FreeFMUstate", |_| unsafe { free_state(FMUstate) })
-}
-
-#[no_mangle]
-pub unsafe extern "C" fn fmi2SerializedFMUstateSize(
-    c: fmi2Component,
-    FMUstate: fmi2FMUstate,
-    size: *mut size_t,
-) -> fmi2Status {
-    call(c, "fmi2SerializedFMUstateSize", |inst| {
-        // SAFETY: forwarded from the caller (FMI contract).
-        unsafe { state_size(inst, "fmi2SerializedFMUstateSize", FMUstate, size) }
-    })
-}
-
-#[no_mangle]
-pub unsafe extern "C" fn fmi2SerializeFMUstate(
-    c: fmi2Component,
-    FMUstate: fmi2FMUstate,
-    serializedState: *mut fmi2Byte,
-    size: size_t,
-) -> fmi2Status {
-    call(c, "fmi2SerializeFMUstate", |inst| {
-        // SAFETY: forwarded from the caller (FMI contract).
-        unsafe {
-            serialize_state(
-                inst,
-                "fmi2SerializeFMUstate",
-                "fmi2SerializedFMUstateSize",
-                FMUstate,
-                serializedState as *mut u8,
-                size,
-            )
-        }
-    })
-}
-
-#[no_mangle]
-pub unsafe extern "C" fn fmi2DeSerializeFMUstate(
-    c: fmi2Component,
-    serializedState: *const fmi2Byte,
-    size: size_t,
-    FMUstate: *mut fmi2FMUstate,
-) -> fmi2Status {
-    call(c, "fmi2DeSerializeFMUstate", |inst| {
-        // SAFETY: forwarded from the caller (FMI contract).
-        unsafe {
-            deserialize_state(
-                inst,
-                "fmi2DeSerializeFMUstate",
-                serializedState as *const u8,
-                size,
-                FMUstate,
-            )
-        }
-    })
-}
-
-#[no_mangle]
 pub unsafe extern "C" fn fmi2GetDirectionalDerivative(
     c: fmi2Component,
     _vUnknown_ref: *const fmi2ValueReference,
@@ -790,170 +587,4 @@ pub unsafe extern "C" fn fmi2GetStringStatus(
             "status kind {s} has no String value: fmi2DoStep never returns fmi2Pending"
         ))
     })
-}
-
-// ------------------------------------------- FMU states (FMI 2.0 and 3.0)
-
-/// `fmi2GetFMUstate` / `fmi3GetFMUState`: a new state into `*FMUstate`, or
-/// the state already there overwritten.
-///
-/// # Safety
-/// `FMUstate` is null or points to the environment's state slot, which is
-/// null or holds a state this FMU handed out.
-pub(crate) unsafe fn get_state(
-    inst: &mut Instance,
-    func: &str,
-    FMUstate: *mut *mut c_void,
-) -> Res<Status> {
-    // SAFETY: `FMUstate` is null or points to the environment's state slot.
-    let Some(slot) = (unsafe { FMUstate.as_mut() }) else {
-        return null(func, "FMUstate");
-    };
-    let existing = if slot.is_null() {
-        None
-    } else {
-        // SAFETY: a non-null slot holds a state this FMU handed out
-        // (FMI contract); the magic number rejects others.
-        match unsafe { Snapshot::from_ptr(*slot) } {
-            Some(s) => Some(s),
-            None => return error("*FMUstate is not an FMU state of this FMU"),
-        }
-    };
-    if let Some(new) = inst.get_fmu_state(existing)? {
-        *slot = Box::into_raw(new) as fmi2FMUstate;
-    }
-    Ok(Status::Ok)
-}
-
-/// `fmi2SetFMUstate` / `fmi3SetFMUState`.
-///
-/// # Safety
-/// `FMUstate` is null or a state this FMU handed out.
-pub(crate) unsafe fn set_state(inst: &mut Instance, FMUstate: *mut c_void) -> Res<Status> {
-    // SAFETY: null or a state this FMU handed out (checked by its magic).
-    let Some(s) = (unsafe { Snapshot::from_ptr(FMUstate) }) else {
-        return error("FMUstate is null or not an FMU state of this FMU");
-    };
-    ok(inst.set_fmu_state(s))
-}
-
-/// `fmi2FreeFMUstate` / `fmi3FreeFMUState`: frees `*FMUstate` and clears
-/// the slot; a null slot or state is a no-op.
-///
-/// # Safety
-/// `FMUstate` is null or points to the environment's state slot.
-pub(crate) unsafe fn free_state(FMUstate: *mut *mut c_void) -> Res<Status> {
-    // SAFETY: `FMUstate` is null or points to the environment's state slot.
-    let Some(slot) = (unsafe { FMUstate.as_mut() }) else {
-        return Ok(Status::Ok);
-    };
-    if slot.is_null() {
-        return Ok(Status::Ok);
-    }
-    // SAFETY: a non-null slot holds a state this FMU handed out.
-    let Some(s) = (unsafe { Snapshot::from_ptr(*slot) }) else {
-        return error("*FMUstate is not an FMU state of this FMU");
-    };
-    // SAFETY: states are made by `Box::into_raw`; the slot is cleared
-    // below, so it is freed once.
-    drop(unsafe { Box::from_raw(s as *mut Snapshot) });
-    *slot = std::ptr::null_mut();
-    Ok(Status::Ok)
-}
-
-/// `fmi2SerializedFMUstateSize` / `fmi3SerializedFMUStateSize`.
-///
-/// # Safety
-/// `FMUstate` is null or a state this FMU handed out; `size` is null or
-/// points to a writable `size_t`.
-pub(crate) unsafe fn state_size(
-    inst: &mut Instance,
-    func: &str,
-    FMUstate: *mut c_void,
-    size: *mut size_t,
-) -> Res<Status> {
-    // SAFETY: null or a state this FMU handed out (checked by its magic).
-    let Some(s) = (unsafe { Snapshot::from_ptr(FMUstate) }) else {
-        return error("FMUstate is null or not an FMU state of this FMU");
-    };
-    // SAFETY: `size` is null or points to a writable size_t.
-    let Some(size) = (unsafe { size.as_mut() }) else {
-        return null(func, "size");
-    };
-    *size = inst.serialize(func, s)?.len();
-    Ok(Status::Ok)
-}
-
-/// `fmi2SerializeFMUstate` / `fmi3SerializeFMUState` into a buffer of
-/// `size` bytes (`size_func`: the function that tells the size).
-///
-/// # Safety
-/// `FMUstate` is null or a state this FMU handed out; `buf` is null or
-/// holds `size` writable bytes.
-pub(crate) unsafe fn serialize_state(
-    inst: &mut Instance,
-    func: &str,
-    size_func: &str,
-    FMUstate: *mut c_void,
-    buf: *mut u8,
-    size: size_t,
-) -> Res<Status> {
-    // SAFETY: null or a state this FMU handed out (checked by its magic).
-    let Some(s) = (unsafe { Snapshot::from_ptr(FMUstate) }) else {
-        return error("FMUstate is null or not an FMU state of this FMU");
-    };
-    let bytes = inst.serialize(func, s)?;
-    if size < bytes.len() {
-        return error(format!(
-            "buffer of {size} bytes is smaller than the state's {} ({size_func})",
-            bytes.len()
-        ));
-    }
-    if buf.is_null() {
-        return null(func, "serializedState");
-    }
-    // SAFETY: the buffer is non-null and holds `size` >= len bytes
-    // (FMI contract); it does not overlap the snapshot's own bytes.
-    unsafe { std::ptr::copy_nonoverlapping(bytes.as_ptr(), buf, bytes.len()) };
-    Ok(Status::Ok)
-}
-
-/// `fmi2DeSerializeFMUstate` / `fmi3DeserializeFMUState`: a new state from
-/// `size` bytes into `*FMUstate` (a state already there is freed).
-///
-/// # Safety
-/// `bytes` is null or holds `size` readable bytes; `FMUstate` is null or
-/// points to the environment's state slot.
-pub(crate) unsafe fn deserialize_state(
-    inst: &mut Instance,
-    func: &str,
-    bytes: *const u8,
-    size: size_t,
-    FMUstate: *mut *mut c_void,
-) -> Res<Status> {
-    // SAFETY: FMI passes `size` bytes of a serialized state.
-    let Some(bytes) = (unsafe { slice(bytes, size) }) else {
-        return null(func, "serializedState");
-    };
-    // SAFETY: `FMUstate` is null or points to the environment's state slot.
-    let Some(slot) = (unsafe { FMUstate.as_mut() }) else {
-        return null(func, "FMUstate");
-    };
-    let old = if slot.is_null() {
-        None
-    } else {
-        // SAFETY: a non-null slot holds a state this FMU handed out.
-        match unsafe { Snapshot::from_ptr(*slot) } {
-            Some(s) => Some(s as *mut Snapshot),
-            None => return error("*FMUstate is not an FMU state of this FMU"),
-        }
-    };
-    let new = inst.deserialize(bytes)?;
-    if let Some(old) = old {
-        // SAFETY: made by `Box::into_raw`; the slot is overwritten
-        // below, so the old state is freed once.
-        drop(unsafe { Box::from_raw(old) });
-    }
-    *slot = Box::into_raw(new) as *mut c_void;
-    Ok(Status::Ok)
 }
