@@ -10,6 +10,7 @@ use std::fmt::Write as _;
 
 use yarnsim::scene::Scene;
 pub use YarnBundle::ffi::FMI2_FUNCTIONS;
+pub use YarnBundle::fmi3::FMI3_FUNCTIONS;
 use YarnBundle::model::{xml_escape, SCENE_FILE};
 use YarnBundle::SceneFmu;
 
@@ -144,8 +145,43 @@ pub fn zip_entries(zip: &[u8]) -> Result<Vec<(String, Vec<u8>)>, String> {
     Ok(out)
 }
 
-/// `documentation/index.html`: the variables of this FMU.
+/// The FMI version of an FMU to pack.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum FmiVersion {
+    /// FMI 2.0 Co-Simulation: `binaries/linux64/`, no arrays.
+    Fmi2,
+    /// FMI 3.0 Co-Simulation: `binaries/x86_64-linux/`, with the array
+    /// outputs.
+    Fmi3,
+}
+
+impl FmiVersion {
+    /// `binaries/<platform>/<modelIdentifier>.so`.
+    pub fn binary_path(self, identifier: &str) -> String {
+        let platform = match self {
+            FmiVersion::Fmi2 => "linux64",
+            FmiVersion::Fmi3 => "x86_64-linux",
+        };
+        format!("binaries/{platform}/{identifier}.so")
+    }
+
+    /// `modelDescription.xml` of this version.
+    pub fn model_description(self, scene: &Scene) -> Result<String, String> {
+        match self {
+            FmiVersion::Fmi2 => scene.model_description(),
+            FmiVersion::Fmi3 => scene.model_description_fmi3(),
+        }
+    }
+}
+
+/// `documentation/index.html` of the FMI 2.0 FMU: the variables of this FMU.
 pub fn documentation_html(scene: &Scene) -> Result<String, String> {
+    documentation_html_of(scene, FmiVersion::Fmi2)
+}
+
+/// `documentation/index.html` of the FMU of `version`: the variables (for
+/// FMI 3.0 also the arrays with their dimensions).
+pub fn documentation_html_of(scene: &Scene, version: FmiVersion) -> Result<String, String> {
     let d = scene.description()?;
     let ident = d.identifier;
     let (what, details) = match scene {
@@ -173,7 +209,11 @@ pub fn documentation_html(scene: &Scene) -> Result<String, String> {
         h,
         "<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>{ident}</title></head><body>"
     );
-    let _ = writeln!(h, "<h1>{ident}: FMI 2.0 Co-Simulation FMU of {what}</h1>");
+    let fmi = match version {
+        FmiVersion::Fmi2 => "FMI 2.0",
+        FmiVersion::Fmi3 => "FMI 3.0",
+    };
+    let _ = writeln!(h, "<h1>{ident}: {fmi} Co-Simulation FMU of {what}</h1>");
     let _ = writeln!(
         h,
         "<p>{}. Scene <code>{}</code>: {details}. The scene is <code>resources/{SCENE_FILE}</code>; GUID <code>{}</code>. Each communication step runs an integer number of substeps: the substeps done by time t are round((t - startTime) / dt).</p>",
@@ -195,6 +235,21 @@ pub fn documentation_html(scene: &Scene) -> Result<String, String> {
             xml_escape(&v.description)
         );
     }
+    if version == FmiVersion::Fmi3 {
+        h.push_str("<tr><td>time</td><td>0</td><td>independent</td><td>continuous</td><td>s</td><td></td><td>Simulation time</td></tr>\n");
+        for a in &d.arrays {
+            let dims: Vec<String> = a.dims.iter().map(|n| n.to_string()).collect();
+            let _ = writeln!(
+                h,
+                "<tr><td>{}</td><td>{}</td><td>output</td><td>continuous</td><td>{}</td><td>Float64 array [{}]</td><td>{}</td></tr>",
+                xml_escape(&a.name),
+                a.vr,
+                a.unit.unwrap_or(""),
+                dims.join(", "),
+                xml_escape(&a.description)
+            );
+        }
+    }
     h.push_str("</table>\n<p>Built by yarnsim-fmu; see the section on the FMUs in the README of the yarnsim repository.</p>\n</body></html>\n");
     Ok(h)
 }
@@ -202,17 +257,19 @@ pub fn documentation_html(scene: &Scene) -> Result<String, String> {
 /// The complete `.fmu` archive for `scene` around the shared library `so`
 /// (packed as `binaries/linux64/<modelIdentifier>.so`).
 pub fn build_fmu(scene: &Scene, so: &[u8]) -> Result<Vec<u8>, String> {
+    build_fmu_of(scene, so, FmiVersion::Fmi2)
+}
+
+/// The complete `.fmu` archive of `version` for `scene` around the shared
+/// library `so` ([`FmiVersion::binary_path`]).
+pub fn build_fmu_of(scene: &Scene, so: &[u8], version: FmiVersion) -> Result<Vec<u8>, String> {
     let mut z = Zip::default();
     z.add(
         "modelDescription.xml",
-        scene.model_description()?.as_bytes(),
+        version.model_description(scene)?.as_bytes(),
         false,
     )?;
-    z.add(
-        &format!("binaries/linux64/{}.so", scene.identifier()),
-        so,
-        true,
-    )?;
+    z.add(&version.binary_path(scene.identifier()), so, true)?;
     z.add(
         &format!("resources/{SCENE_FILE}"),
         scene.to_toml_string().as_bytes(),
@@ -220,7 +277,7 @@ pub fn build_fmu(scene: &Scene, so: &[u8]) -> Result<Vec<u8>, String> {
     )?;
     z.add(
         "documentation/index.html",
-        documentation_html(scene)?.as_bytes(),
+        documentation_html_of(scene, version)?.as_bytes(),
         false,
     )?;
     Ok(z.finish())
@@ -315,12 +372,13 @@ pub const ALLOWED_NEEDED: [&str; 7] = [
     "librt.so.1",
 ];
 
-/// Checks a shared library for the FMU: all 34 functions exported, no
-/// dependency beyond [`ALLOWED_NEEDED`].
+/// Checks a shared library for the FMU: all 34 FMI 2.0 functions and all
+/// 75 FMI 3.0 functions exported, no dependency beyond [`ALLOWED_NEEDED`].
 pub fn check_library(so: &[u8]) -> Result<ElfInfo, String> {
     let info = elf_info(so)?;
     let missing: Vec<&str> = FMI2_FUNCTIONS
         .iter()
+        .chain(&FMI3_FUNCTIONS)
         .copied()
         .filter(|f| !info.exported.iter().any(|e| e == f))
         .collect();

@@ -1,6 +1,8 @@
 //! The packager: the .fmu archive (layout, reproducible bytes, corruption
 //! detected), the zip CRC and the ELF check of the FMU's shared library
-//! (all 34 `fmi2*` exports, only libc/libm/libgcc_s/loader needed).
+//! (all 34 `fmi2*` exports, only libc/libm/libgcc_s/loader needed); the
+//! FMI 3.0 archive (`build-fmu --fmi-version 3`: `binaries/x86_64-linux/`,
+//! the FMI 3.0 modelDescription with the arrays) and the 75 `fmi3*` exports.
 
 use yarnsim::massspring::scenes::wire;
 use yarnsim::scene::{Scene, YarnScene};
@@ -105,4 +107,80 @@ fn mass_spring_archive_layout() {
     assert_eq!(packed.guid(), scene.guid());
     let doc = String::from_utf8(entries[3].1.clone()).unwrap();
     assert!(doc.contains("particle[10].x") && doc.contains("mass-spring"));
+}
+
+/// The FMI 3.0 archive of `scene` and its entries, checked to have the
+/// FMI 3.0 layout with `binaries/x86_64-linux/{library}.so`.
+fn archive3(scene: &Scene, library: &str) -> Vec<(String, Vec<u8>)> {
+    let zip = build_fmu_of(scene, b"\x7fELF stand-in", FmiVersion::Fmi3).unwrap();
+    let entries = zip_entries(&zip).unwrap();
+    let names: Vec<&str> = entries.iter().map(|(n, _)| n.as_str()).collect();
+    let library = format!("binaries/x86_64-linux/{library}.so");
+    assert_eq!(
+        names,
+        [
+            "modelDescription.xml",
+            library.as_str(),
+            "resources/scene.toml",
+            "documentation/index.html"
+        ]
+    );
+    // the same inputs give the same bytes
+    assert_eq!(
+        build_fmu_of(scene, b"\x7fELF stand-in", FmiVersion::Fmi3).unwrap(),
+        zip
+    );
+    entries
+}
+
+#[test]
+fn fmi3_archives_of_the_yarn_and_the_mass_spring_scenes() {
+    let small =
+        Scene::Yarn(YarnScene::from_toml_str(include_str!("../../fmu/scenes/small.toml")).unwrap());
+    let e = archive3(&small, "YarnBundle");
+    let xml = String::from_utf8(e[0].1.clone()).unwrap();
+    assert_eq!(xml, small.model_description_fmi3().unwrap());
+    assert!(xml.contains("fmiVersion=\"3.0\""));
+    assert!(xml.contains("name=\"yarn[2].velocities\""));
+    let doc = String::from_utf8(e[3].1.clone()).unwrap();
+    assert!(doc.contains("FMI 3.0 Co-Simulation FMU"));
+    assert!(doc.contains("Float64 array [24, 2]"));
+    // the FMI 2.0 archive of the same scene keeps its layout and bytes
+    assert_eq!(
+        build_fmu_of(&small, b"x", FmiVersion::Fmi2).unwrap(),
+        build_fmu(&small, b"x").unwrap()
+    );
+
+    let wire = Scene::MassSpring(wire());
+    let e = archive3(&wire, "MassSpring");
+    let xml = String::from_utf8(e[0].1.clone()).unwrap();
+    let n = YarnBundle::massspring::num_particles(&wire_layout()).unwrap();
+    assert!(xml.contains(&format!(
+        "name=\"positions\" valueReference=\"{}\"",
+        YarnBundle::massspring::VR_POSITIONS
+    )));
+    assert!(xml.contains(&format!(
+        "<Dimension start=\"{n}\"/>\n      <Dimension start=\"3\"/>"
+    )));
+}
+
+fn wire_layout() -> yarnsim::massspring::MassSpringScene {
+    wire()
+}
+
+#[test]
+fn shared_library_exports_all_75_fmi3_functions() {
+    let path = cdylib_path();
+    let so = std::fs::read(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let info = check_library(&so).unwrap();
+    let mut fmi3: Vec<&str> = info
+        .exported
+        .iter()
+        .map(|s| s.as_str())
+        .filter(|s| s.starts_with("fmi3"))
+        .collect();
+    fmi3.sort_unstable();
+    let mut expected = FMI3_FUNCTIONS.to_vec();
+    expected.sort_unstable();
+    assert_eq!(fmi3, expected);
 }

@@ -2,7 +2,7 @@
 //!
 //! ```text
 //! cargo run --release -p yarnsim-fmu-pack --bin build-fmu -- [--scene NAME_OR_FILE] [-o OUT.fmu]
-//!     [--lib libYarnBundle.so | --no-build] [--model-description FILE]
+//!     [--lib libYarnBundle.so | --no-build] [--model-description FILE] [--fmi-version 2|3]
 //! ```
 //!
 //! Without `--scene` it packs the default scene (`yarn-reference`) into
@@ -13,15 +13,18 @@
 //! same profile) unless `--lib` names one or `--no-build` is given.
 //! `--model-description FILE` only writes the generated modelDescription.xml
 //! (used to refresh `modelDescription/YarnBundle.xml`).
+//! `--fmi-version 3` packs the FMI 3.0 FMU of the scene instead (default 2):
+//! `binaries/x86_64-linux/`, the array outputs, and `-fmi3` before `.fmu` in
+//! the default file name (`YarnBundle-fmi3.fmu`, `MassSpring-wire-fmi3.fmu`).
 
 use std::path::PathBuf;
 use std::process::ExitCode;
 
 use yarnsim::scene::{Scene, DEFAULT_SCENE};
-use yarnsim_fmu_pack::{build_fmu, check_library, zip_entries};
+use yarnsim_fmu_pack::{build_fmu_of, check_library, zip_entries, FmiVersion};
 use YarnBundle::{SceneFmu, MODEL_IDENTIFIER};
 
-const USAGE: &str = "usage: build-fmu [--scene NAME_OR_FILE] [-o OUT.fmu] [--lib libYarnBundle.so | --no-build] [--model-description FILE]";
+const USAGE: &str = "usage: build-fmu [--scene NAME_OR_FILE] [-o OUT.fmu] [--lib libYarnBundle.so | --no-build] [--model-description FILE] [--fmi-version 2|3]";
 
 fn run() -> Result<(), String> {
     let mut scene_arg: Option<String> = None;
@@ -29,6 +32,7 @@ fn run() -> Result<(), String> {
     let mut lib: Option<PathBuf> = None;
     let mut xml_only: Option<PathBuf> = None;
     let mut no_build = false;
+    let mut version = FmiVersion::Fmi2;
     let mut args = std::env::args().skip(1);
     while let Some(a) = args.next() {
         let mut value = |what: &str| args.next().ok_or(format!("{a} needs {what}\n{USAGE}"));
@@ -38,6 +42,13 @@ fn run() -> Result<(), String> {
             "--lib" => lib = Some(value("a shared library")?.into()),
             "--model-description" => xml_only = Some(value("a file name")?.into()),
             "--no-build" => no_build = true,
+            "--fmi-version" => {
+                version = match value("2 or 3")?.as_str() {
+                    "2" | "2.0" => FmiVersion::Fmi2,
+                    "3" | "3.0" => FmiVersion::Fmi3,
+                    v => return Err(format!("--fmi-version {v:?}: use 2 or 3\n{USAGE}")),
+                }
+            }
             "-h" | "--help" => {
                 println!("{USAGE}");
                 return Ok(());
@@ -57,7 +68,7 @@ fn run() -> Result<(), String> {
             .map_err(|e| e.0),
     }
     .map_err(|e| format!("{name}: {e}"))?;
-    let xml = scene.model_description()?;
+    let xml = version.model_description(&scene)?;
     if let Some(path) = xml_only {
         std::fs::write(&path, xml).map_err(|e| format!("cannot write {}: {e}", path.display()))?;
         println!("wrote {}", path.display());
@@ -82,10 +93,14 @@ fn run() -> Result<(), String> {
         )
     })?;
     let info = check_library(&so).map_err(|e| format!("{}: {e}", lib.display()))?;
+    let suffix = match version {
+        FmiVersion::Fmi2 => "",
+        FmiVersion::Fmi3 => "-fmi3",
+    };
     let out = out.unwrap_or_else(|| {
         let dir = exe_dir.parent().unwrap_or(&exe_dir).join("fmu");
         if scene_arg.is_none() {
-            dir.join(format!("{MODEL_IDENTIFIER}.fmu"))
+            dir.join(format!("{MODEL_IDENTIFIER}{suffix}.fmu"))
         } else {
             let tag: String = scene
                 .name()
@@ -103,10 +118,10 @@ fn run() -> Result<(), String> {
             } else {
                 tag
             };
-            dir.join(format!("{}-{tag}.fmu", scene.identifier()))
+            dir.join(format!("{}-{tag}{suffix}.fmu", scene.identifier()))
         }
     });
-    let zip = build_fmu(&scene, &so)?;
+    let zip = build_fmu_of(&scene, &so, version)?;
     zip_entries(&zip)?;
     if let Some(dir) = out.parent().filter(|d| !d.as_os_str().is_empty()) {
         std::fs::create_dir_all(dir)
