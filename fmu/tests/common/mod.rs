@@ -65,12 +65,26 @@ extern "C" fn logger(
     category: *const c_char,
     message: *const c_char,
 ) {
+    // SAFETY: the logger's own arguments (see `record`).
+    unsafe { record(env, status, category, message) }
+}
+
+/// Adds a log line to the `Mutex<Vec<Line>>` behind `env` (a test that
+/// passes no environment does not collect log lines).
+///
+/// # Safety
+/// `env` is null or the `Mutex<Vec<Line>>` of the live master that owns the
+/// instance; `category` and `message` are valid C strings.
+pub unsafe fn record(
+    env: *mut c_void,
+    status: c_int,
+    category: *const c_char,
+    message: *const c_char,
+) {
     if env.is_null() {
-        // a test that passes no environment does not collect log lines
         return;
     }
-    // SAFETY: `env` is the `Mutex<Vec<Line>>` of the `Fmu` that owns the
-    // instance; the strings are valid C strings for the call.
+    // SAFETY: the caller's contract.
     unsafe {
         let lines = &*(env as *const Mutex<Vec<Line>>);
         let cat = CStr::from_ptr(category).to_string_lossy().into_owned();
