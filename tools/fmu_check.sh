@@ -8,7 +8,10 @@
 # the default FMU for two frames; then runs the small and the wire FMUs in
 # libcosimpy 0.0.6 (the Open Simulation Platform's libcosim: an input
 # changed through its override manipulator, two FMUs connected output ->
-# input) and compares them bit for bit with fmpy. Exits non-zero on failure.
+# input) and compares them bit for bit with fmpy; then builds the FMI 3.0
+# FMUs of the small, default and wire scenes (build-fmu --fmi-version 3) and
+# checks them in fmpy against the FMI 2.0 FMUs and the library
+# (tools/fmu3_check.py). Exits non-zero on failure.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 venv=tools/.venv
@@ -31,3 +34,10 @@ trap 'rm -rf "$work"' EXIT
     "$work" "$target/release/fmu-replay" fmu/scenes/small.toml "$target/fmu/MassSpring-wire.fmu" \
     "$target/fmu/YarnBundle-driven.fmu" fmu/scenes/driven.toml
 "$venv/bin/python" tools/cosim_check.py "$target/fmu/YarnBundle-small.fmu" "$target/fmu/MassSpring-wire.fmu"
+"$target/release/build-fmu" --no-build --fmi-version 3
+"$target/release/build-fmu" --no-build --fmi-version 3 --scene fmu/scenes/small.toml -o "$target/fmu/YarnBundle-small-fmi3.fmu"
+"$target/release/build-fmu" --no-build --fmi-version 3 --scene wire
+"$venv/bin/python" tools/fmu3_check.py "$work" "$target/release/fmu-replay" fmu/scenes/small.toml \
+    "$target/fmu/YarnBundle-small-fmi3.fmu" "$target/fmu/YarnBundle-small.fmu" \
+    "$target/fmu/YarnBundle-fmi3.fmu" "$target/fmu/YarnBundle.fmu" \
+    "$target/fmu/MassSpring-wire-fmi3.fmu" "$target/fmu/MassSpring-wire.fmu"

@@ -3,7 +3,7 @@
 //! steps the FMU, and writes the outputs as CSV.
 //!
 //! ```text
-//! fmu-replay --scene FILE --inputs in.csv --step H --stop T -o out.csv [--integrator NAME]
+//! fmu-replay --scene FILE --inputs in.csv --step H --stop T -o out.csv [--integrator NAME] [--vertices]
 //! ```
 //!
 //! Yarn scenes (the YarnBundle FMU): `in.csv` has the header
@@ -14,7 +14,10 @@
 //! `kinetic_energy`, `elastic_energy`, `max_stretch`, `substeps`, then
 //! `pin[i].force.x`, `pin[i].force.y` of every pin (the FMU's rule: the
 //! mean of `-pin_reactions()` over the substeps of the step; the pin
-//! targets are set at each communication point, as the FMU latches them).
+//! targets are set at each communication point, as the FMU latches them);
+//! with `--vertices` then the FMI 3.0 FMU's arrays flattened row-major,
+//! `yarn[i].positions[j]` and `yarn[i].velocities[j]` (j = 2 v + axis for
+//! vertex v) of every yarn.
 //!
 //! Mass-spring scenes (the MassSpring FMU, `--integrator` as its parameter,
 //! default backward-euler): `in.csv` has `time,gravity.x,gravity.y,gravity.z`;
@@ -71,8 +74,13 @@ fn read_rows(path: &str, cols: usize) -> Result<Vec<Vec<f64>>, String> {
 fn run() -> Result<(), String> {
     let (mut scene, mut inputs, mut step, mut stop, mut out) = (None, None, None, None, None);
     let mut integrator: Option<String> = None;
+    let mut vertices = false;
     let mut args = std::env::args().skip(1);
     while let Some(a) = args.next() {
+        if a == "--vertices" {
+            vertices = true;
+            continue;
+        }
         let v = args.next().ok_or(format!("{a} needs a value"))?;
         match a.as_str() {
             "--scene" => scene = Some(v),
@@ -84,7 +92,7 @@ fn run() -> Result<(), String> {
             _ => return Err(format!("unknown argument {a}")),
         }
     }
-    let usage = "usage: fmu-replay --scene FILE --inputs in.csv --step H --stop T -o out.csv [--integrator NAME]";
+    let usage = "usage: fmu-replay --scene FILE --inputs in.csv --step H --stop T -o out.csv [--integrator NAME] [--vertices]";
     let (Some(scene), Some(inputs), Some(h), Some(stop), Some(out)) =
         (scene, inputs, step, stop, out)
     else {
@@ -96,7 +104,8 @@ fn run() -> Result<(), String> {
                 return Err("--integrator applies to mass-spring scenes only".into());
             }
             let pins = input_pins(&s);
-            replay_yarn(&s, &read_rows(&inputs, 7 + 4 * pins.len())?, h, stop)?
+            let rows = read_rows(&inputs, 7 + 4 * pins.len())?;
+            replay_yarn(&s, &rows, h, stop, vertices)?
         }
         Scene::MassSpring(l) => {
             let integrator = match integrator {
@@ -129,7 +138,13 @@ fn push_values(csv: &mut String, values: impl IntoIterator<Item = f64>) {
     }
 }
 
-fn replay_yarn(scene: &YarnScene, rows: &[Vec<f64>], h: f64, stop: f64) -> Result<String, String> {
+fn replay_yarn(
+    scene: &YarnScene,
+    rows: &[Vec<f64>],
+    h: f64,
+    stop: f64,
+    vertices: bool,
+) -> Result<String, String> {
     let mut sim = YarnSim::new(scene).map_err(|e| e.to_string())?;
     let yarns = sim.num_yarns();
     let inputs = input_pins(scene);
@@ -145,6 +160,16 @@ fn replay_yarn(scene: &YarnScene, rows: &[Vec<f64>], h: f64, stop: f64) -> Resul
     for i in 0..pins {
         let _ = write!(csv, ",pin[{i}].force.x,pin[{i}].force.y");
     }
+    if vertices {
+        let r = &sim.particles().yarn_vertices;
+        for i in 0..yarns {
+            for what in ["positions", "velocities"] {
+                for j in 0..2 * (r[i + 1] - r[i]) {
+                    let _ = write!(csv, ",yarn[{i}].{what}[{j}]");
+                }
+            }
+        }
+    }
     csv.push('\n');
     let record = |csv: &mut String, t: f64, sim: &YarnSim, force: &[Vec2]| {
         let _ = write!(csv, "{t:?}");
@@ -159,6 +184,15 @@ fn replay_yarn(scene: &YarnScene, rows: &[Vec<f64>], h: f64, stop: f64) -> Resul
         push_values(csv, [d.kinetic_energy, d.elastic_energy, d.max_stretch]);
         let _ = write!(csv, ",{}", sim.steps());
         push_values(csv, force.iter().flat_map(|f| [f.x, f.y]));
+        if vertices {
+            let p = sim.particles();
+            for i in 0..yarns {
+                let range = p.yarn_vertices[i]..p.yarn_vertices[i + 1];
+                for field in [&p.vert.x, &p.vert.v] {
+                    push_values(csv, field[range.clone()].iter().flat_map(|v| [v.x, v.y]));
+                }
+            }
+        }
         csv.push('\n');
     };
     record(&mut csv, 0.0, &sim, &force);
