@@ -1,8 +1,14 @@
-//! # YarnBundle and MassSpring: FMI 2.0 Co-Simulation FMUs of yarnsim
+//! # YarnBundle and MassSpring: FMI 2.0 and FMI 3.0 Co-Simulation FMUs of yarnsim
 //!
 //! The cdylib (`libYarnBundle.so`, shipped as `binaries/linux64/YarnBundle.so`,
 //! or as `binaries/linux64/MassSpring.so` in a mass-spring FMU) exports the 34
-//! `fmi2*` functions of FMI 2.0 Co-Simulation ([`ffi`]). The scene it runs
+//! `fmi2*` functions of FMI 2.0 Co-Simulation ([`ffi`]) and the 75 `fmi3*`
+//! functions of FMI 3.0 ([`fmi3`]; Co-Simulation works, the rest returns
+//! fmi3Error with a logged reason). The FMI 3.0 FMU (`build-fmu
+//! --fmi-version 3`, the library under `binaries/x86_64-linux/`) has the same
+//! variables plus Float64 arrays of the whole state: every yarn's vertex
+//! positions and velocities, every particle's position, with sizes fixed
+//! by the bundled scene ([`model::ArrayVariable`], [`yarn::arrays`]). The scene it runs
 //! travels in the FMU's `resources/scene.toml`: a yarn scene makes it the MPM
 //! yarn bundle (`YarnBundle`), a mass-spring scene (`wire`, `cloth`, ...) the
 //! mass-spring system (`MassSpring`). The scene fixes the outputs (yarns or
@@ -13,7 +19,8 @@
 //!
 //! Model-neutral (they import no model):
 //! * [`model`]: the variable types and static-table mechanics, the variables
-//!   every model has, the `modelDescription.xml` writer and the GUID hash.
+//!   every model has, the `modelDescription.xml` writers (FMI 2.0, FMI 3.0)
+//!   and the GUID hash.
 //! * [`fmu_model`]: the [`fmu_model::FmuModel`] trait between the FMI front
 //!   end and the models, with typed errors.
 //! * [`state_bytes`]: the framing of a serialized FMU state (magics, version,
@@ -30,10 +37,12 @@
 //! * [`models`]: the bundled scene's model, identifier, GUID and description
 //!   (the one module that knows both models).
 //! * [`instance`]: an instance around either model: stepping, values.
-//! * [`ffi`]: the C ABI.
+//! * [`ffi`]: the FMI 2.0 C ABI; [`fmi3`]: the FMI 3.0 C ABI (the same
+//!   instance with [`state_machine::Api::Fmi3`]: the table's fmi3 rows, FMI
+//!   3.0 words in the log, the non-variadic logger).
 //!
-//! See the README, section "YarnBundle: the FMI 2.0 Co-Simulation FMU", for
-//! the variables and the build command.
+//! See `docs/fmu.md` for the FMI 2.0 FMUs (variables, build command) and
+//! `docs/fmu3.md` for the FMI 3.0 ones (arrays, fmpy, what differs).
 
 // The crate is named after the FMI modelIdentifier `YarnBundle`.
 #![allow(non_snake_case)]
