@@ -47,7 +47,7 @@
 // The crate is named after the FMI modelIdentifier `YarnBundle`.
 #![allow(non_snake_case)]
 // Every unsafe operation sits in its own `unsafe` block with a SAFETY
-// comment, also inside `unsafe fn` (the C ABI in `ffi.rs`): the workspace
+// comment, also inside `unsafe fn` (the C ABIs in `ffi/` and `fmi3/`): the workspace
 // lints `unsafe_op_in_unsafe_fn` and `clippy::undocumented_unsafe_blocks`
 // (Cargo.toml) deny anything else.
 
