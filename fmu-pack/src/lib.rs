@@ -232,7 +232,10 @@ pub fn documentation_html_of(scene: &Scene, version: FmiVersion) -> Result<Strin
             v.variability,
             v.unit.unwrap_or(""),
             xml_escape(v.start.as_deref().unwrap_or("")),
-            xml_escape(&v.description)
+            xml_escape(&match version {
+                FmiVersion::Fmi2 => v.description.clone(),
+                FmiVersion::Fmi3 => YarnBundle::model::fmi3_words(&v.description),
+            })
         );
     }
     if version == FmiVersion::Fmi3 {

@@ -264,3 +264,30 @@ fn fmi3_attractor_on_a_circle_snapshot() {
     }
     insta::assert_snapshot!(snap.join("\n"));
 }
+
+/// The checked-in FMI 3.0 modelDescriptions of the default scene and the
+/// wire are what the generator writes (refresh with `build-fmu
+/// --fmi-version 3 [--scene wire] --model-description FILE`).
+#[test]
+fn checked_in_fmi3_model_descriptions_are_current() {
+    let yarn = Scene::Yarn(yarnsim::scene::builtin::yarn_reference());
+    let wire = Scene::MassSpring(yarnsim::massspring::scenes::wire());
+    for (scene, checked_in, file) in [
+        (
+            yarn,
+            include_str!("../../modelDescription/YarnBundle-fmi3.xml"),
+            "YarnBundle-fmi3.xml",
+        ),
+        (
+            wire,
+            include_str!("../../modelDescription/MassSpring-wire-fmi3.xml"),
+            "MassSpring-wire-fmi3.xml",
+        ),
+    ] {
+        assert!(
+            scene.model_description_fmi3().unwrap() == checked_in,
+            "modelDescription/{file} drifted from the generator"
+        );
+        assert!(!checked_in.contains("fmi2"), "{file}");
+    }
+}

@@ -27,6 +27,12 @@ pub fn fmi3_type(t: VarType) -> &'static str {
     }
 }
 
+/// A description in FMI 3.0 words (the FMI 2.0 function and status names
+/// the shared variable tables use, such as `fmi2DoStep`, `fmi2Error`).
+pub fn fmi3_words(text: &str) -> String {
+    text.replace("fmi2", "fmi3")
+}
+
 /// Value references as a `dependencies` list: ascending, space-separated.
 fn vr_list(vrs: &[u32]) -> String {
     let mut v = vrs.to_vec();
@@ -42,7 +48,7 @@ fn scalar(x: &mut String, v: &Variable) {
         "    <{ty} name=\"{}\" valueReference=\"{}\" description=\"{}\" causality=\"{}\" variability=\"{}\"",
         xml_escape(&v.name),
         v.vr,
-        xml_escape(&v.description),
+        xml_escape(&fmi3_words(&v.description)),
         v.causality,
         v.variability
     );
@@ -130,7 +136,7 @@ pub fn write_model_description_fmi3(d: &Description) -> String {
             || vars.iter().any(|v| v.unit == Some(u))
             || d.arrays.iter().any(|a| a.unit == Some(u))
     };
-    write_units_to_experiment(&mut x, d, used, |w| w.replace("fmi2", "fmi3"));
+    write_units_to_experiment(&mut x, d, used, fmi3_words);
     x.push_str("  <ModelVariables>\n");
     let _ = writeln!(
         x,
