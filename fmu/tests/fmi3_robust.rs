@@ -332,3 +332,29 @@ fn a_diverging_step_discards_with_terminate_simulation() {
     }
     f.free_state(saved);
 }
+
+/// The `scene` parameter may load a scene with other vertex counts (same
+/// yarns, same pins): the arrays then have the new sizes, and a read with
+/// the bundled scene's sizes is refused with the counts in the message.
+#[test]
+fn arrays_follow_a_scene_parameter_with_other_vertex_counts() {
+    let f = Fmu3::small();
+    let other = SMALL_SCENE.replace("vertices = 24", "vertices = 30");
+    assert_ne!(other, SMALL_SCENE);
+    std::fs::write(f.dir.join("other.toml"), other).unwrap();
+    let name = std::ffi::CString::new("other.toml").unwrap();
+    let p = name.as_ptr();
+    // SAFETY: a live instance; one value reference and one live C string.
+    assert_eq!(unsafe { fmi3SetString(f.c, &VR_SCENE, 1, &p, 1) }, fmi3OK);
+    f.init();
+    assert_eq!(f.step(0.0, H).0, fmi3OK);
+    let (s, v) = f.get(&[array_vr(0, false)], 60);
+    assert_eq!(s, fmi3OK, "{:?}", f.lines());
+    assert!(v.iter().all(|x| x.is_finite()));
+    assert_eq!(f.get(&[array_vr(0, false)], 48).0, fmi3Error);
+    assert!(
+        f.last_error().contains("nValues = 48") && f.last_error().contains("have 60 values"),
+        "{}",
+        f.last_error()
+    );
+}
