@@ -18,7 +18,6 @@ usage: fmu3_check.py WORKDIR REPLAY_EXE SMALL_SCENE SMALL3.fmu SMALL2.fmu REF3.f
 Exits non-zero on any problem; prints the comparison counts.
 """
 import csv
-import math
 import subprocess
 import sys
 
@@ -26,6 +25,8 @@ import numpy as np
 from fmpy import extract, read_model_description, simulate_fmu
 from fmpy.fmi3 import FMU3Slave
 from fmpy.validation import validate_fmu
+
+from fmu_inputs import circling_attractor, input_signals, time_grid
 
 work, replay, small_scene = sys.argv[1:4]
 small3, small2, ref3, ref2, wire3, wire2 = sys.argv[4:10]
@@ -135,25 +136,8 @@ for f in (small3, ref3, wire3):
 
 # the small scene: attractor on a circle, gravity turning (as fmu_check.py)
 H, STOP = 0.01, 0.4
-n = int(round(STOP / H)) + 1
-t = np.array([k * H for k in range(n)])
-w = 2 * math.pi * t / 0.4
-cols = [
-    ("time", t),
-    ("attractor.x", 0.5 + 0.2 * np.cos(w)),
-    ("attractor.y", 0.5 + 0.2 * np.sin(w)),
-    ("attractor.strength", np.full(n, 30.0)),
-    ("attractor.active", t >= 0.1 - 1e-12),
-    ("gravity.x", 4.0 * np.sin(3.0 * t)),
-    ("gravity.y", -9.8 * np.cos(3.0 * t)),
-]
 in_csv = f"{work}/inputs3.csv"
-with open(in_csv, "w") as fh:
-    fh.write(",".join(name for name, _ in cols) + "\n")
-    for row in zip(*[c for _, c in cols]):
-        fh.write(",".join(repr(float(v)) for v in row) + "\n")
-dtype = [(name, np.bool_ if name == "attractor.active" else np.double) for name, _ in cols]
-signals = np.array(list(zip(*[c for _, c in cols])), dtype=dtype)
+signals = input_signals(in_csv, circling_attractor(H, STOP))
 r3, _ = against_fmi2("YarnBundle (small)", small3, small2, signals, H, STOP)
 
 # arrays against the library run of the same inputs (fmu-replay --vertices)
@@ -180,8 +164,7 @@ against_fmi2("YarnBundle (default scene)", ref3, ref2, None, HR, 2 * HR)
 
 # the wire: gravity signal; positions against the FMI 2.0 particle outputs
 HW, STOPW = 0.05, 1.0
-n = int(round(STOPW / HW)) + 1
-t = np.array([k * HW for k in range(n)])
+n, t = time_grid(HW, STOPW)
 wcols = [("time", t), ("gravity.x", 3.0 * np.sin(4.0 * t)), ("gravity.y", np.full(n, -9.81)), ("gravity.z", 2.0 * np.cos(3.0 * t))]
 wsignals = np.array(list(zip(*[c for _, c in wcols])), dtype=[(name, np.double) for name, _ in wcols])
 w3, w2 = against_fmi2("MassSpring (wire)", wire3, wire2, wsignals, HW, STOPW)

@@ -33,30 +33,10 @@ from fmpy import read_model_description, simulate_fmu, extract
 from fmpy.fmi2 import FMU2Slave
 from fmpy.validation import validate_fmu
 
+from fmu_inputs import circling_attractor, input_signals, time_grid
+
 small_fmu, ref_fmu, work, replay, small_scene, wire_fmu, driven_fmu, driven_scene = sys.argv[1:9]
 failures = []
-
-
-def write_inputs(path, cols):
-    """The input table as fmu-replay reads it."""
-    with open(path, "w") as fh:
-        fh.write(",".join(name for name, _ in cols) + "\n")
-        for row in zip(*[c for _, c in cols]):
-            fh.write(",".join(repr(float(v)) for v in row) + "\n")
-
-
-def input_signals(path, cols):
-    """The input columns `cols` as fmpy's structured array (booleans for
-    attractor.active), also written to `path` for fmu-replay."""
-    write_inputs(path, cols)
-    dtype = [(name, np.bool_ if name == "attractor.active" else np.double) for name, _ in cols]
-    return np.array(list(zip(*[c for _, c in cols])), dtype=dtype)
-
-
-def time_grid(h, stop):
-    """`(n, t)`: the n communication points 0, h, ..., stop."""
-    n = int(round(stop / h)) + 1
-    return n, np.array([k * h for k in range(n)])
 
 
 def compare(label, result, rust_csv, outputs):
@@ -152,17 +132,7 @@ for f in (small_fmu, ref_fmu, wire_fmu):
 
 # 2. simulate with an input signal and compare with the Rust side
 H, STOP = 0.01, 0.4
-n, t = time_grid(H, STOP)
-w = 2 * math.pi * t / 0.4
-cols = [
-    ("time", t),
-    ("attractor.x", 0.5 + 0.2 * np.cos(w)),
-    ("attractor.y", 0.5 + 0.2 * np.sin(w)),
-    ("attractor.strength", np.full(n, 30.0)),
-    ("attractor.active", t >= 0.1 - 1e-12),
-    ("gravity.x", 4.0 * np.sin(3.0 * t)),
-    ("gravity.y", -9.8 * np.cos(3.0 * t)),
-]
+cols = circling_attractor(H, STOP)
 in_csv = f"{work}/inputs.csv"
 signals = input_signals(in_csv, cols)
 

@@ -69,6 +69,17 @@ extern "C" fn logger(
     unsafe { record(env, status, category, message) }
 }
 
+/// The message of the last line logged with a status of at least `discard`
+/// (the Discard status of either FMI version), or "".
+pub fn last_error_in(lines: &[Line], discard: c_int) -> String {
+    lines
+        .iter()
+        .rev()
+        .find(|l| l.0 >= discard)
+        .map(|l| l.2.clone())
+        .unwrap_or_default()
+}
+
 /// Adds a log line to the `Mutex<Vec<Line>>` behind `env` (a test that
 /// passes no environment does not collect log lines).
 ///
@@ -184,12 +195,7 @@ impl Fmu {
     }
 
     pub fn last_error(&self) -> String {
-        self.lines()
-            .iter()
-            .rev()
-            .find(|l| l.0 >= fmi2Discard)
-            .map(|l| l.2.clone())
-            .unwrap_or_default()
+        last_error_in(&self.lines(), fmi2Discard)
     }
 
     /// Asserts that the last error logged contains `what` (the whole log

@@ -89,12 +89,7 @@ impl Fmu3 {
     }
 
     pub fn last_error(&self) -> String {
-        self.lines()
-            .iter()
-            .rev()
-            .find(|l| l.0 >= fmi3Discard)
-            .map(|l| l.2.clone())
-            .unwrap_or_default()
+        crate::common::last_error_in(&self.lines(), fmi3Discard)
     }
 
     /// Enter (start 0, no stop time) and exit initialization mode.
