@@ -1,13 +1,14 @@
 """fmpy checks of the FMI 3.0 YarnBundle and MassSpring FMUs (run by tools/fmu_check.sh).
 
-usage: fmu3_check.py WORKDIR REPLAY_EXE SMALL_SCENE SMALL3.fmu SMALL2.fmu REF3.fmu REF2.fmu WIRE3.fmu WIRE2.fmu
+usage: fmu3_check.py WORKDIR REPLAY_EXE SMALL_SCENE SMALL3.fmu SMALL2.fmu REF3.fmu REF2.fmu WIRE3.fmu WIRE2.fmu DRIVEN3.fmu DRIVEN2.fmu
 
 1. fmpy's validation (schema, structure, start values, units) of every
    FMI 3.0 FMU.
 2. fmpy.simulate_fmu of the FMI 3.0 and the FMI 2.0 FMU of the same scene
    with the same input signals: every scalar output of the FMI 2.0 FMU (yarn
-   ends, energies, stretch, substeps, particle positions) equal bit for bit
-   in the FMI 3.0 run.
+   ends, energies, stretch, substeps, pin forces, particle positions) equal
+   bit for bit in the FMI 3.0 run; on the driven scene with a table that
+   waves the driven yarn end (pin[0].x, .y, .vx, .vy).
 3. The arrays against the library: the small scene's yarn[i].positions and
    yarn[i].velocities against fmu-replay --vertices (the Rust library run of
    the same inputs, no FMU), the wire's positions against the FMI 2.0 FMU's
@@ -18,6 +19,7 @@ usage: fmu3_check.py WORKDIR REPLAY_EXE SMALL_SCENE SMALL3.fmu SMALL2.fmu REF3.f
 Exits non-zero on any problem; prints the comparison counts.
 """
 import csv
+import math
 import subprocess
 import sys
 
@@ -29,7 +31,7 @@ from fmpy.validation import validate_fmu
 from fmu_inputs import circling_attractor, input_signals, time_grid
 
 work, replay, small_scene = sys.argv[1:4]
-small3, small2, ref3, ref2, wire3, wire2 = sys.argv[4:10]
+small3, small2, ref3, ref2, wire3, wire2, driven3, driven2 = sys.argv[4:12]
 failures = []
 
 
@@ -53,7 +55,8 @@ def simulate(path, signals, h, stop, names):
 
 def same_bits(label, a, b):
     """Counts the values of two equal-shaped float sequences; every pair must be bit-identical."""
-    a, b = np.asarray(a, dtype=np.float64).ravel(), np.asarray(b, dtype=np.float64).ravel()
+    a = np.ascontiguousarray(a, dtype=np.float64).ravel()
+    b = np.ascontiguousarray(b, dtype=np.float64).ravel()
     if a.shape != b.shape:
         failures.append(f"{label}: {a.shape} values vs {b.shape}")
         return 0
@@ -131,7 +134,7 @@ def read_csv(path):
         return list(csv.DictReader(fh))
 
 
-for f in (small3, ref3, wire3):
+for f in (small3, ref3, wire3, driven3):
     validate(f)
 
 # the small scene: attractor on a circle, gravity turning (as fmu_check.py)
@@ -173,6 +176,23 @@ particles = [v.name for v in outs2 if v.name.startswith("particle[")]
 flat = np.array([[row[p] for p in particles] for row in w2])
 count = same_bits("MassSpring (wire) positions vs particle[i]", np.stack(list(w3["positions"])).reshape(len(w3), -1), flat)
 print(f"MassSpring (wire): positions array vs the FMI 2.0 particle outputs: {count} values")
+
+# the driven scene: the driven end waves sideways and rises (as fmu_check.py)
+HD, STOPD = 0.01, 0.3
+n, t = time_grid(HD, STOPD)
+w = 2 * math.pi / 0.3
+dcols = [
+    ("time", t),
+    ("pin[0].x", 0.25 + 0.05 * np.sin(w * t)),
+    ("pin[0].y", 0.65 + 0.1 * t),
+    ("pin[0].vx", 0.05 * w * np.cos(w * t)),
+    ("pin[0].vy", np.full(n, 0.1)),
+]
+dsignals = input_signals(f"{work}/driven3.csv", dcols)
+d3, _ = against_fmi2("YarnBundle (driven)", driven3, driven2, dsignals, HD, STOPD)
+# the driven end is the first vertex of yarn 0's positions
+first = np.stack([p[0] for p in d3["yarn[0].positions"]])
+same_bits("YarnBundle (driven): yarn[0].positions[0] vs yarn[0].left", first, np.stack([d3["yarn[0].left.x"], d3["yarn[0].left.y"]], axis=1))
 
 state_round_trip("YarnBundle (small)", small3, H, [v.name for v in outs3 if v.type == "Float64"])
 _, wouts3 = outputs_of(wire3)

@@ -9,7 +9,7 @@
 # libcosimpy 0.0.6 (the Open Simulation Platform's libcosim: an input
 # changed through its override manipulator, two FMUs connected output ->
 # input) and compares them bit for bit with fmpy; then builds the FMI 3.0
-# FMUs of the small, default and wire scenes (build-fmu --fmi-version 3) and
+# FMUs of the small, default, wire and driven scenes (build-fmu --fmi-version 3) and
 # checks them in fmpy against the FMI 2.0 FMUs and the library
 # (tools/fmu3_check.py). Exits non-zero on failure.
 set -euo pipefail
@@ -37,7 +37,9 @@ trap 'rm -rf "$work"' EXIT
 "$target/release/build-fmu" --no-build --fmi-version 3
 "$target/release/build-fmu" --no-build --fmi-version 3 --scene fmu/scenes/small.toml -o "$target/fmu/YarnBundle-small-fmi3.fmu"
 "$target/release/build-fmu" --no-build --fmi-version 3 --scene wire
+"$target/release/build-fmu" --no-build --fmi-version 3 --scene fmu/scenes/driven.toml -o "$target/fmu/YarnBundle-driven-fmi3.fmu"
 "$venv/bin/python" tools/fmu3_check.py "$work" "$target/release/fmu-replay" fmu/scenes/small.toml \
     "$target/fmu/YarnBundle-small-fmi3.fmu" "$target/fmu/YarnBundle-small.fmu" \
     "$target/fmu/YarnBundle-fmi3.fmu" "$target/fmu/YarnBundle.fmu" \
-    "$target/fmu/MassSpring-wire-fmi3.fmu" "$target/fmu/MassSpring-wire.fmu"
+    "$target/fmu/MassSpring-wire-fmi3.fmu" "$target/fmu/MassSpring-wire.fmu" \
+    "$target/fmu/YarnBundle-driven-fmi3.fmu" "$target/fmu/YarnBundle-driven.fmu"
