@@ -218,6 +218,17 @@ const SET: &[Phase] = &[Instantiated, InitializationMode, StepComplete];
 /// Where `fmi2Get*Status` may be called.
 const STATUS: &[Phase] = &[StepComplete, StepFailed, Terminated];
 
+/// Where the FMI 3.0 getters may read values: as FMI 2.0, and also in
+/// Instantiated (the start values and the initial state), as
+/// modelica/Reference-FMUs `fmi3Functions.c` allows (`MASK_fmi3GetFloat64`).
+const GET3: &[Phase] = &[
+    Instantiated,
+    InitializationMode,
+    StepComplete,
+    StepFailed,
+    Terminated,
+];
+
 /// Where the FMI 3.0 functions that end a step-mode run may be called: Step
 /// Mode, also after `terminateSimulation`.
 const STEP_MODE: &[Phase] = &[StepComplete, StepFailed];
@@ -261,10 +272,10 @@ pub const ALLOWED: &[(&str, &[Phase])] = &[
     ("fmi3EnterStepMode", &[StepComplete]),
     ("fmi3Terminate", STEP_MODE),
     ("fmi3Reset", NOT_FATAL),
-    ("fmi3GetFloat64", GET),
-    ("fmi3GetInt32", GET),
-    ("fmi3GetBoolean", GET),
-    ("fmi3GetString", GET),
+    ("fmi3GetFloat64", GET3),
+    ("fmi3GetInt32", GET3),
+    ("fmi3GetBoolean", GET3),
+    ("fmi3GetString", GET3),
     ("fmi3SetFloat64", SET),
     ("fmi3SetInt32", SET),
     ("fmi3SetBoolean", SET),
@@ -354,6 +365,8 @@ mod tests {
         assert!(require(Instantiated, "fmi3EnterStepMode").is_err());
         assert!(require(Error, "fmi3Reset").is_ok());
         assert!(require(Error, "fmi3GetFloat64").is_err());
+        assert!(require(Instantiated, "fmi3GetFloat64").is_ok());
+        assert!(require(Instantiated, "fmi2GetReal").is_err());
         let e = require(Instantiated, "fmi3DoStep").unwrap_err();
         assert_eq!(e.msg, "fmi3DoStep is not allowed in state \"Instantiated\"");
         assert_eq!(name_in(Api::Fmi2, "fmi2GetReal"), "fmi2GetReal");
