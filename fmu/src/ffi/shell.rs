@@ -9,7 +9,8 @@ use libc::size_t;
 
 use super::{fmi2Component, fmi2Error, fmi2Fatal, fmi2Status, fmi2String};
 use crate::instance::{
-    error, message_in, Instance, Phase, Res, Status, LOG_ALL, LOG_DISCARD, LOG_ERROR, LOG_FATAL,
+    error, message_in, Fail, Instance, Phase, Res, Status, LOG_ALL, LOG_DISCARD, LOG_ERROR,
+    LOG_FATAL,
 };
 
 pub(crate) fn panic_message(p: &(dyn std::any::Any + Send)) -> String {
@@ -137,3 +138,156 @@ pub(crate) unsafe fn string(p: fmi2String) -> Option<String> {
 pub(crate) fn null(func: &str, what: &str) -> Res<Status> {
     error(format!("{func}: {what} is a null pointer"))
 }
+
+/// The value references and a writable array of `n_values` values from C,
+/// or the null-pointer failure (`what`: the arguments' names in its message).
+///
+/// # Safety
+/// As [`slice`] and [`slice_mut`].
+pub(crate) unsafe fn get_args<'a, T>(
+    func: &str,
+    what: &str,
+    vr: *const u32,
+    nvr: size_t,
+    values: *mut T,
+    n_values: size_t,
+) -> Result<(&'a [u32], &'a mut [T]), Fail> {
+    // SAFETY: FMI passes `nvr` value references and a writable array of
+    // `n_values` values (null only when the count is 0, else refused).
+    match unsafe { (slice(vr, nvr), slice_mut(values, n_values)) } {
+        (Some(v), Some(o)) => Ok((v, o)),
+        _ => Err(null(func, what).unwrap_err()),
+    }
+}
+
+/// The value references and an array of `n_values` values from C, or the
+/// null-pointer failure (`what`: the arguments' names in its message).
+///
+/// # Safety
+/// As [`slice`].
+pub(crate) unsafe fn set_args<'a, T>(
+    func: &str,
+    what: &str,
+    vr: *const u32,
+    nvr: size_t,
+    values: *const T,
+    n_values: size_t,
+) -> Result<(&'a [u32], &'a [T]), Fail> {
+    // SAFETY: FMI passes `nvr` value references and `n_values` values
+    // (null only when the count is 0, else refused).
+    match unsafe { (slice(vr, nvr), slice(values, n_values)) } {
+        (Some(v), Some(o)) => Ok((v, o)),
+        _ => Err(null(func, what).unwrap_err()),
+    }
+}
+
+/// The string getter of either version: pointers to the instance's strings.
+pub(crate) fn get_strings(inst: &mut Instance, vrs: &[u32], out: &mut [fmi2String]) -> Res<Status> {
+    let strings = inst.get_string(vrs)?;
+    for (o, s) in out.iter_mut().zip(strings) {
+        *o = s.as_ptr();
+    }
+    Ok(Status::Ok)
+}
+
+/// The string setter of either version.
+///
+/// # Safety
+/// Each value is null or a NUL-terminated string valid for the call.
+pub(crate) unsafe fn set_strings(
+    inst: &mut Instance,
+    vrs: &[u32],
+    vals: &[fmi2String],
+) -> Res<Status> {
+    // SAFETY: each value is null or a NUL-terminated string (FMI contract).
+    let vals: Vec<Option<String>> = vals.iter().map(|&p| unsafe { string(p) }).collect();
+    ok(inst.set_string(vrs, &vals))
+}
+
+/// `fmi2SetDebugLogging` / `fmi3SetDebugLogging`: the categories from C,
+/// then [`Instance::set_debug_logging`].
+///
+/// # Safety
+/// `categories` is null or holds `n` pointers, each null or a
+/// NUL-terminated string.
+pub(crate) unsafe fn debug_logging(
+    inst: &mut Instance,
+    func: &str,
+    on: bool,
+    categories: *const fmi2String,
+    n: size_t,
+) -> Res<Status> {
+    // SAFETY: FMI passes `nCategories` category strings.
+    let Some(cats) = (unsafe { slice(categories, n) }) else {
+        return null(func, "categories");
+    };
+    let mut names = Vec::with_capacity(cats.len());
+    for &p in cats {
+        // SAFETY: each category is null or a NUL-terminated string.
+        match unsafe { string(p) } {
+            Some(s) => names.push(s),
+            None => return null(func, "a category"),
+        }
+    }
+    let refs: Vec<&str> = names.iter().map(|s| s.as_str()).collect();
+    ok(inst.set_debug_logging(on, &refs))
+}
+
+/// Exports functions of either version whose body runs on the instance:
+/// `call(instance type) -> status type;` then `name(args) |inst| body;`
+/// (the first argument, the instance, is implicit; `call` is [`call`] or
+/// `call3`, which checks the instance's version and names the function).
+macro_rules! exports {
+    ($call:ident($inst:ty) -> $status:ty;
+     $($name:ident($($arg:ident: $ty:ty),*) |$i:pat_param| $body:expr;)*) => {$(
+        #[no_mangle]
+        pub unsafe extern "C" fn $name(instance: $inst, $($arg: $ty),*) -> $status {
+            $call(instance, stringify!($name), |$i| $body)
+        }
+    )*};
+}
+pub(crate) use exports;
+
+/// Exports getters and setters of either version from one table:
+/// `call(instance type) -> status type, "the null-pointer message's
+/// names", [nValues];` then `name(value pointer, get_args or set_args)
+/// |inst, func, vrs, values| body;`. The FMI 3.0 ones have the number of
+/// values as a fifth argument (`[nValues]`); the FMI 2.0 ones as many
+/// values as value references (`[]`). `value pointer as *const u8` reads a
+/// C `bool` as bytes, so that another byte value cannot be undefined
+/// behaviour.
+macro_rules! value_exports {
+    (@count $nvr:ident) => { $nvr };
+    (@count $nvr:ident $nv:ident) => { $nv };
+    (@one $call:ident($inst:ty) -> $status:ty, $what:literal, [$($nv:ident)?];
+     $name:ident($ptr:ty $(as $cast:ty)?, $args:ident)
+     |$i:ident, $func:ident, $vrs:ident, $vals:ident| $body:expr) => {
+        #[no_mangle]
+        pub unsafe extern "C" fn $name(
+            instance: $inst,
+            vr: *const u32,
+            nvr: libc::size_t,
+            values: $ptr,
+            $($nv: libc::size_t,)?
+        ) -> $status {
+            let $func = stringify!($name);
+            $call(instance, $func, |$i| {
+                let n_values = $crate::ffi::value_exports!(@count nvr $($nv)?);
+                // SAFETY: FMI passes `nvr` value references and an array of
+                // `n_values` values (null only when a count is 0, else refused).
+                let ($vrs, $vals) = unsafe {
+                    $crate::ffi::$args($func, $what, vr, nvr, values $(as $cast)?, n_values)
+                }?;
+                $body
+            })
+        }
+    };
+    ($call:ident($inst:ty) -> $status:ty, $what:literal, $nv:tt;
+     $($name:ident($ptr:ty $(as $cast:ty)?, $args:ident)
+       |$i:ident, $func:ident, $vrs:ident, $vals:ident| $body:expr;)*) => {$(
+        $crate::ffi::value_exports! { @one $call($inst) -> $status, $what, $nv;
+            $name($ptr $(as $cast)?, $args) |$i, $func, $vrs, $vals| $body
+        }
+    )*};
+}
+pub(crate) use value_exports;

@@ -9,87 +9,48 @@ use libc::size_t;
 use super::{call, fmi2Byte, fmi2Component, fmi2FMUstate, fmi2Status, null, ok, slice};
 use crate::instance::{error, Instance, Res, Snapshot, Status};
 
-#[no_mangle]
-pub unsafe extern "C" fn fmi2GetFMUstate(
-    c: fmi2Component,
-    FMUstate: *mut fmi2FMUstate,
-) -> fmi2Status {
-    call(c, "fmi2GetFMUstate", |inst| {
-        // SAFETY: forwarded from the caller (FMI contract).
-        unsafe { get_state(inst, "fmi2GetFMUstate", FMUstate) }
-    })
-}
-
-#[no_mangle]
-pub unsafe extern "C" fn fmi2SetFMUstate(c: fmi2Component, FMUstate: fmi2FMUstate) -> fmi2Status {
-    // SAFETY: forwarded from the caller (FMI contract).
-    call(c, "fmi2SetFMUstate", |inst| unsafe {
-        set_state(inst, FMUstate)
-    })
-}
-
-#[no_mangle]
-pub unsafe extern "C" fn fmi2FreeFMUstate(
-    c: fmi2Component,
-    FMUstate: *mut fmi2FMUstate,
-) -> fmi2Status {
-    // SAFETY: forwarded from the caller (FMI contract).
-    call(c, "fmi2FreeFMUstate", |_| unsafe { free_state(FMUstate) })
-}
-
-#[no_mangle]
-pub unsafe extern "C" fn fmi2SerializedFMUstateSize(
-    c: fmi2Component,
-    FMUstate: fmi2FMUstate,
-    size: *mut size_t,
-) -> fmi2Status {
-    call(c, "fmi2SerializedFMUstateSize", |inst| {
-        // SAFETY: forwarded from the caller (FMI contract).
-        unsafe { state_size(inst, "fmi2SerializedFMUstateSize", FMUstate, size) }
-    })
-}
-
-#[no_mangle]
-pub unsafe extern "C" fn fmi2SerializeFMUstate(
-    c: fmi2Component,
-    FMUstate: fmi2FMUstate,
-    serializedState: *mut fmi2Byte,
-    size: size_t,
-) -> fmi2Status {
-    call(c, "fmi2SerializeFMUstate", |inst| {
-        // SAFETY: forwarded from the caller (FMI contract).
-        unsafe {
-            serialize_state(
-                inst,
-                "fmi2SerializeFMUstate",
-                "fmi2SerializedFMUstateSize",
-                FMUstate,
-                serializedState as *mut u8,
-                size,
-            )
+/// Exports the six FMU-state functions of either version over the bodies
+/// below: `call(instance type) -> status type, state type, byte type; get,
+/// set, free, size, serialize, deserialize`.
+macro_rules! state_exports {
+    ($call:ident($inst:ty) -> $status:ty, $state:ty, $byte:ty;
+     $get:ident, $set:ident, $free:ident, $size:ident, $ser:ident, $deser:ident) => {
+        $crate::ffi::exports! { $call($inst) -> $status;
+            $get(FMUstate: *mut $state) |inst| {
+                // SAFETY: forwarded from the caller (FMI contract).
+                unsafe { $crate::ffi::get_state(inst, stringify!($get), FMUstate) }
+            };
+            $set(FMUstate: $state) |inst| {
+                // SAFETY: forwarded from the caller (FMI contract).
+                unsafe { $crate::ffi::set_state(inst, FMUstate) }
+            };
+            $free(FMUstate: *mut $state) |_| {
+                // SAFETY: forwarded from the caller (FMI contract).
+                unsafe { $crate::ffi::free_state(FMUstate) }
+            };
+            $size(FMUstate: $state, size: *mut libc::size_t) |inst| {
+                // SAFETY: forwarded from the caller (FMI contract).
+                unsafe { $crate::ffi::state_size(inst, stringify!($size), FMUstate, size) }
+            };
+            $ser(FMUstate: $state, serializedState: *mut $byte, size: libc::size_t) |inst| {
+                let (func, size_func) = (stringify!($ser), stringify!($size));
+                let buf = serializedState.cast::<u8>();
+                // SAFETY: forwarded from the caller (FMI contract).
+                unsafe { $crate::ffi::serialize_state(inst, func, size_func, FMUstate, buf, size) }
+            };
+            $deser(serializedState: *const $byte, size: libc::size_t, FMUstate: *mut $state) |inst| {
+                let bytes = serializedState.cast::<u8>();
+                // SAFETY: forwarded from the caller (FMI contract).
+                unsafe { $crate::ffi::deserialize_state(inst, stringify!($deser), bytes, size, FMUstate) }
+            };
         }
-    })
+    };
 }
+pub(crate) use state_exports;
 
-#[no_mangle]
-pub unsafe extern "C" fn fmi2DeSerializeFMUstate(
-    c: fmi2Component,
-    serializedState: *const fmi2Byte,
-    size: size_t,
-    FMUstate: *mut fmi2FMUstate,
-) -> fmi2Status {
-    call(c, "fmi2DeSerializeFMUstate", |inst| {
-        // SAFETY: forwarded from the caller (FMI contract).
-        unsafe {
-            deserialize_state(
-                inst,
-                "fmi2DeSerializeFMUstate",
-                serializedState as *const u8,
-                size,
-                FMUstate,
-            )
-        }
-    })
+state_exports! { call(fmi2Component) -> fmi2Status, fmi2FMUstate, fmi2Byte;
+    fmi2GetFMUstate, fmi2SetFMUstate, fmi2FreeFMUstate,
+    fmi2SerializedFMUstateSize, fmi2SerializeFMUstate, fmi2DeSerializeFMUstate
 }
 
 /// `fmi2GetFMUstate` / `fmi3GetFMUState`: a new state into `*FMUstate`, or

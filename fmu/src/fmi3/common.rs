@@ -8,7 +8,7 @@ use std::panic::{catch_unwind, AssertUnwindSafe};
 use libc::size_t;
 
 use super::*;
-use crate::ffi::{null, ok, panic_message, slice, string};
+use crate::ffi::{debug_logging, exports, ok, panic_message, string};
 use crate::instance::{escape_nul, LOG_ERROR};
 use crate::model::LOG_CATEGORIES;
 
@@ -17,29 +17,11 @@ pub extern "C" fn fmi3GetVersion() -> *const c_char {
     c"3.0".as_ptr()
 }
 
-#[no_mangle]
-pub unsafe extern "C" fn fmi3SetDebugLogging(
-    instance: fmi3Instance,
-    loggingOn: fmi3Boolean,
-    nCategories: size_t,
-    categories: *const fmi3String,
-) -> fmi3Status {
-    call3(instance, "fmi3SetDebugLogging", |inst| {
+exports! { call3(fmi3Instance) -> fmi3Status;
+    fmi3SetDebugLogging(loggingOn: fmi3Boolean, nCategories: size_t, categories: *const fmi3String) |inst| {
         // SAFETY: FMI passes `nCategories` category strings.
-        let Some(cats) = (unsafe { slice(categories, nCategories) }) else {
-            return null("fmi3SetDebugLogging", "categories");
-        };
-        let mut names = Vec::with_capacity(cats.len());
-        for &p in cats {
-            // SAFETY: each category is null or a NUL-terminated string.
-            match unsafe { string(p) } {
-                Some(s) => names.push(s),
-                None => return null("fmi3SetDebugLogging", "a category"),
-            }
-        }
-        let refs: Vec<&str> = names.iter().map(|s| s.as_str()).collect();
-        ok(inst.set_debug_logging(loggingOn, &refs))
-    })
+        unsafe { debug_logging(inst, "fmi3SetDebugLogging", loggingOn, categories, nCategories) }
+    };
 }
 
 /// Logs a refused instantiation through the environment's callback.
@@ -59,43 +41,29 @@ fn refuse_instance(
     std::ptr::null_mut()
 }
 
-#[no_mangle]
-pub unsafe extern "C" fn fmi3InstantiateModelExchange(
-    _instanceName: fmi3String,
-    _instantiationToken: fmi3String,
-    _resourcePath: fmi3String,
-    _visible: fmi3Boolean,
-    _loggingOn: fmi3Boolean,
-    instanceEnvironment: fmi3InstanceEnvironment,
-    logMessage: Option<fmi3LogMessageCallback>,
-) -> fmi3Instance {
-    refuse_instance(
-        logMessage,
-        instanceEnvironment,
-        "fmi3InstantiateModelExchange",
-        "this FMU supports Co-Simulation only (no <ModelExchange> in modelDescription.xml)",
-    )
+/// Exports the instantiations of the interfaces this FMU does not have:
+/// `name(the arguments after logMessage) => reason;`.
+macro_rules! refused_instantiate {
+    ($($name:ident($($arg:ident: $ty:ty),*) => $why:literal;)*) => {$(
+        #[no_mangle]
+        pub unsafe extern "C" fn $name(
+            _instanceName: fmi3String,
+            _instantiationToken: fmi3String,
+            _resourcePath: fmi3String,
+            _visible: fmi3Boolean,
+            _loggingOn: fmi3Boolean,
+            instanceEnvironment: fmi3InstanceEnvironment,
+            logMessage: Option<fmi3LogMessageCallback>,
+            $($arg: $ty),*
+        ) -> fmi3Instance {
+            refuse_instance(logMessage, instanceEnvironment, stringify!($name), $why)
+        }
+    )*};
 }
 
-#[no_mangle]
-pub unsafe extern "C" fn fmi3InstantiateScheduledExecution(
-    _instanceName: fmi3String,
-    _instantiationToken: fmi3String,
-    _resourcePath: fmi3String,
-    _visible: fmi3Boolean,
-    _loggingOn: fmi3Boolean,
-    instanceEnvironment: fmi3InstanceEnvironment,
-    logMessage: Option<fmi3LogMessageCallback>,
-    _clockUpdate: fmi3ClockUpdateCallback,
-    _lockPreemption: fmi3PreemptionCallback,
-    _unlockPreemption: fmi3PreemptionCallback,
-) -> fmi3Instance {
-    refuse_instance(
-        logMessage,
-        instanceEnvironment,
-        "fmi3InstantiateScheduledExecution",
-        "this FMU supports Co-Simulation only (no <ScheduledExecution> in modelDescription.xml)",
-    )
+refused_instantiate! {
+    fmi3InstantiateModelExchange() => "this FMU supports Co-Simulation only (no <ModelExchange> in modelDescription.xml)";
+    fmi3InstantiateScheduledExecution(_clockUpdate: fmi3ClockUpdateCallback, _lockPreemption: fmi3PreemptionCallback, _unlockPreemption: fmi3PreemptionCallback) => "this FMU supports Co-Simulation only (no <ScheduledExecution> in modelDescription.xml)";
 }
 
 #[no_mangle]
@@ -167,34 +135,12 @@ pub unsafe extern "C" fn fmi3FreeInstance(instance: fmi3Instance) {
     unsafe { crate::ffi::fmi2FreeInstance(instance) }
 }
 
-#[no_mangle]
-pub unsafe extern "C" fn fmi3EnterInitializationMode(
-    instance: fmi3Instance,
-    _toleranceDefined: fmi3Boolean,
-    _tolerance: fmi3Float64,
-    startTime: fmi3Float64,
-    stopTimeDefined: fmi3Boolean,
-    stopTime: fmi3Float64,
-) -> fmi3Status {
-    call3(instance, "fmi3EnterInitializationMode", |inst| {
+exports! { call3(fmi3Instance) -> fmi3Status;
+    fmi3EnterInitializationMode(_toleranceDefined: fmi3Boolean, _tolerance: fmi3Float64, startTime: fmi3Float64, stopTimeDefined: fmi3Boolean, stopTime: fmi3Float64) |inst| {
         inst.setup_experiment(startTime, stopTimeDefined.then_some(stopTime))?;
         ok(inst.enter_initialization_mode())
-    })
-}
-
-#[no_mangle]
-pub unsafe extern "C" fn fmi3ExitInitializationMode(instance: fmi3Instance) -> fmi3Status {
-    call3(instance, "fmi3ExitInitializationMode", |inst| {
-        inst.exit_initialization_mode()
-    })
-}
-
-#[no_mangle]
-pub unsafe extern "C" fn fmi3Terminate(instance: fmi3Instance) -> fmi3Status {
-    call3(instance, "fmi3Terminate", |inst| ok(inst.terminate()))
-}
-
-#[no_mangle]
-pub unsafe extern "C" fn fmi3Reset(instance: fmi3Instance) -> fmi3Status {
-    call3(instance, "fmi3Reset", |inst| ok(inst.reset()))
+    };
+    fmi3ExitInitializationMode() |inst| inst.exit_initialization_mode();
+    fmi3Terminate() |inst| ok(inst.terminate());
+    fmi3Reset() |inst| ok(inst.reset());
 }

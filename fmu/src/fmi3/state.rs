@@ -5,97 +5,11 @@
 use libc::size_t;
 
 use super::*;
-use crate::ffi::{
-    deserialize_state, free_state, get_state, null, serialize_state, set_state, slice_mut,
-    state_size,
-};
+use crate::ffi::{null, slice_mut, state_exports};
 
-#[no_mangle]
-pub unsafe extern "C" fn fmi3GetFMUState(
-    instance: fmi3Instance,
-    FMUState: *mut fmi3FMUState,
-) -> fmi3Status {
-    call3(instance, "fmi3GetFMUState", |inst| {
-        // SAFETY: forwarded from the caller (FMI contract).
-        unsafe { get_state(inst, "fmi3GetFMUState", FMUState) }
-    })
-}
-
-#[no_mangle]
-pub unsafe extern "C" fn fmi3SetFMUState(
-    instance: fmi3Instance,
-    FMUState: fmi3FMUState,
-) -> fmi3Status {
-    // SAFETY: forwarded from the caller (FMI contract).
-    call3(instance, "fmi3SetFMUState", |inst| unsafe {
-        set_state(inst, FMUState)
-    })
-}
-
-#[no_mangle]
-pub unsafe extern "C" fn fmi3FreeFMUState(
-    instance: fmi3Instance,
-    FMUState: *mut fmi3FMUState,
-) -> fmi3Status {
-    // SAFETY: forwarded from the caller (FMI contract).
-    call3(instance, "fmi3FreeFMUState", |_| unsafe {
-        free_state(FMUState)
-    })
-}
-
-#[no_mangle]
-pub unsafe extern "C" fn fmi3SerializedFMUStateSize(
-    instance: fmi3Instance,
-    FMUState: fmi3FMUState,
-    size: *mut size_t,
-) -> fmi3Status {
-    call3(instance, "fmi3SerializedFMUStateSize", |inst| {
-        // SAFETY: forwarded from the caller (FMI contract).
-        unsafe { state_size(inst, "fmi3SerializedFMUStateSize", FMUState, size) }
-    })
-}
-
-#[no_mangle]
-pub unsafe extern "C" fn fmi3SerializeFMUState(
-    instance: fmi3Instance,
-    FMUState: fmi3FMUState,
-    serializedState: *mut fmi3Byte,
-    size: size_t,
-) -> fmi3Status {
-    call3(instance, "fmi3SerializeFMUState", |inst| {
-        // SAFETY: forwarded from the caller (FMI contract).
-        unsafe {
-            serialize_state(
-                inst,
-                "fmi3SerializeFMUState",
-                "fmi3SerializedFMUStateSize",
-                FMUState,
-                serializedState,
-                size,
-            )
-        }
-    })
-}
-
-#[no_mangle]
-pub unsafe extern "C" fn fmi3DeserializeFMUState(
-    instance: fmi3Instance,
-    serializedState: *const fmi3Byte,
-    size: size_t,
-    FMUState: *mut fmi3FMUState,
-) -> fmi3Status {
-    call3(instance, "fmi3DeserializeFMUState", |inst| {
-        // SAFETY: forwarded from the caller (FMI contract).
-        unsafe {
-            deserialize_state(
-                inst,
-                "fmi3DeserializeFMUState",
-                serializedState,
-                size,
-                FMUState,
-            )
-        }
-    })
+state_exports! { call3(fmi3Instance) -> fmi3Status, fmi3FMUState, fmi3Byte;
+    fmi3GetFMUState, fmi3SetFMUState, fmi3FreeFMUState,
+    fmi3SerializedFMUStateSize, fmi3SerializeFMUState, fmi3DeserializeFMUState
 }
 
 #[no_mangle]

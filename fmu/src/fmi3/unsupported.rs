@@ -9,7 +9,7 @@
 use libc::size_t;
 
 use super::*;
-use crate::ffi::slice;
+use crate::ffi::{exports, slice};
 use crate::instance::error;
 
 /// Exports functions that always refuse: `name(args) => reason;`.
@@ -43,36 +43,26 @@ fn no_variable(
     }
 }
 
-/// Exports the getters and setters of a type without variables:
+/// Exports getters and setters of types without variables: `name(the
+/// arguments after nValueReferences) "the state table's row" => "type";`.
+macro_rules! no_variable {
+    ($($name:ident($($arg:ident: $ty:ty),*) $row:literal => $tyname:literal;)*) => {$(
+        exports! { call3(fmi3Instance) -> fmi3Status;
+            $name(valueReferences: *const fmi3ValueReference, nValueReferences: size_t, $($arg: $ty),*) |inst| {
+                inst.require($row)?;
+                no_variable($tyname, valueReferences, nValueReferences)
+            };
+        }
+    )*};
+}
+
+/// Exports the getter and setter of each type without variables:
 /// `(getter, setter, type name, element type);`.
 macro_rules! no_such_type {
-    ($(($get:ident, $set:ident, $tyname:expr, $elem:ty);)*) => {$(
-        #[no_mangle]
-        pub unsafe extern "C" fn $get(
-            instance: fmi3Instance,
-            valueReferences: *const fmi3ValueReference,
-            nValueReferences: size_t,
-            _values: *mut $elem,
-            _nValues: size_t,
-        ) -> fmi3Status {
-            call3(instance, stringify!($get), |inst| {
-                inst.require("fmi2GetReal")?;
-                no_variable($tyname, valueReferences, nValueReferences)
-            })
-        }
-
-        #[no_mangle]
-        pub unsafe extern "C" fn $set(
-            instance: fmi3Instance,
-            valueReferences: *const fmi3ValueReference,
-            nValueReferences: size_t,
-            _values: *const $elem,
-            _nValues: size_t,
-        ) -> fmi3Status {
-            call3(instance, stringify!($set), |inst| {
-                inst.require("fmi2SetReal")?;
-                no_variable($tyname, valueReferences, nValueReferences)
-            })
+    ($(($get:ident, $set:ident, $tyname:literal, $elem:ty);)*) => {$(
+        no_variable! {
+            $get(_values: *mut $elem, _nValues: size_t) "fmi2GetReal" => $tyname;
+            $set(_values: *const $elem, _nValues: size_t) "fmi2SetReal" => $tyname;
         }
     )*};
 }
@@ -88,34 +78,9 @@ no_such_type! {
     (fmi3GetUInt64, fmi3SetUInt64, "UInt64", fmi3UInt64);
 }
 
-#[no_mangle]
-pub unsafe extern "C" fn fmi3GetBinary(
-    instance: fmi3Instance,
-    valueReferences: *const fmi3ValueReference,
-    nValueReferences: size_t,
-    _valueSizes: *mut size_t,
-    _values: *mut fmi3Binary,
-    _nValues: size_t,
-) -> fmi3Status {
-    call3(instance, "fmi3GetBinary", |inst| {
-        inst.require("fmi2GetReal")?;
-        no_variable("Binary", valueReferences, nValueReferences)
-    })
-}
-
-#[no_mangle]
-pub unsafe extern "C" fn fmi3SetBinary(
-    instance: fmi3Instance,
-    valueReferences: *const fmi3ValueReference,
-    nValueReferences: size_t,
-    _valueSizes: *const size_t,
-    _values: *const fmi3Binary,
-    _nValues: size_t,
-) -> fmi3Status {
-    call3(instance, "fmi3SetBinary", |inst| {
-        inst.require("fmi2SetReal")?;
-        no_variable("Binary", valueReferences, nValueReferences)
-    })
+no_variable! {
+    fmi3GetBinary(_valueSizes: *mut size_t, _values: *mut fmi3Binary, _nValues: size_t) "fmi2GetReal" => "Binary";
+    fmi3SetBinary(_valueSizes: *const size_t, _values: *const fmi3Binary, _nValues: size_t) "fmi2SetReal" => "Binary";
 }
 
 const NO_CLOCKS: &str = "not supported: this FMU has no clocks";
