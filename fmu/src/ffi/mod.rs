@@ -159,36 +159,32 @@ pub unsafe extern "C" fn fmi2Instantiate(
         }
         std::ptr::null_mut()
     };
-    let result = catch_unwind(AssertUnwindSafe(|| {
-        let Some(name) = name.as_deref().filter(|n| !n.is_empty()) else {
-            return Err("the instance name is null or empty".to_string());
-        };
+    let checks = || {
         if fmuType != fmi2CoSimulation {
             return Err(format!(
                 "fmuType {fmuType} is not fmi2CoSimulation: this is a Co-Simulation FMU only"
             ));
         }
-        // SAFETY: null or NUL-terminated strings (FMI contract).
-        let Some(guid) = (unsafe { string(fmuGUID) }) else {
-            return Err("the GUID is a null pointer".into());
-        };
-        // SAFETY: as above.
-        let Some(res) = (unsafe { string(fmuResourceLocation) }) else {
-            return Err("the resource location is a null pointer".into());
-        };
-        Instance::new(
-            name,
-            &guid,
-            &res,
-            cb.logger,
-            cb.componentEnvironment,
-            loggingOn != fmi2False,
+        Ok(())
+    };
+    let make = |name: &str, guid: &str, res: &str| {
+        let on = loggingOn != fmi2False;
+        Instance::new(name, guid, res, cb.logger, cb.componentEnvironment, on)
+    };
+    let what = ("the GUID", "the resource location");
+    // SAFETY: null or NUL-terminated strings (FMI contract).
+    match unsafe {
+        instantiate(
+            name.as_deref(),
+            fmuGUID,
+            fmuResourceLocation,
+            what,
+            checks,
+            make,
         )
-    }));
-    match result {
-        Ok(Ok(inst)) => Box::into_raw(inst) as fmi2Component,
-        Ok(Err(msg)) => fail(&msg),
-        Err(p) => fail(&format!("internal error: {}", panic_message(&*p))),
+    } {
+        Ok(inst) => Box::into_raw(inst) as fmi2Component,
+        Err(msg) => fail(&msg),
     }
 }
 

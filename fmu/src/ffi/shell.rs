@@ -9,8 +9,7 @@ use libc::size_t;
 
 use super::{fmi2Component, fmi2Error, fmi2Fatal, fmi2Status, fmi2String};
 use crate::instance::{
-    error, message_in, Fail, Instance, Phase, Res, Status, LOG_ALL, LOG_DISCARD, LOG_ERROR,
-    LOG_FATAL,
+    error, message_in, Instance, Phase, Res, Status, LOG_ALL, LOG_DISCARD, LOG_ERROR, LOG_FATAL,
 };
 
 pub(crate) fn panic_message(p: &(dyn std::any::Any + Send)) -> String {
@@ -135,7 +134,7 @@ pub(crate) unsafe fn string(p: fmi2String) -> Option<String> {
     (!p.is_null()).then(|| unsafe { CStr::from_ptr(p) }.to_string_lossy().into_owned())
 }
 
-pub(crate) fn null(func: &str, what: &str) -> Res<Status> {
+pub(crate) fn null<T>(func: &str, what: &str) -> Res<T> {
     error(format!("{func}: {what} is a null pointer"))
 }
 
@@ -151,12 +150,12 @@ pub(crate) unsafe fn get_args<'a, T>(
     nvr: size_t,
     values: *mut T,
     n_values: size_t,
-) -> Result<(&'a [u32], &'a mut [T]), Fail> {
+) -> Res<(&'a [u32], &'a mut [T])> {
     // SAFETY: FMI passes `nvr` value references and a writable array of
     // `n_values` values (null only when the count is 0, else refused).
     match unsafe { (slice(vr, nvr), slice_mut(values, n_values)) } {
         (Some(v), Some(o)) => Ok((v, o)),
-        _ => Err(null(func, what).unwrap_err()),
+        _ => null(func, what),
     }
 }
 
@@ -172,12 +171,12 @@ pub(crate) unsafe fn set_args<'a, T>(
     nvr: size_t,
     values: *const T,
     n_values: size_t,
-) -> Result<(&'a [u32], &'a [T]), Fail> {
+) -> Res<(&'a [u32], &'a [T])> {
     // SAFETY: FMI passes `nvr` value references and `n_values` values
     // (null only when the count is 0, else refused).
     match unsafe { (slice(vr, nvr), slice(values, n_values)) } {
         (Some(v), Some(o)) => Ok((v, o)),
-        _ => Err(null(func, what).unwrap_err()),
+        _ => null(func, what),
     }
 }
 
@@ -291,3 +290,36 @@ macro_rules! value_exports {
     )*};
 }
 pub(crate) use value_exports;
+
+/// The body of `fmi2Instantiate` and `fmi3InstantiateCoSimulation`: the
+/// instance name (not empty), the version's own `checks`, the token and the
+/// resource location from C (`what`: their names in the null-pointer
+/// messages), then `make`; a panic is caught and becomes the message.
+///
+/// # Safety
+/// `token` and `res` are null or NUL-terminated strings valid for the call.
+pub(crate) unsafe fn instantiate(
+    name: Option<&str>,
+    token: fmi2String,
+    res: fmi2String,
+    what: (&str, &str),
+    checks: impl FnOnce() -> Result<(), String>,
+    make: impl FnOnce(&str, &str, &str) -> Result<Box<Instance>, String>,
+) -> Result<Box<Instance>, String> {
+    let result = catch_unwind(AssertUnwindSafe(|| {
+        let Some(name) = name.filter(|n| !n.is_empty()) else {
+            return Err("the instance name is null or empty".to_string());
+        };
+        checks()?;
+        // SAFETY: null or NUL-terminated strings (FMI contract).
+        let Some(token) = (unsafe { string(token) }) else {
+            return Err(format!("{} is a null pointer", what.0));
+        };
+        // SAFETY: as above.
+        let Some(res) = (unsafe { string(res) }) else {
+            return Err(format!("{} is a null pointer", what.1));
+        };
+        make(name, &token, &res)
+    }));
+    result.unwrap_or_else(|p| Err(format!("internal error: {}", panic_message(&*p))))
+}

@@ -53,6 +53,31 @@ state_exports! { call(fmi2Component) -> fmi2Status, fmi2FMUstate, fmi2Byte;
     fmi2SerializedFMUstateSize, fmi2SerializeFMUstate, fmi2DeSerializeFMUstate
 }
 
+/// The environment's state slot and the state already in it (none where
+/// the slot holds null), for the functions that write a state into it.
+///
+/// # Safety
+/// `FMUstate` is null or points to the environment's state slot, which is
+/// null or holds a state this FMU handed out.
+unsafe fn state_slot<'a>(
+    func: &str,
+    FMUstate: *mut *mut c_void,
+) -> Res<(&'a mut *mut c_void, Option<&'a mut Snapshot>)> {
+    // SAFETY: `FMUstate` is null or points to the environment's state slot.
+    let Some(slot) = (unsafe { FMUstate.as_mut() }) else {
+        return null(func, "FMUstate");
+    };
+    if slot.is_null() {
+        return Ok((slot, None));
+    }
+    // SAFETY: a non-null slot holds a state this FMU handed out
+    // (FMI contract); the magic number rejects others.
+    match unsafe { Snapshot::from_ptr(*slot) } {
+        Some(s) => Ok((slot, Some(s))),
+        None => error("*FMUstate is not an FMU state of this FMU"),
+    }
+}
+
 /// `fmi2GetFMUstate` / `fmi3GetFMUState`: a new state into `*FMUstate`, or
 /// the state already there overwritten.
 ///
@@ -64,20 +89,8 @@ pub(crate) unsafe fn get_state(
     func: &str,
     FMUstate: *mut *mut c_void,
 ) -> Res<Status> {
-    // SAFETY: `FMUstate` is null or points to the environment's state slot.
-    let Some(slot) = (unsafe { FMUstate.as_mut() }) else {
-        return null(func, "FMUstate");
-    };
-    let existing = if slot.is_null() {
-        None
-    } else {
-        // SAFETY: a non-null slot holds a state this FMU handed out
-        // (FMI contract); the magic number rejects others.
-        match unsafe { Snapshot::from_ptr(*slot) } {
-            Some(s) => Some(s),
-            None => return error("*FMUstate is not an FMU state of this FMU"),
-        }
-    };
+    // SAFETY: as this function's contract.
+    let (slot, existing) = unsafe { state_slot(func, FMUstate) }?;
     if let Some(new) = inst.get_fmu_state(existing)? {
         *slot = Box::into_raw(new) as fmi2FMUstate;
     }
@@ -194,19 +207,9 @@ pub(crate) unsafe fn deserialize_state(
     let Some(bytes) = (unsafe { slice(bytes, size) }) else {
         return null(func, "serializedState");
     };
-    // SAFETY: `FMUstate` is null or points to the environment's state slot.
-    let Some(slot) = (unsafe { FMUstate.as_mut() }) else {
-        return null(func, "FMUstate");
-    };
-    let old = if slot.is_null() {
-        None
-    } else {
-        // SAFETY: a non-null slot holds a state this FMU handed out.
-        match unsafe { Snapshot::from_ptr(*slot) } {
-            Some(s) => Some(s as *mut Snapshot),
-            None => return error("*FMUstate is not an FMU state of this FMU"),
-        }
-    };
+    // SAFETY: as this function's contract.
+    let (slot, old) = unsafe { state_slot(func, FMUstate) }?;
+    let old = old.map(|s| s as *mut Snapshot);
     let new = inst.deserialize(bytes)?;
     if let Some(old) = old {
         // SAFETY: made by `Box::into_raw`; the slot is overwritten

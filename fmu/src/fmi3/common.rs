@@ -3,12 +3,11 @@
 //! termination and reset.
 
 use std::ffi::c_char;
-use std::panic::{catch_unwind, AssertUnwindSafe};
 
 use libc::size_t;
 
 use super::*;
-use crate::ffi::{debug_logging, exports, ok, panic_message, string};
+use crate::ffi::{debug_logging, exports, instantiate, ok, string};
 use crate::instance::{escape_nul, LOG_ERROR};
 use crate::model::LOG_CATEGORIES;
 
@@ -81,13 +80,7 @@ pub unsafe extern "C" fn fmi3InstantiateCoSimulation(
     logMessage: Option<fmi3LogMessageCallback>,
     _intermediateUpdate: fmi3IntermediateUpdateCallback,
 ) -> fmi3Instance {
-    let func = "fmi3InstantiateCoSimulation";
-    let result = catch_unwind(AssertUnwindSafe(|| {
-        // SAFETY: null or a NUL-terminated string (FMI contract).
-        let name = unsafe { string(instanceName) };
-        let Some(name) = name.as_deref().filter(|n| !n.is_empty()) else {
-            return Err("the instance name is null or empty".to_string());
-        };
+    let checks = || {
         if eventModeUsed {
             return Err(
                 "eventModeUsed = true, but this FMU has no event mode (hasEventMode=\"false\")"
@@ -103,28 +96,32 @@ pub unsafe extern "C" fn fmi3InstantiateCoSimulation(
                 "{nRequiredIntermediateVariables} required intermediate variables, but this FMU has no intermediate update (providesIntermediateUpdate=\"false\")"
             ));
         }
-        // SAFETY: null or NUL-terminated strings (FMI contract).
-        let Some(token) = (unsafe { string(instantiationToken) }) else {
-            return Err("the instantiationToken is a null pointer".into());
-        };
-        // SAFETY: as above.
-        let Some(res) = (unsafe { string(resourcePath) }) else {
-            return Err("the resourcePath is a null pointer".into());
-        };
-        Instance::new_fmi3(
-            name,
-            &token,
-            &res,
+        Ok(())
+    };
+    let make = |name: &str, token: &str, res: &str| {
+        Instance::new_fmi3(name, token, res, logMessage, instanceEnvironment, loggingOn)
+    };
+    // SAFETY: null or a NUL-terminated string (FMI contract).
+    let name = unsafe { string(instanceName) };
+    let what = ("the instantiationToken", "the resourcePath");
+    // SAFETY: null or NUL-terminated strings (FMI contract).
+    match unsafe {
+        instantiate(
+            name.as_deref(),
+            instantiationToken,
+            resourcePath,
+            what,
+            checks,
+            make,
+        )
+    } {
+        Ok(inst) => Box::into_raw(inst) as fmi3Instance,
+        Err(msg) => refuse_instance(
             logMessage,
             instanceEnvironment,
-            loggingOn,
-        )
-    }));
-    let fail = |msg: &str| refuse_instance(logMessage, instanceEnvironment, func, msg);
-    match result {
-        Ok(Ok(inst)) => Box::into_raw(inst) as fmi3Instance,
-        Ok(Err(msg)) => fail(&msg),
-        Err(p) => fail(&format!("internal error: {}", panic_message(&*p))),
+            "fmi3InstantiateCoSimulation",
+            &msg,
+        ),
     }
 }
 
