@@ -162,41 +162,91 @@ pub fn write_units_to_experiment(
     );
 }
 
-/// Writes `modelDescription.xml`; only the units the variables use are defined.
-pub fn write_model_description(d: &Description) -> String {
-    let vars = &d.variables;
+/// What the two FMI versions write differently before `<ModelVariables>`.
+pub struct Header<'a> {
+    /// `fmiVersion`.
+    pub version: &'a str,
+    /// The name of the GUID (FMI 2.0) or token (FMI 3.0) attribute.
+    pub id_attr: &'a str,
+    /// The attributes of `<fmiModelDescription>` after
+    /// `variableNamingConvention`.
+    pub extra: &'a str,
+    /// The attributes of `<CoSimulation>` after `modelIdentifier`.
+    pub cosim: &'a str,
+}
+
+/// Writes the start of `modelDescription.xml` of either FMI version, up to
+/// `<ModelVariables>`: the XML declaration, `<fmiModelDescription>`,
+/// `<CoSimulation>` and [`write_units_to_experiment`].
+pub fn write_header(
+    d: &Description,
+    h: Header<'_>,
+    used: impl Fn(&str) -> bool,
+    words: impl Fn(&str) -> String,
+) -> String {
     let ident = d.identifier;
-    let mut x = String::new();
-    x.push_str("<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n");
+    let mut x = String::from("<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n");
     let _ = writeln!(
         x,
-        "<fmiModelDescription fmiVersion=\"2.0\" modelName=\"{ident}\" guid=\"{}\" description=\"{}\" generationTool=\"yarnsim-fmu {}\" generationDateAndTime=\"{}\" variableNamingConvention=\"structured\" numberOfEventIndicators=\"0\">",
+        "<fmiModelDescription fmiVersion=\"{}\" modelName=\"{ident}\" {}=\"{}\" description=\"{}\" generationTool=\"yarnsim-fmu {}\" generationDateAndTime=\"{}\" variableNamingConvention=\"structured\"{}>",
+        h.version,
+        h.id_attr,
         d.guid,
         xml_escape(&d.description),
         env!("CARGO_PKG_VERSION"),
         generation_date_and_time(),
+        h.extra,
     );
     let _ = writeln!(
         x,
-        "  <CoSimulation modelIdentifier=\"{ident}\" canHandleVariableCommunicationStepSize=\"true\" canInterpolateInputs=\"false\" maxOutputDerivativeOrder=\"0\" canRunAsynchronuously=\"false\" canBeInstantiatedOnlyOncePerProcess=\"false\" canNotUseMemoryManagementFunctions=\"true\" canGetAndSetFMUstate=\"true\" canSerializeFMUstate=\"true\" providesDirectionalDerivative=\"false\"/>"
+        "  <CoSimulation modelIdentifier=\"{ident}\" {}/>",
+        h.cosim
     );
-    write_units_to_experiment(
-        &mut x,
-        d,
-        |u| vars.iter().any(|v| v.unit == Some(u)),
-        |w| w.to_string(),
-    );
+    write_units_to_experiment(&mut x, d, used, words);
     x.push_str("  <ModelVariables>\n");
+    x
+}
+
+/// Writes the start of a variable element of either FMI version, up to its
+/// `variability` attribute (`attrs`: causality and variability).
+pub fn write_variable(
+    x: &mut String,
+    tag: &str,
+    name: &str,
+    vr: u32,
+    description: &str,
+    (causality, variability): (&str, &str),
+) {
+    let _ = write!(
+        x,
+        "    <{tag} name=\"{}\" valueReference=\"{vr}\" description=\"{}\" causality=\"{causality}\" variability=\"{variability}\"",
+        xml_escape(name),
+        xml_escape(description),
+    );
+}
+
+/// Writes a ` unit` attribute where there is a unit.
+pub fn write_unit(x: &mut String, unit: Option<&str>) {
+    if let Some(u) = unit {
+        let _ = write!(x, " unit=\"{}\"", xml_escape(u));
+    }
+}
+
+/// Writes `modelDescription.xml`; only the units the variables use are defined.
+pub fn write_model_description(d: &Description) -> String {
+    let vars = &d.variables;
+    let used = |u: &str| vars.iter().any(|v| v.unit == Some(u));
+    let mut x = write_header(d, HEADER, used, |w| w.to_string());
     for (i, v) in vars.iter().enumerate() {
         let _ = writeln!(x, "    <!-- index {} -->", i + 1);
-        let _ = write!(
-            x,
-            "    <ScalarVariable name=\"{}\" valueReference=\"{}\" description=\"{}\" causality=\"{}\" variability=\"{}\"",
-            xml_escape(&v.name),
+        let attrs = (v.causality, v.variability);
+        write_variable(
+            &mut x,
+            "ScalarVariable",
+            &v.name,
             v.vr,
-            xml_escape(&v.description),
-            v.causality,
-            v.variability
+            &v.description,
+            attrs,
         );
         // Parameters are initial="exact" by default, inputs take no initial,
         // outputs default to initial="calculated".
@@ -207,9 +257,7 @@ pub fn write_model_description(d: &Description) -> String {
             VarType::Boolean => "Boolean",
             VarType::String => "String",
         });
-        if let Some(u) = v.unit {
-            let _ = write!(x, " unit=\"{}\"", xml_escape(u));
-        }
+        write_unit(&mut x, v.unit);
         if let Some(s) = &v.start {
             let _ = write!(x, " start=\"{}\"", xml_escape(s));
         }
@@ -259,3 +307,11 @@ pub fn write_model_description(d: &Description) -> String {
     x.push_str("    </InitialUnknowns>\n  </ModelStructure>\n</fmiModelDescription>\n");
     x
 }
+
+/// The FMI 2.0 `<fmiModelDescription>` and `<CoSimulation>` attributes.
+const HEADER: Header = Header {
+    version: "2.0",
+    id_attr: "guid",
+    extra: " numberOfEventIndicators=\"0\"",
+    cosim: "canHandleVariableCommunicationStepSize=\"true\" canInterpolateInputs=\"false\" maxOutputDerivativeOrder=\"0\" canRunAsynchronuously=\"false\" canBeInstantiatedOnlyOncePerProcess=\"false\" canNotUseMemoryManagementFunctions=\"true\" canGetAndSetFMUstate=\"true\" canSerializeFMUstate=\"true\" providesDirectionalDerivative=\"false\"",
+};

@@ -13,7 +13,7 @@
 use std::fmt::Write as _;
 
 use super::{
-    generation_date_and_time, write_units_to_experiment, xml_escape, ArrayVariable, Description,
+    write_header, write_unit, write_variable, xml_escape, ArrayVariable, Description, Header,
     VarType, Variable, VR_TIME,
 };
 
@@ -43,18 +43,16 @@ fn vr_list(vrs: &[u32]) -> String {
 /// One scalar variable element.
 fn scalar(x: &mut String, v: &Variable) {
     let ty = fmi3_type(v.ty);
-    let _ = write!(
+    let description = fmi3_words(&v.description);
+    write_variable(
         x,
-        "    <{ty} name=\"{}\" valueReference=\"{}\" description=\"{}\" causality=\"{}\" variability=\"{}\"",
-        xml_escape(&v.name),
+        ty,
+        &v.name,
         v.vr,
-        xml_escape(&fmi3_words(&v.description)),
-        v.causality,
-        v.variability
+        &description,
+        (v.causality, v.variability),
     );
-    if let Some(u) = v.unit {
-        let _ = write!(x, " unit=\"{}\"", xml_escape(u));
-    }
+    write_unit(x, v.unit);
     match (&v.start, v.ty) {
         (Some(s), VarType::String) => {
             let _ = writeln!(
@@ -72,16 +70,9 @@ fn scalar(x: &mut String, v: &Variable) {
 
 /// One Float64 array output element.
 fn array(x: &mut String, a: &ArrayVariable) {
-    let _ = write!(
-        x,
-        "    <Float64 name=\"{}\" valueReference=\"{}\" description=\"{}\" causality=\"output\" variability=\"continuous\"",
-        xml_escape(&a.name),
-        a.vr,
-        xml_escape(&a.description)
-    );
-    if let Some(u) = a.unit {
-        let _ = write!(x, " unit=\"{}\"", xml_escape(u));
-    }
+    let attrs = ("output", "continuous");
+    write_variable(x, "Float64", &a.name, a.vr, &a.description, attrs);
+    write_unit(x, a.unit);
     x.push_str(">\n");
     for n in &a.dims {
         let _ = writeln!(x, "      <Dimension start=\"{n}\"/>");
@@ -116,28 +107,12 @@ pub fn fmi3_outputs(d: &Description) -> Vec<(u32, Vec<u32>, Vec<u32>)> {
 /// use are defined.
 pub fn write_model_description_fmi3(d: &Description) -> String {
     let vars = &d.variables;
-    let ident = d.identifier;
-    let mut x = String::new();
-    x.push_str("<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n");
-    let _ = writeln!(
-        x,
-        "<fmiModelDescription fmiVersion=\"3.0\" modelName=\"{ident}\" instantiationToken=\"{}\" description=\"{}\" generationTool=\"yarnsim-fmu {}\" generationDateAndTime=\"{}\" variableNamingConvention=\"structured\">",
-        d.guid,
-        xml_escape(&d.description),
-        env!("CARGO_PKG_VERSION"),
-        generation_date_and_time(),
-    );
-    let _ = writeln!(
-        x,
-        "  <CoSimulation modelIdentifier=\"{ident}\" canHandleVariableCommunicationStepSize=\"true\" maxOutputDerivativeOrder=\"0\" canBeInstantiatedOnlyOncePerProcess=\"false\" canGetAndSetFMUState=\"true\" canSerializeFMUState=\"true\" providesDirectionalDerivatives=\"false\" providesAdjointDerivatives=\"false\" providesPerElementDependencies=\"false\" hasEventMode=\"false\" providesIntermediateUpdate=\"false\" mightReturnEarlyFromDoStep=\"false\" canReturnEarlyAfterIntermediateUpdate=\"false\" providesEvaluateDiscreteStates=\"false\"/>"
-    );
     let used = |u: &str| {
         u == "s"
             || vars.iter().any(|v| v.unit == Some(u))
             || d.arrays.iter().any(|a| a.unit == Some(u))
     };
-    write_units_to_experiment(&mut x, d, used, fmi3_words);
-    x.push_str("  <ModelVariables>\n");
+    let mut x = write_header(d, HEADER, used, fmi3_words);
     let _ = writeln!(
         x,
         "    <Float64 name=\"time\" valueReference=\"{VR_TIME}\" description=\"Simulation time\" causality=\"independent\" variability=\"continuous\" unit=\"s\"/>"
@@ -167,3 +142,11 @@ pub fn write_model_description_fmi3(d: &Description) -> String {
     x.push_str("  </ModelStructure>\n</fmiModelDescription>\n");
     x
 }
+
+/// The FMI 3.0 `<fmiModelDescription>` and `<CoSimulation>` attributes.
+const HEADER: Header = Header {
+    version: "3.0",
+    id_attr: "instantiationToken",
+    extra: "",
+    cosim: "canHandleVariableCommunicationStepSize=\"true\" maxOutputDerivativeOrder=\"0\" canBeInstantiatedOnlyOncePerProcess=\"false\" canGetAndSetFMUState=\"true\" canSerializeFMUState=\"true\" providesDirectionalDerivatives=\"false\" providesAdjointDerivatives=\"false\" providesPerElementDependencies=\"false\" hasEventMode=\"false\" providesIntermediateUpdate=\"false\" mightReturnEarlyFromDoStep=\"false\" canReturnEarlyAfterIntermediateUpdate=\"false\" providesEvaluateDiscreteStates=\"false\"",
+};
