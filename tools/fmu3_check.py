@@ -26,20 +26,12 @@ import sys
 import numpy as np
 from fmpy import extract, read_model_description, simulate_fmu
 from fmpy.fmi3 import FMU3Slave
-from fmpy.validation import validate_fmu
 
-from fmu_inputs import circling_attractor, input_signals, time_grid
+from fmu_inputs import circling_attractor, finish, input_signals, state_round_trip, time_grid, validate
 
 work, replay, small_scene = sys.argv[1:4]
 small3, small2, ref3, ref2, wire3, wire2, driven3, driven2 = sys.argv[4:12]
 failures = []
-
-
-def validate(path):
-    problems = validate_fmu(path)
-    if problems:
-        failures.append(f"{path}: fmpy validation: {problems}")
-    print(f"validate {path}: {len(problems)} problems")
 
 
 def outputs_of(path):
@@ -90,7 +82,7 @@ def against_fmi2(label, path3, path2, signals, h, stop):
     return r3, r2
 
 
-def state_round_trip(label, path, h, names):
+def fmi3_state_round_trip(label, path, h, names):
     """get + serialize at t1, run on, deserialize + set, run on again."""
     md = read_model_description(path)
     vrs = {v.name: v for v in md.modelVariables}
@@ -104,27 +96,19 @@ def state_round_trip(label, path, h, names):
     fmu.enterInitializationMode(startTime=0.0)
     fmu.exitInitializationMode()
 
-    def run(t, steps):
-        out = []
-        for _ in range(steps):
-            _, terminate, early, _ = fmu.doStep(t, h)
-            if terminate or early:
-                failures.append(f"{label}: doStep set terminateSimulation or earlyReturn")
-            t += h
-            out.append(fmu.getFloat64(refs, n_values))
-        return t, out
+    def step(t, h):
+        _, terminate, early, _ = fmu.doStep(t, h)
+        if terminate or early:
+            failures.append(f"{label}: doStep set terminateSimulation or earlyReturn")
 
-    t1, _ = run(0.0, 5)
-    state = fmu.getFMUState()
-    blob = fmu.serializeFMUState(state)
-    _, first = run(t1, 5)
-    restored = fmu.deserializeFMUState(blob)
-    fmu.setFMUState(restored)
-    _, second = run(t1, 5)
+    blob, first, second, states = state_round_trip(
+        step, lambda: fmu.getFloat64(refs, n_values), fmu.getFMUState, fmu.serializeFMUState,
+        fmu.deserializeFMUState, fmu.setFMUState, h,
+    )
     count = same_bits(f"{label}: state round trip", second, first)
     print(f"{label}: FMI 3.0 state round trip through fmpy: {len(bytes(blob))} bytes, {count} values after it, identical: {first == second}")
-    fmu.freeFMUState(state)
-    fmu.freeFMUState(restored)
+    for state in states:
+        fmu.freeFMUState(state)
     fmu.terminate()
     fmu.freeInstance()
 
@@ -135,7 +119,7 @@ def read_csv(path):
 
 
 for f in (small3, ref3, wire3, driven3):
-    validate(f)
+    validate(f, failures)
 
 # the small scene: attractor on a circle, gravity turning (as fmu_check.py)
 H, STOP = 0.01, 0.4
@@ -194,13 +178,8 @@ d3, _ = against_fmi2("YarnBundle (driven)", driven3, driven2, dsignals, HD, STOP
 first = np.stack([p[0] for p in d3["yarn[0].positions"]])
 same_bits("YarnBundle (driven): yarn[0].positions[0] vs yarn[0].left", first, np.stack([d3["yarn[0].left.x"], d3["yarn[0].left.y"]], axis=1))
 
-state_round_trip("YarnBundle (small)", small3, H, [v.name for v in outs3 if v.type == "Float64"])
+fmi3_state_round_trip("YarnBundle (small)", small3, H, [v.name for v in outs3 if v.type == "Float64"])
 _, wouts3 = outputs_of(wire3)
-state_round_trip("MassSpring (wire)", wire3, HW, [v.name for v in wouts3 if v.type == "Float64"])
+fmi3_state_round_trip("MassSpring (wire)", wire3, HW, [v.name for v in wouts3 if v.type == "Float64"])
 
-if failures:
-    print(f"FMI 3.0 FMU check FAILED ({len(failures)} problems):")
-    for f in failures[:40]:
-        print("  " + f)
-    sys.exit(1)
-print("FMI 3.0 FMU check passed")
+finish("FMI 3.0 FMU check", failures)

@@ -31,9 +31,8 @@ import sys
 import numpy as np
 from fmpy import read_model_description, simulate_fmu, extract
 from fmpy.fmi2 import FMU2Slave
-from fmpy.validation import validate_fmu
 
-from fmu_inputs import circling_attractor, input_signals, time_grid
+from fmu_inputs import circling_attractor, finish, input_signals, state_round_trip, time_grid, validate
 
 small_fmu, ref_fmu, work, replay, small_scene, wire_fmu, driven_fmu, driven_scene = sys.argv[1:9]
 failures = []
@@ -83,7 +82,7 @@ def against_replay(label, fmu, scene, in_csv, signals, outputs, h, stop, out_csv
     return result
 
 
-def state_round_trip(label, path, h, vrs):
+def fmi2_state_round_trip(label, path, h, vrs):
     """get + serialize at t1, run on, deserialize + set, run on again."""
     md = read_model_description(path)
     unzip = extract(path)
@@ -92,43 +91,22 @@ def state_round_trip(label, path, h, vrs):
     fmu.setupExperiment(startTime=0.0)
     fmu.enterInitializationMode()
     fmu.exitInitializationMode()
-
-    def run(t, steps):
-        """`steps` communication steps from t: the end time, the outputs after each."""
-        out = []
-        for _ in range(steps):
-            fmu.doStep(t, h)
-            t += h
-            out.append(fmu.getReal(vrs))
-        return t, out
-
-    t1, _ = run(0.0, 5)
-    state = fmu.getFMUstate()
-    blob = fmu.serializeFMUstate(state)
-    _, first = run(t1, 5)
-    restored = fmu.deSerializeFMUstate(blob)
-    fmu.setFMUstate(restored)
-    _, second = run(t1, 5)
+    blob, first, second, states = state_round_trip(
+        fmu.doStep, lambda: fmu.getReal(vrs), fmu.getFMUstate, fmu.serializeFMUstate,
+        fmu.deSerializeFMUstate, fmu.setFMUstate, h,
+    )
     if first != second:
         failures.append(f"{label}: FMU state round trip through fmpy: outputs differ")
     print(f"{label}: state round trip through fmpy: {len(bytes(blob))} bytes, {'identical' if first == second else 'DIFFERENT'} outputs")
-    fmu.freeFMUstate(state)
-    fmu.freeFMUstate(restored)
+    for state in states:
+        fmu.freeFMUstate(state)
     fmu.terminate()
     fmu.freeInstance()
 
 
-def validate(path):
-    """fmpy's validation of the FMU at `path`; its problems become failures."""
-    problems = validate_fmu(path)
-    if problems:
-        failures.append(f"{path}: fmpy validation: {problems}")
-    print(f"validate {path}: {len(problems)} problems")
-
-
 # 1. validation
 for f in (small_fmu, ref_fmu, wire_fmu):
-    validate(f)
+    validate(f, failures)
 
 # 2. simulate with an input signal and compare with the Rust side
 H, STOP = 0.01, 0.4
@@ -164,7 +142,7 @@ if not auto_n < fixed_n:
 
 # 3. FMU state through fmpy's C calls
 vrs = [v.valueReference for v in md.modelVariables if v.causality == "output" and v.type == "Real"]
-state_round_trip("YarnBundle (small)", small_fmu, H, vrs)
+fmi2_state_round_trip("YarnBundle (small)", small_fmu, H, vrs)
 
 # 4. the default scene FMU runs in fmpy
 ref = simulate_fmu(ref_fmu, stop_time=2 / 60, output_interval=1 / 60, validate=True)
@@ -193,10 +171,10 @@ for integrator in ("backward-euler", "symplectic-euler"):
         replay_args=("--integrator", integrator),
     )
 vrs = [v.valueReference for v in md.modelVariables if v.causality == "output" and v.type == "Real"]
-state_round_trip("MassSpring (wire)", wire_fmu, HW, vrs)
+fmi2_state_round_trip("MassSpring (wire)", wire_fmu, HW, vrs)
 
 # 6. a driven yarn end from an input table
-validate(driven_fmu)
+validate(driven_fmu, failures)
 HD, STOPD = 0.01, 0.3
 n, t = time_grid(HD, STOPD)
 w = 2 * math.pi / 0.3
@@ -241,9 +219,4 @@ print(f"driven FMU: mean force on the held pin (t >= 0.1 s) {held:.4f} N/m (y), 
 if not held < 0.0:
     failures.append(f"the held pin is not pulled down ({held} N/m)")
 
-if failures:
-    print(f"FMU check FAILED ({len(failures)} problems):")
-    for f in failures[:40]:
-        print("  " + f)
-    sys.exit(1)
-print("FMU check passed")
+finish("FMU check", failures)

@@ -1,7 +1,9 @@
-"""Input tables shared by the fmpy checks (tools/fmu_check.py, tools/fmu3_check.py)."""
+"""Input tables and helpers shared by the fmpy checks (tools/fmu_check.py, tools/fmu3_check.py)."""
 import math
+import sys
 
 import numpy as np
+from fmpy.validation import validate_fmu
 
 
 def write_inputs(path, cols):
@@ -40,3 +42,46 @@ def circling_attractor(h, stop):
         ("gravity.x", 4.0 * np.sin(3.0 * t)),
         ("gravity.y", -9.8 * np.cos(3.0 * t)),
     ]
+
+
+def validate(path, failures):
+    """fmpy's validation of the FMU at `path`; its problems become failures."""
+    problems = validate_fmu(path)
+    if problems:
+        failures.append(f"{path}: fmpy validation: {problems}")
+    print(f"validate {path}: {len(problems)} problems")
+
+
+def state_round_trip(step, read, get, serialize, deserialize, set_state, h, steps=5):
+    """The FMU-state round trip of either FMI version: `steps` steps, get +
+    serialize at t1, `steps` steps on, deserialize + set, the same steps
+    again. `step(t, h)` does one communication step, `read()` gives the
+    outputs after it. Returns the serialized state, the outputs after t1
+    the first and the second time, and the two states (to free)."""
+
+    def run(t):
+        out = []
+        for _ in range(steps):
+            step(t, h)
+            t += h
+            out.append(read())
+        return t, out
+
+    t1, _ = run(0.0)
+    state = get()
+    blob = serialize(state)
+    _, first = run(t1)
+    restored = deserialize(blob)
+    set_state(restored)
+    _, second = run(t1)
+    return blob, first, second, (state, restored)
+
+
+def finish(title, failures):
+    """Prints the failures and exits non-zero if there are any, else says the check passed."""
+    if failures:
+        print(f"{title} FAILED ({len(failures)} problems):")
+        for f in failures[:40]:
+            print("  " + f)
+        sys.exit(1)
+    print(f"{title} passed")
