@@ -240,14 +240,8 @@ fn corrupt_or_truncated_state_is_rejected() {
     }
     for (what, b) in cases {
         let f = Fmu::new(&scene);
-        let (st, d) = f.deserialize(&b);
-        assert_eq!(st, fmi2Error, "{what}");
-        assert!(d.is_null(), "{what}");
-        assert!(
-            f.last_error().contains("fmi2DeSerializeFMUstate"),
-            "{what}: {:?}",
-            f.lines()
-        );
+        let func = "fmi2DeSerializeFMUstate";
+        assert_refused_state(what, f.deserialize(&b), fmi2Error, &f.last_error(), func);
     }
     // A state of a scene with another number of yarns.
     let mut two = scene.clone();

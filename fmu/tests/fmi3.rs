@@ -201,11 +201,7 @@ fn variable_dependencies_match_the_model_description() {
     // SAFETY: as above.
     let s = unsafe { fmi3GetNumberOfVariableDependencies(f.c, VR_GRAVITY_X, &mut n) };
     assert_eq!(s, fmi3Error);
-    assert!(
-        f.last_error().contains("is not an output"),
-        "{}",
-        f.last_error()
-    );
+    f.assert_error_contains("is not an output");
 }
 
 #[test]

@@ -8,6 +8,7 @@
 mod common;
 mod common3;
 
+use common::assert_refused_state;
 use common3::*;
 use YarnBundle::fmi3::common::*;
 use YarnBundle::fmi3::cosim::*;
@@ -79,15 +80,10 @@ fn illegal_call_orders_are_refused_with_the_fmi3_state_names() {
     // SAFETY: a live instance throughout.
     unsafe {
         assert_eq!(f.step(0.0, H).0, fmi3Error);
-        assert!(
-            f.last_error()
-                .contains("fmi3DoStep is not allowed in state \"Instantiated\""),
-            "{}",
-            f.last_error()
-        );
+        f.assert_error_contains("fmi3DoStep is not allowed in state \"Instantiated\"");
         // only Reset (and the state functions) leave the Error state
         assert_eq!(fmi3ExitInitializationMode(f.c), fmi3Error);
-        assert!(f.last_error().contains("\"Error\""), "{}", f.last_error());
+        f.assert_error_contains("\"Error\"");
         assert_eq!(fmi3Reset(f.c), fmi3OK);
         assert_eq!(fmi3EnterStepMode(f.c), fmi3Error);
         assert_eq!(fmi3Reset(f.c), fmi3OK);
@@ -98,12 +94,7 @@ fn illegal_call_orders_are_refused_with_the_fmi3_state_names() {
         );
         assert_eq!(f.step(0.0, H).0, fmi3Error);
         assert_eq!(f.get(&[VR_KINETIC_ENERGY], 1).0, fmi3Error);
-        assert!(
-            f.last_error()
-                .contains("fmi3GetFloat64 is not allowed in state \"Error\""),
-            "{}",
-            f.last_error()
-        );
+        f.assert_error_contains("fmi3GetFloat64 is not allowed in state \"Error\"");
         assert_eq!(fmi3Reset(f.c), fmi3OK);
         f.init();
         assert_eq!(fmi3EnterStepMode(f.c), fmi3OK);
@@ -115,11 +106,7 @@ fn illegal_call_orders_are_refused_with_the_fmi3_state_names() {
         f.init();
         assert_eq!(fmi3Terminate(f.c), fmi3OK);
         assert_eq!(f.step(0.0, H).0, fmi3Error);
-        assert!(
-            f.last_error().contains("\"Terminated\""),
-            "{}",
-            f.last_error()
-        );
+        f.assert_error_contains("\"Terminated\"");
         // the unsupported interfaces say why
         assert_eq!(fmi3Reset(f.c), fmi3OK);
         assert_eq!(fmi3EnterEventMode(f.c), fmi3Error);
@@ -227,14 +214,9 @@ fn foreign_and_truncated_states_are_refused() {
         }),
     ] {
         let before = state_bytes(&f);
-        let (st, s) = f.deserialize(&b);
-        assert_eq!(st, fmi3Error, "{what}");
-        assert!(s.is_null(), "{what}");
-        assert!(
-            f.last_error().starts_with("fmi3DeserializeFMUState"),
-            "{what}: {}",
-            f.last_error()
-        );
+        let func = "fmi3DeserializeFMUState";
+        assert_refused_state(what, f.deserialize(&b), fmi3Error, &f.last_error(), func);
+        assert!(f.last_error().starts_with(func), "{what}");
         assert_eq!(state_bytes(&f), before, "{what}");
         // SAFETY: a live instance.
         assert_eq!(unsafe { fmi3Reset(f.c) }, fmi3OK);
@@ -329,12 +311,7 @@ fn a_diverging_step_discards_with_terminate_simulation() {
     assert_eq!(phase(&f), Phase::StepFailed);
     let saved = f.get_state();
     assert_eq!(f.step(t, H).0, fmi3Error);
-    assert!(
-        f.last_error()
-            .contains("Step Mode after terminateSimulation"),
-        "{}",
-        f.last_error()
-    );
+    f.assert_error_contains("Step Mode after terminateSimulation");
     // SAFETY: a live instance and a state it made.
     unsafe {
         assert_eq!(fmi3SetFMUState(f.c, saved), fmi3OK);
@@ -363,9 +340,6 @@ fn arrays_follow_a_scene_parameter_with_other_vertex_counts() {
     assert_eq!(s, fmi3OK, "{:?}", f.lines());
     assert!(v.iter().all(|x| x.is_finite()));
     assert_eq!(f.get(&[array_vr(0, false)], 48).0, fmi3Error);
-    assert!(
-        f.last_error().contains("nValues = 48") && f.last_error().contains("have 60 values"),
-        "{}",
-        f.last_error()
-    );
+    f.assert_error_contains("nValues = 48");
+    f.assert_error_contains("have 60 values");
 }

@@ -69,6 +69,30 @@ extern "C" fn logger(
     unsafe { record(env, status, category, message) }
 }
 
+/// Asserts that `what` is in `last_error` (the whole log `lines` in the
+/// panic message otherwise): both versions' `assert_error_contains`.
+pub fn assert_in_last_error(last_error: &str, what: &str, lines: &[Line]) {
+    assert!(
+        last_error.contains(what),
+        "{what:?} not in the last error; log {lines:?}"
+    );
+}
+
+/// Asserts that a deserialization (`what`: the bytes it was given) was
+/// refused: the version's `error` status, no state, `func` in the last
+/// error.
+pub fn assert_refused_state(
+    what: &str,
+    (status, state): (c_int, *mut c_void),
+    error: c_int,
+    last_error: &str,
+    func: &str,
+) {
+    assert_eq!(status, error, "{what}");
+    assert!(state.is_null(), "{what}");
+    assert!(last_error.contains(func), "{what}: {last_error}");
+}
+
 /// The message of the last line logged with a status of at least `discard`
 /// (the Discard status of either FMI version), or "".
 pub fn last_error_in(lines: &[Line], discard: c_int) -> String {
@@ -201,12 +225,7 @@ impl Fmu {
     /// Asserts that the last error logged contains `what` (the whole log
     /// in the panic message otherwise).
     pub fn assert_error_contains(&self, what: &str) {
-        let e = self.last_error();
-        assert!(
-            e.contains(what),
-            "{what:?} not in the last error; log {:?}",
-            self.lines()
-        );
+        assert_in_last_error(&self.last_error(), what, &self.lines());
     }
 
     pub fn setup(&self, start: f64, stop: Option<f64>) -> fmi2Status {

@@ -92,6 +92,11 @@ impl Fmu3 {
         crate::common::last_error_in(&self.lines(), fmi3Discard)
     }
 
+    /// Asserts that the last error logged contains `what`.
+    pub fn assert_error_contains(&self, what: &str) {
+        crate::common::assert_in_last_error(&self.last_error(), what, &self.lines());
+    }
+
     /// Enter (start 0, no stop time) and exit initialization mode.
     pub fn init(&self) {
         // SAFETY: `self.c` is a live instance.
