@@ -68,3 +68,16 @@ pub mod yarn;
 
 pub use models::{new_model, scene_from_toml_str, SceneFmu};
 pub use yarn::variables::{guid, model_description, MODEL_IDENTIFIER};
+
+/// The exit code of a command-line tool of the FMU crates (`fmu-replay`,
+/// and `build-fmu` in yarnsim-fmu-pack): success, or failure with the error
+/// printed after the tool's name.
+pub fn tool_exit(tool: &str, result: Result<(), String>) -> std::process::ExitCode {
+    match result {
+        Ok(()) => std::process::ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("{tool}: {e}");
+            std::process::ExitCode::FAILURE
+        }
+    }
+}

@@ -165,11 +165,5 @@ fn build_cdylib(exe_dir: &std::path::Path) -> Result<(), String> {
 }
 
 fn main() -> ExitCode {
-    match run() {
-        Ok(()) => ExitCode::SUCCESS,
-        Err(e) => {
-            eprintln!("build-fmu: {e}");
-            ExitCode::FAILURE
-        }
-    }
+    YarnBundle::tool_exit("build-fmu", run())
 }

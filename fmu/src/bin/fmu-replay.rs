@@ -308,11 +308,5 @@ fn replay_mass_spring(
 }
 
 fn main() -> ExitCode {
-    match run() {
-        Ok(()) => ExitCode::SUCCESS,
-        Err(e) => {
-            eprintln!("fmu-replay: {e}");
-            ExitCode::FAILURE
-        }
-    }
+    YarnBundle::tool_exit("fmu-replay", run())
 }
