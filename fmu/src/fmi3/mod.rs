@@ -36,16 +36,12 @@ pub type fmi3Instance = *mut c_void;
 pub type fmi3InstanceEnvironment = *mut c_void;
 pub type fmi3FMUState = *mut c_void;
 pub type fmi3ValueReference = u32;
-pub type fmi3Float32 = f32;
 pub type fmi3Float64 = f64;
-pub type fmi3Int8 = i8;
-pub type fmi3UInt8 = u8;
-pub type fmi3Int16 = i16;
-pub type fmi3UInt16 = u16;
 pub type fmi3Int32 = i32;
-pub type fmi3UInt32 = u32;
-pub type fmi3Int64 = i64;
-pub type fmi3UInt64 = u64;
+/// The other integer types and Float32: [`unsupported`] (no variables).
+pub use unsupported::{
+    fmi3Float32, fmi3Int16, fmi3Int64, fmi3Int8, fmi3UInt16, fmi3UInt32, fmi3UInt64, fmi3UInt8,
+};
 /// A C `bool` (one byte), unlike `fmi2Boolean` (a C `int`).
 pub type fmi3Boolean = bool;
 pub type fmi3Char = c_char;

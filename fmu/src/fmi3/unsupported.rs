@@ -56,10 +56,13 @@ macro_rules! no_variable {
     )*};
 }
 
-/// Exports the getter and setter of each type without variables:
-/// `(getter, setter, type name, element type);`.
+/// Declares each type without variables (its `fmi3FunctionTypes.h` name)
+/// and exports its getter and setter: `(getter, setter, type name, C type
+/// = Rust type);`.
 macro_rules! no_such_type {
-    ($(($get:ident, $set:ident, $tyname:literal, $elem:ty);)*) => {$(
+    ($(($get:ident, $set:ident, $tyname:literal, $elem:ident = $rust:ty);)*) => {$(
+        #[doc = concat!("`", stringify!($elem), "` (no variable of this type).")]
+        pub type $elem = $rust;
         no_variable! {
             $get(_values: *mut $elem, _nValues: size_t) "fmi2GetReal" => $tyname;
             $set(_values: *const $elem, _nValues: size_t) "fmi2SetReal" => $tyname;
@@ -68,14 +71,14 @@ macro_rules! no_such_type {
 }
 
 no_such_type! {
-    (fmi3GetFloat32, fmi3SetFloat32, "Float32", fmi3Float32);
-    (fmi3GetInt8, fmi3SetInt8, "Int8", fmi3Int8);
-    (fmi3GetUInt8, fmi3SetUInt8, "UInt8", fmi3UInt8);
-    (fmi3GetInt16, fmi3SetInt16, "Int16", fmi3Int16);
-    (fmi3GetUInt16, fmi3SetUInt16, "UInt16", fmi3UInt16);
-    (fmi3GetUInt32, fmi3SetUInt32, "UInt32", fmi3UInt32);
-    (fmi3GetInt64, fmi3SetInt64, "Int64", fmi3Int64);
-    (fmi3GetUInt64, fmi3SetUInt64, "UInt64", fmi3UInt64);
+    (fmi3GetFloat32, fmi3SetFloat32, "Float32", fmi3Float32 = f32);
+    (fmi3GetInt8, fmi3SetInt8, "Int8", fmi3Int8 = i8);
+    (fmi3GetUInt8, fmi3SetUInt8, "UInt8", fmi3UInt8 = u8);
+    (fmi3GetInt16, fmi3SetInt16, "Int16", fmi3Int16 = i16);
+    (fmi3GetUInt16, fmi3SetUInt16, "UInt16", fmi3UInt16 = u16);
+    (fmi3GetUInt32, fmi3SetUInt32, "UInt32", fmi3UInt32 = u32);
+    (fmi3GetInt64, fmi3SetInt64, "Int64", fmi3Int64 = i64);
+    (fmi3GetUInt64, fmi3SetUInt64, "UInt64", fmi3UInt64 = u64);
 }
 
 no_variable! {
