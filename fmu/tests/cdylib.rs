@@ -10,15 +10,6 @@ use common::*;
 use YarnBundle::ffi::*;
 use YarnBundle::yarn::variables::*;
 
-type Instantiate = unsafe extern "C" fn(
-    fmi2String,
-    fmi2Type,
-    fmi2String,
-    fmi2String,
-    *const fmi2CallbackFunctions,
-    fmi2Boolean,
-    fmi2Boolean,
-) -> fmi2Component;
 type Setup = unsafe extern "C" fn(fmi2Component, c_int, f64, f64, c_int, f64) -> fmi2Status;
 type Unary = unsafe extern "C" fn(fmi2Component) -> fmi2Status;
 type Free = unsafe extern "C" fn(fmi2Component);
@@ -85,15 +76,7 @@ fn shared_library_loads_and_runs_like_the_rlib() {
         let name = CString::new("dl").unwrap();
         let g = CString::new(guid(&scene)).unwrap();
         let uri = CString::new(format!("file://{}", dir.display())).unwrap();
-        let c = instantiate(
-            name.as_ptr(),
-            fmi2CoSimulation,
-            g.as_ptr(),
-            uri.as_ptr(),
-            &cb,
-            0,
-            0,
-        );
+        let c = instantiate_with(instantiate, (&name, fmi2CoSimulation, &g, &uri), &cb);
         assert!(!c.is_null());
         assert_eq!(setup(c, 0, 0.0, 0.0, 0, 0.0), fmi2OK);
         assert_eq!(enter(c), fmi2OK);

@@ -415,37 +415,17 @@ fn guid_mismatch_and_bad_arguments_fail_instantiation() {
             stepFinished: None,
             componentEnvironment: std::ptr::null_mut(),
         };
-        let c = fmi2Instantiate(
-            n.as_ptr(),
-            fmi2ModelExchange,
-            g.as_ptr(),
-            uri.as_ptr(),
-            &cb,
-            0,
-            0,
-        );
+        let c = instantiate_with(fmi2Instantiate, (&n, fmi2ModelExchange, &g, &uri), &cb);
         assert!(c.is_null());
-        let c = fmi2Instantiate(
-            n.as_ptr(),
-            fmi2CoSimulation,
-            g.as_ptr(),
-            uri.as_ptr(),
+        let c = instantiate_with(
+            fmi2Instantiate,
+            (&n, fmi2CoSimulation, &g, &uri),
             std::ptr::null(),
-            0,
-            0,
         );
         assert!(c.is_null());
         // Without a logger it still works; file:/ and %-escaped URIs too.
         let uri2 = CString::new(format!("file:{}", dir.display())).unwrap();
-        let c = fmi2Instantiate(
-            n.as_ptr(),
-            fmi2CoSimulation,
-            g.as_ptr(),
-            uri2.as_ptr(),
-            &cb,
-            0,
-            0,
-        );
+        let c = instantiate_with(fmi2Instantiate, (&n, fmi2CoSimulation, &g, &uri2), &cb);
         assert!(!c.is_null());
         fmi2FreeInstance(c);
         let spaced = std::env::temp_dir().join(format!("yarn bundle {}", std::process::id()));
@@ -453,15 +433,7 @@ fn guid_mismatch_and_bad_arguments_fail_instantiation() {
         std::fs::write(spaced.join(SCENE_FILE), scene.to_toml_string()).unwrap();
         let uri3 =
             CString::new(format!("file://{}", spaced.display()).replace(' ', "%20")).unwrap();
-        let c = fmi2Instantiate(
-            n.as_ptr(),
-            fmi2CoSimulation,
-            g.as_ptr(),
-            uri3.as_ptr(),
-            &cb,
-            0,
-            0,
-        );
+        let c = instantiate_with(fmi2Instantiate, (&n, fmi2CoSimulation, &g, &uri3), &cb);
         assert!(!c.is_null());
         fmi2FreeInstance(c);
         std::fs::remove_dir_all(spaced).unwrap();

@@ -69,6 +69,41 @@ extern "C" fn logger(
     unsafe { record(env, status, category, message) }
 }
 
+/// `fmi2Instantiate` or a pointer to it (as `dlsym` gives it).
+pub type Instantiate = unsafe extern "C" fn(
+    fmi2String,
+    fmi2Type,
+    fmi2String,
+    fmi2String,
+    *const fmi2CallbackFunctions,
+    fmi2Boolean,
+    fmi2Boolean,
+) -> fmi2Component;
+
+/// A new instance of `fmu_type` through `instantiate`, not visible and
+/// with logging off.
+///
+/// # Safety
+/// `cb` is null or points to callbacks valid for the instance's life.
+pub unsafe fn instantiate_with(
+    instantiate: Instantiate,
+    (name, fmu_type, guid, uri): (&CStr, fmi2Type, &CStr, &CStr),
+    cb: *const fmi2CallbackFunctions,
+) -> fmi2Component {
+    // SAFETY: live NUL-terminated strings; `cb` as the caller's contract.
+    unsafe {
+        instantiate(
+            name.as_ptr(),
+            fmu_type,
+            guid.as_ptr(),
+            uri.as_ptr(),
+            cb,
+            fmi2False,
+            fmi2False,
+        )
+    }
+}
+
 /// Asserts that `what` is in `last_error` (the whole log `lines` in the
 /// panic message otherwise): both versions' `assert_error_contains`.
 pub fn assert_in_last_error(last_error: &str, what: &str, lines: &[Line]) {
@@ -192,15 +227,7 @@ impl Fmu {
         // SAFETY: the strings are live `CString`s and `cb` outlives the call; `log`, the logger's
         // environment, is boxed and lives as long as the instance (both are owned by the `Fmu`).
         let c = unsafe {
-            fmi2Instantiate(
-                name.as_ptr(),
-                fmi2CoSimulation,
-                guid.as_ptr(),
-                uri.as_ptr(),
-                &cb,
-                fmi2False,
-                fmi2False,
-            )
+            instantiate_with(fmi2Instantiate, (&name, fmi2CoSimulation, &guid, &uri), &cb)
         };
         if c.is_null() {
             let _ = std::fs::remove_dir_all(&dir);
