@@ -8,33 +8,28 @@ use serde::{Deserialize, Deserializer};
 /// A finite `f64`.
 pub(crate) fn finite<'de, D: Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
     let v = f64::deserialize(d)?;
-    if v.is_finite() {
+    accept(v, v.is_finite(), "a finite number")
+}
+
+/// `v` where `ok`, else the readers' error `must be {what}, got {v}`.
+fn accept<E: serde::de::Error>(v: f64, ok: bool, what: &str) -> Result<f64, E> {
+    if ok {
         Ok(v)
     } else {
-        Err(D::Error::custom(format!(
-            "must be a finite number, got {v}"
-        )))
+        Err(E::custom(format!("must be {what}, got {v}")))
     }
 }
 
 /// A finite `f64 > 0`.
 pub(crate) fn positive<'de, D: Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
     let v = finite(d)?;
-    if v > 0.0 {
-        Ok(v)
-    } else {
-        Err(D::Error::custom(format!("must be > 0, got {v}")))
-    }
+    accept(v, v > 0.0, "> 0")
 }
 
 /// A finite `f64 >= 0`.
 pub(crate) fn nonnegative<'de, D: Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
     let v = finite(d)?;
-    if v >= 0.0 {
-        Ok(v)
-    } else {
-        Err(D::Error::custom(format!("must be >= 0, got {v}")))
-    }
+    accept(v, v >= 0.0, ">= 0")
 }
 
 /// An optional field that, when present, is a finite `f64 > 0`.
@@ -78,24 +73,14 @@ pub(crate) fn bounded_u32<'de, D: Deserializer<'de>>(
 /// A finite number in the closed interval `[0, 1]`.
 pub(crate) fn unit_interval_closed<'de, D: Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
     let v = finite(d)?;
-    if (0.0..=1.0).contains(&v) {
-        Ok(v)
-    } else {
-        Err(D::Error::custom(format!(
-            "must be between 0 and 1, got {v}"
-        )))
-    }
+    accept(v, (0.0..=1.0).contains(&v), "between 0 and 1")
 }
 
 /// A finite number in the half-open interval `(0, 1]`: a fraction that may
 /// not be zero.
 pub(crate) fn unit_interval_open_low<'de, D: Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
     let v = finite(d)?;
-    if v > 0.0 && v <= 1.0 {
-        Ok(v)
-    } else {
-        Err(D::Error::custom(format!("must be in (0, 1], got {v}")))
-    }
+    accept(v, v > 0.0 && v <= 1.0, "in (0, 1]")
 }
 
 /// An optional field that, when present, is a finite `f64`.
