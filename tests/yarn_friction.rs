@@ -20,7 +20,7 @@
 
 mod common;
 
-use common::scene;
+use common::{on_threads, scene};
 use yarnsim::scene::TransferScheme;
 use yarnsim::YarnSim;
 
@@ -216,11 +216,7 @@ fn two_fields_are_bit_identical_for_one_and_two_threads_and_the_pin_carries_the_
     let t_end = if cfg!(debug_assertions) { 0.005 } else { 0.1 };
     let theta = 0.1_f64.atan();
     let run = |threads: usize| {
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .unwrap();
-        pool.install(|| {
+        on_threads(threads, || {
             let mut sim = incline(theta, 0.2, TransferScheme::Flip);
             assert!(sim.has_two_fields());
             sim.advance(t_end).unwrap();
