@@ -182,7 +182,7 @@ impl Fields {
 fn contact_normal(gf: Vec2, gh: Vec2) -> Option<Vec2> {
     let d = gf - gh;
     let s = gh.dot(&d);
-    let n = if s != 0.0 { gh * -s.signum() } else { d };
+    let n = if s != 0.0 { gh * s.signum() } else { d };
     let norm = n.norm();
     (norm > 0.0).then(|| n / norm)
 }
