@@ -15,11 +15,11 @@
 //! interact through it and the return mapping, as before.
 //!
 //! The contact at a node with masses `m_f`, `m_h` and velocities `v_f`,
-//! `v_h` after the grid update and the pin constraint: the normal from the
-//! held to the free field is `n = (grad m_f - grad m_h) / |...|` (central
-//! differences of the node masses; at the nodes shared by two thin yarns the
-//! gradient of either field alone can point the wrong way, their difference
-//! does not); if the fields approach, `u = v_f - v_h` with `u . n < 0`, the
+//! `v_h` after the grid update and the pin constraint: the normal `n` from
+//! the held to the free field is along the held field's mass gradient,
+//! oriented by the difference of the two fields' gradients
+//! ([`contact_normal`]; central differences of the node masses); if the
+//! fields approach, `u = v_f - v_h` with `u . n < 0`, the
 //! relative velocity becomes `u' = coulomb(u, n, mu)`
 //! ([`super::contact::coulomb`]: no approach, tangential part reduced by
 //! `mu` times the normal change, or stopped), shared about the centre of
@@ -179,7 +179,7 @@ impl Fields {
 /// perpendicular to it (a node on the held yarn's centre line). `None`
 /// where both vanish.
 #[inline]
-fn contact_normal(gf: Vec2, gh: Vec2) -> Option<Vec2> {
+pub fn contact_normal(gf: Vec2, gh: Vec2) -> Option<Vec2> {
     let d = gf - gh;
     let s = gh.dot(&d);
     let n = if s != 0.0 { gh * s.signum() } else { d };
@@ -216,5 +216,48 @@ fn node_masses(grid: &Grid, out: &mut Vec<f64>) {
             }
             out[idx] = m;
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A free yarn one cell above a held one (centres at 1.2 and 2.2 cells,
+    /// quadratic B-spline masses): at both shared nodes, and at the free
+    /// yarn's end (its gradient along the yarn), the normal points up, from
+    /// the held yarn to the free one.
+    #[test]
+    fn the_normal_points_from_the_held_yarn_to_the_free_one() {
+        let w = |d: f64| {
+            let d = d.abs();
+            if d < 0.5 {
+                0.75 - d * d
+            } else if d < 1.5 {
+                0.5 * (1.5 - d) * (1.5 - d)
+            } else {
+                0.0
+            }
+        };
+        let grad_y = |centre: f64, j: f64| w(j + 1.0 - centre) - w(j - 1.0 - centre);
+        for j in [1.0, 2.0] {
+            let gh = Vec2::new(0.0, grad_y(1.2, j));
+            let gf = Vec2::new(0.0, grad_y(2.2, j));
+            assert_eq!(
+                contact_normal(gf, gh),
+                Some(Vec2::new(0.0, 1.0)),
+                "node {j}"
+            );
+            let end = Vec2::new(-0.5, gf.y);
+            assert_eq!(
+                contact_normal(end, gh),
+                Some(Vec2::new(0.0, 1.0)),
+                "end, node {j}"
+            );
+        }
+        // a held yarn without gradient there: the difference
+        let n = contact_normal(Vec2::new(0.0, 2.0), Vec2::zeros()).unwrap();
+        assert_eq!(n, Vec2::new(0.0, 1.0));
+        assert_eq!(contact_normal(Vec2::zeros(), Vec2::zeros()), None);
     }
 }
