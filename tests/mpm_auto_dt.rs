@@ -5,7 +5,7 @@
 
 mod common;
 
-use common::{bundle, SceneBuilder};
+use common::{bundle, on_threads, SceneBuilder};
 use yarnsim::mpm::Stepping;
 use yarnsim::scene::{builtin, Scene, SceneError, StepSize, WallMode, YarnScene, DEFAULT_SAFETY};
 use yarnsim::YarnSim;
@@ -138,11 +138,7 @@ fn dt_max_caps_the_substep() {
 fn bit_identical_for_one_and_two_threads() {
     let t_end = if cfg!(debug_assertions) { 0.01 } else { 0.1 };
     let run = |threads: usize| {
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .unwrap();
-        pool.install(|| {
+        on_threads(threads, || {
             let mut sim = YarnSim::new(&small()).unwrap();
             sim.advance_to(t_end).unwrap();
             (sim.save_state(), sim.dt_stats())

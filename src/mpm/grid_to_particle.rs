@@ -181,9 +181,21 @@ fn transfer<const FLIP: bool>(
     (vn, cn)
 }
 
+/// The grid particle `i` gathers from: `held`'s when it names the particle.
+#[inline(always)]
+fn field_of<'a>(grid: &'a Grid, held: Option<(&'a Grid, &'a [bool])>, i: usize) -> &'a Grid {
+    match held {
+        Some((h, mask)) if mask[i] => h,
+        _ => grid,
+    }
+}
+
 /// What the vertex gather reads.
 pub struct VertexGather<'a> {
     pub grid: &'a Grid,
+    /// With two fields: the held field's grid and which vertices it holds
+    /// (they gather from it, the others from `grid`).
+    pub held: Option<(&'a Grid, &'a [bool])>,
     pub dt: f64,
     pub obstacles: &'a [Obstacle],
     pub transfer: Transfer,
@@ -214,10 +226,11 @@ pub fn gather_vertices(
         .into_par_iter()
         .enumerate()
         .filter_map(|(k, (x, v, c, st, sp))| {
+            let base = k * PAR_MIN;
             let bad = if g.transfer.needs_delta() {
-                gather_vertex_chunk::<true>(x, v, c, st, sp, g)
+                gather_vertex_chunk::<true>(base, x, v, c, st, sp, g)
             } else {
-                gather_vertex_chunk::<false>(x, v, c, st, sp, g)
+                gather_vertex_chunk::<false>(base, x, v, c, st, sp, g)
             };
             bad.map(|b| BadVertex {
                 index: k * PAR_MIN + b.index,
@@ -229,8 +242,9 @@ pub fn gather_vertices(
 
 multiversion! {
     /// [`gather_vertices`] on one chunk; returns the first bad vertex in it
-    /// (index within the chunk).
+    /// (index within the chunk); `base` is the chunk's first vertex.
     fn gather_vertex_chunk<const FLIP: bool>(
+        base: usize,
         xs: &mut [Vec2],
         vs: &mut [Vec2],
         cs: &mut [Mat2],
@@ -245,7 +259,8 @@ multiversion! {
         let mut bad = None;
         let it = xs.iter_mut().zip(vs).zip(cs).zip(sts).zip(spins);
         for (k, ((((x, v), c), st), spin)) in it.enumerate() {
-            let (nv, _) = transfer::<FLIP>(g.grid, st, ratio, avx, v, c);
+            let grid = field_of(g.grid, g.held, base + k);
+            let (nv, _) = transfer::<FLIP>(grid, st, ratio, avx, v, c);
             *x += nv * dt;
             if FLIP {
                 // the moment this move gives the particle's momentum (zero
@@ -280,11 +295,14 @@ multiversion! {
 /// vertices, `d2 += dt grad(v_grid) d2` and the return mapping (when
 /// `plastic`); then, for the next step, the particle's stencil and its
 /// stress from the new frame. Returns the first quadrature particle with a
-/// non-finite frame or velocity, if any.
+/// non-finite frame or velocity, if any. With `held`, the particles it names
+/// gather from its grid.
+#[allow(clippy::too_many_arguments)]
 pub fn gather_quads(
     quad: &mut Quads,
     vx: &[Vec2],
     grid: &Grid,
+    held: Option<(&Grid, &[bool])>,
     dt: f64,
     energy: &YarnEnergy,
     plastic: bool,
@@ -299,6 +317,7 @@ pub fn gather_quads(
         energy,
         plastic,
         ratio: transfer.flip_ratio(),
+        held,
     };
     let flip = transfer.needs_delta();
     (
@@ -359,6 +378,7 @@ struct QuadRest<'a> {
     energy: &'a YarnEnergy,
     plastic: bool,
     ratio: f64,
+    held: Option<(&'a Grid, &'a [bool])>,
 }
 
 multiversion! {
@@ -378,7 +398,8 @@ multiversion! {
         // transfer, position and d1 from the vertices, d2 advected
         for k in 0..n {
             let g = base + k;
-            let (_, nc) = transfer::<FLIP>(grid, &q.stencil[k], rest.ratio, avx, &mut q.v[k], &mut q.c[k]);
+            let field = field_of(grid, rest.held, g);
+            let (_, nc) = transfer::<FLIP>(field, &q.stencil[k], rest.ratio, avx, &mut q.v[k], &mut q.c[k]);
             let left = rest.left[g] as usize;
             let (xl, xr) = (rest.vx[left], rest.vx[left + 1]);
             let x = (xl + xr) * 0.5;

@@ -11,6 +11,7 @@
 //! * [`particle_to_grid`]: pass 1, P2G of mass, momentum and force impulses.
 //! * [`grid_update`]: pass 2, velocities, gravity, attractor, contact, walls.
 //! * [`contact`]: the obstacle (Coulomb), wall and grid-edge laws.
+//! * [`fields`]: the held and free velocity fields and their Coulomb contact.
 //! * [`grid_to_particle`]: passes 3 and 4, G2P of vertices and quadrature particles.
 //! * [`frames`]: the quadrature particles' QR, return mapping and stress,
 //!   over a batch (vectorized across particles).
@@ -27,6 +28,7 @@ pub mod bending;
 pub mod constitutive;
 pub mod contact;
 pub mod error;
+pub mod fields;
 pub mod frames;
 pub mod grid;
 pub mod grid_to_particle;

@@ -101,7 +101,16 @@ struct ScatterCtx<'a> {
     dt: f64,
     bending: f64,
     obstacles: &'a [Obstacle],
+    /// Which vertices and quadrature particles scatter into the held field
+    /// (empty with one field).
+    vert_held: &'a [bool],
+    quad_held: &'a [bool],
 }
+
+/// The held field of a two-field scene as the scatter fills it: its grid
+/// and which vertices and quadrature particles belong to it
+/// ([`super::fields`]).
+pub type HeldTarget<'a> = (&'a mut Grid, &'a [bool], &'a [bool]);
 
 /// Splits `v` into the scatter's chunks of `n` items.
 fn split_chunks<T>(v: &mut [T], n: usize) -> Vec<&mut [T]> {
@@ -122,6 +131,19 @@ fn split_chunks<T>(v: &mut [T], n: usize) -> Vec<&mut [T]> {
 /// alone too (in lanes that only FLIP reads); `obstacles` are the ones
 /// whose contact mass is marked.
 pub fn scatter(p: &mut Particles, grid: &mut Grid, dt: f64, bending: f64, obstacles: &[Obstacle]) {
+    scatter_fields(p, grid, None, dt, bending, obstacles)
+}
+
+/// [`scatter`] with two fields: the particles `held` names go into its
+/// grid instead (same window, same chunks).
+pub fn scatter_fields(
+    p: &mut Particles,
+    grid: &mut Grid,
+    held: Option<HeldTarget>,
+    dt: f64,
+    bending: f64,
+    obstacles: &[Obstacle],
+) {
     // a window that holds every stencil
     let inv_dx = grid.geom.inv_dx;
     let mut bounds = StencilBounds::default();
@@ -131,6 +153,13 @@ pub fn scatter(p: &mut Particles, grid: &mut Grid, dt: f64, bending: f64, obstac
     }
     grid.fit_window(&bounds);
     let geom = grid.geom;
+    let (mut held_grid, vert_held, quad_held) = match held {
+        Some((g, v, q)) => {
+            g.fit_window(&bounds);
+            (Some(g), v, q)
+        }
+        None => (None, &[][..], &[][..]),
+    };
     let (nv, nq) = (p.vert.x.len(), p.quad.x.len());
     // Each chunk writes the stencils and forces of its own vertex range
     // (taken out of `p.vert` meanwhile, so the rest of it can be shared).
@@ -145,26 +174,58 @@ pub fn scatter(p: &mut Particles, grid: &mut Grid, dt: f64, bending: f64, obstac
         dt,
         bending,
         obstacles,
+        vert_held,
+        quad_held,
+    };
+    let mut held_bufs: Vec<Option<&mut ScatterBuffer>> = match held_grid.as_deref_mut() {
+        Some(g) => g.buffers.iter_mut().map(Some).collect(),
+        None => (0..CHUNKS).map(|_| None).collect(),
     };
     grid.buffers
         .par_iter_mut()
+        .zip(held_bufs.par_iter_mut())
         .zip(stencils)
         .zip(forces)
         .enumerate()
-        .for_each(|(k, ((buf, sts), fs))| {
+        .for_each(|(k, (((buf, held), sts), fs))| {
             let (vr, qr) = (chunk_range(nv, k), chunk_range(nq, k));
-            scatter_chunk(buf, sts, fs, vr, qr, &ctx)
+            let bufs = ChunkBuffers {
+                free: buf,
+                held: held.as_deref_mut(),
+            };
+            scatter_chunk(bufs, sts, fs, vr, qr, &ctx)
         });
     p.vert.stencil = vert_stencils;
     p.vert.f = vert_forces;
     grid.collect_active();
+    if let Some(g) = held_grid {
+        g.collect_active();
+    }
+}
+
+/// One chunk's scatter buffers: the (only, or free) field's and, with two
+/// fields, the held field's.
+struct ChunkBuffers<'a> {
+    free: &'a mut ScatterBuffer,
+    held: Option<&'a mut ScatterBuffer>,
+}
+
+impl ChunkBuffers<'_> {
+    /// The buffer of a particle: the held field's when `held` and there is one.
+    #[inline(always)]
+    fn of(&mut self, held: bool) -> &mut ScatterBuffer {
+        match &mut self.held {
+            Some(h) if held => h,
+            _ => &mut *self.free,
+        }
+    }
 }
 
 multiversion! {
     /// Scatters vertices `vr` (writing their stencils to `sts` and forces to
     /// `fs`) and quadrature particles `qr` into one chunk's buffer.
     fn scatter_chunk(
-        buf: &mut ScatterBuffer,
+        bufs: ChunkBuffers,
         sts: &mut [Stencil],
         fs: &mut [Vec2],
         vr: std::ops::Range<usize>,
@@ -176,29 +237,35 @@ multiversion! {
         let margin = super::particle_to_grid::CONTACT_CELLS * dx;
         // the normal force per unit of (w_i (x_i - x_p) / dx . d2): -dt dE/dd2 4 / dx
         let normal_scale = -dt * 4.0 * geom.inv_dx;
-        buf.clear();
+        let mut bufs = bufs;
+        bufs.free.clear();
+        if let Some(h) = &mut bufs.held {
+            h.clear();
+        }
+        let two = bufs.held.is_some();
+        let (v0, q0) = (vr.start, qr.start);
         vertex_forces(vert, &quad.t1, ctx.bending, vr.clone(), fs);
         let (vx, vm) = (&vert.x[vr.clone()], &vert.m[vr.clone()]);
         let (vv, vc) = (&vert.v[vr.clone()], &vert.c[vr]);
         let it = sts.iter_mut().zip(fs.iter()).zip(vx).zip(vm).zip(vv).zip(vc);
-        for (((((st, f), &x), &m), &v), &c) in it {
+        for (k, (((((st, f), &x), &m), &v), &c)) in it.enumerate() {
             *st = Stencil::new(x, geom.inv_dx);
             let f0 = f * dt;
             let mc = contact_mass(ctx.obstacles, margin, x, m);
             let a = c * (m * dx);
             let s = Splat::new(m, mc, v * m + f0, a, f0, Mat2::zeros());
-            splat(buf, geom, st, &s);
+            splat(bufs.of(two && ctx.vert_held[v0 + k]), geom, st, &s);
         }
         let (qm, qd, qt2) = (&quad.m[qr.clone()], &quad.d[qr.clone()], &quad.t2[qr.clone()]);
         let (qx, qc, qv) = (&quad.x[qr.clone()], &quad.c[qr.clone()], &quad.v[qr.clone()]);
         let it = qm.iter().zip(qd).zip(qt2).zip(qx).zip(qc).zip(qv).zip(&quad.stencil[qr]);
-        for ((((((&m, d), &t2), &x), &c), &v), st) in it {
+        for (k, ((((((&m, d), &t2), &x), &c), &v), st)) in it.enumerate() {
             let d2 = d.column(1).into_owned();
             let af = t2 * normal_scale * d2.transpose();
             let mc = contact_mass(ctx.obstacles, margin, x, m);
             let a = c * (m * dx) + af;
             let s = Splat::new(m, mc, v * m, a, Vec2::zeros(), af);
-            splat(buf, geom, st, &s);
+            splat(bufs.of(two && ctx.quad_held[q0 + k]), geom, st, &s);
         }
     }
 }

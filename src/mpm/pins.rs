@@ -244,6 +244,19 @@ pub fn constrain_grid(
     }
 }
 
+/// Marks in `out` (one entry per node of the window) the nodes of every
+/// pinned vertex's stencil that carry weight: `1 + pin` (the last pin in
+/// `entries` order where stencils of two pins share a node).
+pub fn mark_stencil_nodes(entries: &[PinEntry], out: &mut [u32]) {
+    for e in entries {
+        for n in 0..9 {
+            if e.w[n] > 0.0 {
+                out[e.idx[n]] = e.pin as u32 + 1;
+            }
+        }
+    }
+}
+
 /// Puts `pin`'s vertices at their targets at time `t` (position, velocity
 /// and the prescribed velocity gradient as their affine matrix: a FLIP
 /// vertex would otherwise keep adding the grid's change of `C` to a `C`

@@ -40,6 +40,16 @@ pub fn momentum_scale(sim: &YarnSim) -> f64 {
         .sum()
 }
 
+/// Runs `f` on a rayon pool of `threads` threads (for the bit-identity
+/// checks across thread counts).
+pub fn on_threads<R: Send>(threads: usize, f: impl FnOnce() -> R + Send) -> R {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .unwrap()
+        .install(f)
+}
+
 /// A yarn scene from TOML text; panics with the loader's message on error.
 pub fn scene(text: &str) -> YarnScene {
     YarnScene::from_toml_str(text).unwrap_or_else(|e| panic!("{e}"))

@@ -4,6 +4,7 @@ use std::time::Instant;
 
 use super::constitutive::YarnEnergy;
 pub use super::error::SimError;
+use super::fields::Fields;
 use super::grid::{Grid, GridGeom};
 use super::grid_to_particle::{self, VertexGather};
 use super::grid_update::{self, GridForces};
@@ -60,6 +61,9 @@ pub struct YarnSim {
     pin_reactions: Vec<Vec2>,
     /// Whether each vertex is held by a pin.
     pinned: Vec<bool>,
+    /// The held field, when the scene has both held and free yarns
+    /// ([`super::fields`]); `None`: one field for all.
+    fields: Option<Fields>,
 }
 
 /// The transfer scheme a scene asks for.
@@ -97,13 +101,25 @@ impl YarnSim {
                 pinned[i] = true;
             }
         }
+        let mut held_yarn = vec![false; particles.num_yarns()];
+        for pin in &pins {
+            held_yarn[pin.yarn] = true;
+        }
+        let grid = Grid::new(geom);
+        let fields = Fields::of_yarns(
+            &held_yarn,
+            &particles.yarn_vertices,
+            &particles.quad.left,
+            &grid,
+        );
         let mut sim = YarnSim {
             pinned,
+            fields,
             transfer: transfer_of(&scene.transfer),
             pin_reactions: vec![Vec2::zeros(); pins.len()],
             pins,
             particles,
-            grid: Grid::new(geom),
+            grid,
             energy: YarnEnergy::from_material(&scene.material),
             dt: scene.time.dt.fixed().unwrap_or(0.0),
             stepping: stepping_of(scene),
@@ -196,7 +212,12 @@ impl YarnSim {
     /// Bytes the grid holds now: its window of nodes and the scatter
     /// buffers (they follow the particles' bounding box, not the domain).
     pub fn grid_memory_bytes(&self) -> usize {
-        self.grid.memory_bytes()
+        self.grid.memory_bytes() + self.fields.as_ref().map_or(0, |f| f.grid.memory_bytes())
+    }
+    /// Whether held and free yarns move in velocity fields of their own
+    /// ([`super::fields`]): the scene has both.
+    pub fn has_two_fields(&self) -> bool {
+        self.fields.is_some()
     }
     /// Number of blocks (8x8 nodes) the last substep touched.
     pub fn active_blocks(&self) -> usize {
@@ -480,7 +501,18 @@ impl YarnSim {
             self.frames_stale = false;
         }
         let t1 = Instant::now();
-        particle_to_grid::scatter(&mut self.particles, &mut self.grid, dt, bending, obstacles);
+        let held = self
+            .fields
+            .as_mut()
+            .map(|f| (&mut f.grid, &f.vert_held[..], &f.quad_held[..]));
+        particle_to_grid::scatter_fields(
+            &mut self.particles,
+            &mut self.grid,
+            held,
+            dt,
+            bending,
+            obstacles,
+        );
         let t2 = Instant::now();
         let ext = GridForces {
             gravity: self.gravity,
@@ -494,21 +526,41 @@ impl YarnSim {
         let pin_entries = if self.pins.is_empty() {
             Vec::new()
         } else {
-            pins::stencil_masses(&self.pins, &self.particles.vert, &self.grid, self.time + dt)
+            let held = self.fields.as_ref().map_or(&self.grid, |f| &f.grid);
+            pins::stencil_masses(&self.pins, &self.particles.vert, held, self.time + dt)
         };
+        if let Some(f) = &mut self.fields {
+            f.record_masses(&self.grid);
+            grid_update::grid_update(&mut f.grid, dt, &ext, flip);
+        }
         grid_update::grid_update(&mut self.grid, dt, &ext, flip);
         if !self.pins.is_empty() {
             pins::constrain_grid(
                 &pin_entries,
                 self.pins.len(),
-                &mut self.grid,
+                self.fields.as_mut().map_or(&mut self.grid, |f| &mut f.grid),
                 dt,
                 &mut self.pin_reactions,
             );
         }
+        if let Some(f) = &mut self.fields {
+            let mu = self.scene.material.friction;
+            f.contact(
+                &mut self.grid,
+                &pin_entries,
+                mu,
+                dt,
+                &mut self.pin_reactions,
+            );
+        }
+        let held = self
+            .fields
+            .as_ref()
+            .map(|f| (&f.grid, &f.vert_held[..], &f.quad_held[..]));
         let t3 = Instant::now();
         let gather = VertexGather {
             grid: &self.grid,
+            held: held.map(|(g, v, _)| (g, v)),
             dt,
             obstacles,
             transfer,
@@ -528,6 +580,7 @@ impl YarnSim {
             &mut self.particles.quad,
             &self.particles.vert.x,
             &self.grid,
+            held.map(|(g, _, q)| (g, q)),
             dt,
             &self.energy,
             passes.plasticity,
