@@ -79,6 +79,15 @@ impl YarnScene {
             line: text.and_then(|text| key_line(text, "[time]", field)),
             message,
         };
+        if t.integrator == Integrator::Implicit {
+            return Err(invalid(
+                "integrator",
+                "\"implicit\" is not available yet: this version has no backward-Euler \
+                 step (Newton solve of the grid velocities), so no scene can run with it; \
+                 use \"explicit\" (the default)"
+                    .into(),
+            ));
+        }
         match t.dt {
             StepSize::Fixed(dt) => {
                 if !(dt.is_finite() && dt > 0.0) {
