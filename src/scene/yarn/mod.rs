@@ -189,7 +189,7 @@ pub struct TimeSpec {
     #[serde(default = "default_frame_dt", deserialize_with = "positive")]
     pub frame_dt: f64,
     /// How a substep advances the grid velocities: `"explicit"` (default)
-    /// or `"implicit"` (refused at load in this version, see [`Integrator`]).
+    /// or `"implicit"` (backward Euler, in its scope only, see [`Integrator`]).
     #[serde(default, skip_serializing_if = "Integrator::is_explicit")]
     pub integrator: Integrator,
 }
@@ -204,9 +204,10 @@ pub enum Integrator {
     Explicit,
     /// Backward Euler on the grid velocities as a minimisation (Gast,
     /// Schroeder, Stomakhin, Jiang, Teran 2015, "Optimization integrator for
-    /// large time steps", IEEE TVCG 21(10)). Named so that scenes can ask
-    /// for it; not built yet, so a scene that asks is refused at load
-    /// (`time.integrator`), never run with the explicit step instead.
+    /// large time steps", IEEE TVCG 21(10)), [`crate::mpm::implicit`]: only
+    /// for pure fibre stretch with fixed pins and one velocity field; a
+    /// scene outside that scope is refused at load naming the field, never
+    /// run with the explicit step instead.
     Implicit,
 }
 
