@@ -1,6 +1,6 @@
 //! Scene files: round trip, and malformed files name the field and the line.
 
-use yarnsim::scene::{builtin, builtin_names, Scene, SceneError, YarnScene};
+use yarnsim::scene::{builtin, builtin_names, Integrator, Scene, SceneError, YarnScene};
 
 mod common;
 
@@ -91,4 +91,39 @@ fn unknown_builtin_lists_the_known_ones() {
         Scene::resolve("/nonexistent/x.toml"),
         Err(SceneError::Io { .. })
     ));
+}
+
+#[test]
+fn integrator_defaults_to_explicit_and_is_left_out_of_the_toml() {
+    let s = YarnScene::from_toml_str(GOOD).unwrap();
+    assert_eq!(s.time.integrator, Integrator::Explicit);
+    // Saying "explicit" is the same scene as leaving it out (so the same
+    // substeps), and the default is not written back: scene files and
+    // snapshots of today's scenes do not change.
+    let said = YarnScene::from_toml_str(
+        &GOOD.replace("dt = 1e-4", "dt = 1e-4\nintegrator = \"explicit\""),
+    )
+    .unwrap();
+    assert_eq!(said, s);
+    assert!(!s.to_toml_string().contains("integrator"));
+    for (name, _) in builtin_names() {
+        if let Scene::Yarn(y) = builtin(name).unwrap() {
+            assert_eq!(y.time.integrator, Integrator::Explicit, "{name}");
+        }
+    }
+}
+
+#[test]
+fn implicit_integrator_outside_its_scope_is_refused_naming_the_field_and_line() {
+    // The minimal scene has a shear and cross-section energy the implicit
+    // step does not model (tests/implicit.rs covers each refusal): refused
+    // at load, not run with the explicit step.
+    let m = err(&GOOD.replace("dt = 1e-4", "dt = 1e-4\nintegrator = \"implicit\"")).to_string();
+    assert!(m.contains("material.") && m.contains("implicit"), "{m}");
+    // An unknown integrator is a field error too.
+    let m = err(&GOOD.replace("dt = 1e-4", "dt = 1e-4\nintegrator = \"rk4\"")).to_string();
+    assert!(
+        m.contains("line 7") && m.contains("time.integrator") && m.contains("rk4"),
+        "{m}"
+    );
 }

@@ -404,6 +404,17 @@ impl Grid {
         b
     }
 
+    /// Mass the scatter put on node `(i, j)` (window index `idx`), summed
+    /// over the chunk buffers: read before the grid update consumes them.
+    pub fn scattered_mass(&self, idx: usize, i: usize, j: usize) -> f64 {
+        let blk = self.geom.block_of(i, j);
+        self.buffers
+            .iter()
+            .filter(|s| s.touched[blk])
+            .map(|s| s.node[idx][M])
+            .sum()
+    }
+
     /// Collects the union of the chunks' touched blocks into `active`, sorted.
     pub fn collect_active(&mut self) {
         for &b in &self.active {

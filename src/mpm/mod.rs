@@ -33,6 +33,7 @@ pub mod frames;
 pub mod grid;
 pub mod grid_to_particle;
 pub mod grid_update;
+pub mod implicit;
 pub mod line_pool;
 pub mod particle_to_grid;
 pub mod particles;
@@ -46,5 +47,7 @@ pub mod transfer;
 pub mod vertex_forces;
 
 pub use pins::{Pin, PinMotion};
-pub use sim::{Attractor, Diagnostics, DtStats, PassTimes, Passes, SimError, Stepping, YarnSim};
+pub use sim::{
+    Attractor, Diagnostics, DtStats, ImplicitStats, PassTimes, Passes, SimError, Stepping, YarnSim,
+};
 pub use transfer::Transfer;

@@ -15,7 +15,7 @@
 //! position and velocity ([`apply`]); the constraint impulse plus what this
 //! takes, per substep, is the pin's reaction force on the yarn.
 
-use super::grid::{Grid, DVX, DVY, M, VX, VY};
+use super::grid::{Grid, DVX, DVY, VX, VY};
 use super::particles::{Particles, Vertices};
 use crate::math::{perp, Mat2, Vec2};
 use crate::scene::{PinMotionKind, SceneError, YarnScene};
@@ -143,13 +143,13 @@ const PIN_SWEEPS: usize = 200;
 /// substep (see [`constrain_grid`]).
 #[derive(Clone, Debug)]
 pub struct PinEntry {
-    pin: usize,
-    idx: [usize; 9],
-    w: [f64; 9],
+    pub(crate) pin: usize,
+    pub(crate) idx: [usize; 9],
+    pub(crate) w: [f64; 9],
     /// `w_i / m_i` (0 where the node has no mass).
     w_inv_m: [f64; 9],
     denom: f64,
-    target: Vec2,
+    pub(crate) target: Vec2,
 }
 
 /// The stencils of every pinned vertex with the node masses of this
@@ -175,13 +175,7 @@ pub fn stencil_masses(pins: &[Pin], vert: &Vertices, grid: &Grid, t: f64) -> Vec
                     let n = 3 * a + b;
                     let (ni, nj) = (bi + a, bj + b);
                     let idx = geom.index(ni, nj);
-                    let blk = geom.block_of(ni, nj);
-                    let m: f64 = grid
-                        .buffers
-                        .iter()
-                        .filter(|s| s.touched[blk])
-                        .map(|s| s.node[idx][M])
-                        .sum();
+                    let m = grid.scattered_mass(idx, ni, nj);
                     let w = st.weight(a, b);
                     e.idx[n] = idx;
                     e.w[n] = w;

@@ -1,7 +1,8 @@
 //! The built-in scenes.
 
 use super::yarn::{
-    AttractorSpec, GridSpec, Material, Obstacle, StepSize, TimeSpec, Walls, YarnScene, YarnSpec,
+    AttractorSpec, GridSpec, Integrator, Material, Obstacle, StepSize, TimeSpec, Walls, YarnScene,
+    YarnSpec,
 };
 use super::Scene;
 
@@ -83,6 +84,7 @@ pub fn yarn_reference() -> YarnScene {
             safety: None,
             dt_max: None,
             frame_dt: 1.0 / 60.0,
+            integrator: Integrator::Explicit,
         },
         material: reference_material(),
         gravity: [0.0, -9.8],

@@ -17,8 +17,9 @@ pub use builtin::{builtin, builtin_names, DEFAULT_SCENE};
 pub use error::SceneError;
 pub use massspring::MassSpringScene;
 pub use yarn::{
-    AttractorSpec, GridSpec, Material, Obstacle, PinMotionKind, PinSpec, StepSize, TimeSpec,
-    TransferScheme, TransferSpec, WallMode, Walls, YarnEnd, YarnScene, YarnSpec, DEFAULT_SAFETY,
+    AttractorSpec, GridSpec, Integrator, Material, Obstacle, PinMotionKind, PinSpec, StepSize,
+    TimeSpec, TransferScheme, TransferSpec, WallMode, Walls, YarnEnd, YarnScene, YarnSpec,
+    DEFAULT_SAFETY,
 };
 
 /// Any scene this crate can simulate.

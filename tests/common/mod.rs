@@ -2,8 +2,8 @@
 #![allow(dead_code)]
 
 use yarnsim::scene::{
-    AttractorSpec, GridSpec, Material, Obstacle, PinMotionKind, PinSpec, StepSize, TimeSpec,
-    TransferScheme, TransferSpec, WallMode, Walls, YarnEnd, YarnScene, YarnSpec,
+    AttractorSpec, GridSpec, Integrator, Material, Obstacle, PinMotionKind, PinSpec, StepSize,
+    TimeSpec, TransferScheme, TransferSpec, WallMode, Walls, YarnEnd, YarnScene, YarnSpec,
 };
 use yarnsim::YarnSim;
 
@@ -144,6 +144,7 @@ impl SceneBuilder {
                 safety: None,
                 dt_max: None,
                 frame_dt: 1.0 / 60.0,
+                integrator: Integrator::Explicit,
             },
             material: Material {
                 k: 1000.0,

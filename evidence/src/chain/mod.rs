@@ -42,8 +42,8 @@ use crate::{num, Table};
 use yarnsim::mpm::timestep::wave_speed;
 use yarnsim::mpm::YarnSim;
 use yarnsim::scene::{
-    GridSpec, Material, PinSpec, StepSize, TimeSpec, TransferScheme, TransferSpec, WallMode, Walls,
-    YarnEnd, YarnScene, YarnSpec, DEFAULT_SAFETY,
+    GridSpec, Integrator, Material, PinSpec, StepSize, TimeSpec, TransferScheme, TransferSpec,
+    WallMode, Walls, YarnEnd, YarnScene, YarnSpec, DEFAULT_SAFETY,
 };
 use yarnsim::testing::bessel_j0;
 
@@ -175,6 +175,7 @@ pub fn chain_scene(resolution: u32, dt: impl Into<StepSize>, transfer: TransferS
             safety: None,
             dt_max: None,
             frame_dt: 1.0 / 60.0,
+            integrator: Integrator::Explicit,
         },
         material: chain_material(),
         gravity: [0.0, -GRAVITY],

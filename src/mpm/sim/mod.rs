@@ -16,13 +16,16 @@ use super::transfer::Transfer;
 use crate::math::Vec2;
 
 mod diagnostics;
+mod implicit_grid;
 mod stats;
 
 use crate::scene::{
-    Obstacle, SceneError, StepSize, TransferScheme, TransferSpec, WallMode, YarnScene,
+    Integrator, Obstacle, SceneError, StepSize, TransferScheme, TransferSpec, WallMode, YarnScene,
     DEFAULT_SAFETY,
 };
 pub use diagnostics::Diagnostics;
+pub use implicit_grid::ImplicitStats;
+use implicit_grid::{implicit_grid, ImplicitOut};
 pub use stats::{DtStats, PassTimes, Passes};
 
 pub use super::attractor::Attractor;
@@ -64,6 +67,8 @@ pub struct YarnSim {
     /// The held field, when the scene has both held and free yarns
     /// ([`super::fields`]); `None`: one field for all.
     fields: Option<Fields>,
+    /// Newton and CG iterations of the implicit substeps.
+    implicit_stats: ImplicitStats,
 }
 
 /// The transfer scheme a scene asks for.
@@ -136,6 +141,7 @@ impl YarnSim {
             frames_stale: true,
             timings: PassTimes::default(),
             scene: scene.clone(),
+            implicit_stats: ImplicitStats::default(),
         };
         if sim.is_auto() {
             // Not used under "auto"; kept positive for the saved state.
@@ -222,6 +228,14 @@ impl YarnSim {
     /// Number of blocks (8x8 nodes) the last substep touched.
     pub fn active_blocks(&self) -> usize {
         self.grid.active.len()
+    }
+    /// Newton and CG iterations of the implicit substeps so far.
+    pub fn implicit_stats(&self) -> ImplicitStats {
+        self.implicit_stats
+    }
+    /// Whether the substeps are backward Euler (`[time] integrator`).
+    pub fn is_implicit(&self) -> bool {
+        self.scene.time.integrator == Integrator::Implicit
     }
     /// The error that stopped the simulation, if any.
     pub fn failure(&self) -> Option<&SimError> {
@@ -492,6 +506,13 @@ impl YarnSim {
             &empty
         };
 
+        let implicit = self.is_implicit();
+        if implicit && passes.attractor {
+            // validated at load; the attractor can be switched on at run time
+            return Err(SimError::BadInput(
+                "the implicit integrator does not model the attractor: switch it off".into(),
+            ));
+        }
         let transfer = self.transfer;
         let flip = transfer.needs_delta();
         let t0 = Instant::now();
@@ -505,6 +526,12 @@ impl YarnSim {
             .fields
             .as_mut()
             .map(|f| (&mut f.grid, &f.vert_held[..], &f.quad_held[..]));
+        // implicit: the scatter carries momentum only, the fibre forces
+        // enter through the solve
+        let t1_kept = implicit.then(|| {
+            let n = self.particles.quad.t1.len();
+            std::mem::replace(&mut self.particles.quad.t1, vec![Vec2::zeros(); n])
+        });
         particle_to_grid::scatter_fields(
             &mut self.particles,
             &mut self.grid,
@@ -513,6 +540,9 @@ impl YarnSim {
             bending,
             obstacles,
         );
+        if let Some(t1) = t1_kept {
+            self.particles.quad.t1 = t1;
+        }
         let t2 = Instant::now();
         let ext = GridForces {
             gravity: self.gravity,
@@ -529,12 +559,36 @@ impl YarnSim {
             let held = self.fields.as_ref().map_or(&self.grid, |f| &f.grid);
             pins::stencil_masses(&self.pins, &self.particles.vert, held, self.time + dt)
         };
+        let mut problem = implicit.then(|| {
+            super::implicit::Problem::collect(
+                &self.particles,
+                &self.grid,
+                self.energy.k,
+                dt,
+                &pin_entries,
+            )
+        });
         if let Some(f) = &mut self.fields {
             f.record_masses(&self.grid);
             grid_update::grid_update(&mut f.grid, dt, &ext, flip);
         }
         grid_update::grid_update(&mut self.grid, dt, &ext, flip);
-        if !self.pins.is_empty() {
+        if let Some(problem) = &mut problem {
+            let out = ImplicitOut {
+                grid: &mut self.grid,
+                pin_reactions: &mut self.pin_reactions,
+                stats: &mut self.implicit_stats,
+            };
+            if let Err(what) = implicit_grid(problem, out, self.pins.len(), flip) {
+                let e = SimError::NonFinite {
+                    step: self.steps + 1,
+                    time: self.time + dt,
+                    what,
+                };
+                self.failed = Some(e.clone());
+                return Err(e);
+            }
+        } else if !self.pins.is_empty() {
             pins::constrain_grid(
                 &pin_entries,
                 self.pins.len(),

@@ -68,7 +68,121 @@ impl YarnScene {
         }
         self.validate_pins(text)?;
         self.validate_time(text)?;
+        self.validate_implicit(text)?;
         overlap::check_yarns_clear_of_obstacles(self, text)?;
+        Ok(())
+    }
+
+    /// `integrator = "implicit"` runs only scenes whose energy is pure
+    /// fibre stretch and whose boundaries are fixed pins
+    /// ([`crate::mpm::implicit`]); anything else is refused naming the field.
+    fn validate_implicit(&self, text: Option<&str>) -> Result<(), SceneError> {
+        if self.time.integrator != Integrator::Implicit {
+            return Ok(());
+        }
+        let why = "the implicit integrator (time.integrator = \"implicit\") models only pure \
+                   fibre stretch with fixed pins";
+        let refuse = |table: &str, key: &str, what: String| SceneError::Invalid {
+            field: if table.is_empty() {
+                key.to_string()
+            } else {
+                format!("{table}.{key}")
+            },
+            line: text.and_then(|text| {
+                if table.is_empty() {
+                    table_line(Some(text), &format!("[[{key}]]"), 0)
+                } else {
+                    key_line(text, &format!("[{table}]"), key)
+                }
+            }),
+            message: format!("{what}: {why}; use integrator = \"explicit\""),
+        };
+        let m = &self.material;
+        for (key, value) in [
+            ("gamma", m.gamma),
+            ("youngs_modulus", m.youngs_modulus),
+            ("bending", m.bending),
+        ] {
+            if value != 0.0 {
+                return Err(refuse(
+                    "material",
+                    key,
+                    format!("is {value}, the implicit step has no such energy yet (needs 0)"),
+                ));
+            }
+        }
+        if m.plasticity {
+            return Err(refuse(
+                "material",
+                "plasticity",
+                "is true, the implicit step has no return mapping (needs false)".into(),
+            ));
+        }
+        if self.walls.mode != WallMode::None {
+            return Err(refuse(
+                "walls",
+                "mode",
+                format!(
+                    "is {:?}, the implicit step has no wall constraints (needs \"none\")",
+                    self.walls.mode
+                ),
+            ));
+        }
+        if !self.obstacles.is_empty() {
+            return Err(refuse(
+                "",
+                "obstacles",
+                format!(
+                    "{} obstacles given, the implicit step has no contact",
+                    self.obstacles.len()
+                ),
+            ));
+        }
+        if self.attractor.active && self.attractor.strength != 0.0 {
+            return Err(refuse(
+                "attractor",
+                "active",
+                "is true, the implicit step has no attractor energy (needs false)".into(),
+            ));
+        }
+        if let Some(i) = self
+            .pins
+            .iter()
+            .position(|p| p.motion != PinMotionKind::Fixed)
+        {
+            return Err(SceneError::Invalid {
+                field: format!("pins[{i}].motion"),
+                line: table_line(text, "[[pins]]", i),
+                message: format!(
+                    "is {:?}, the implicit step holds only fixed pins: {why}; use integrator = \"explicit\"",
+                    self.pins[i].motion
+                ),
+            });
+        }
+        let yarns: usize = self.yarns.iter().map(|y| y.count as usize).sum();
+        let mut held = vec![false; yarns];
+        for p in &self.pins {
+            if let Some(h) = held.get_mut(p.yarn as usize) {
+                *h = true;
+            }
+        }
+        if held.iter().any(|&h| h) && !held.iter().all(|&h| h) {
+            return Err(refuse(
+                "",
+                "pins",
+                "some yarns are pinned and some free, which needs two velocity fields with \
+                 contact between them; the implicit step has one field"
+                    .into(),
+            ));
+        }
+        if self.time.dt == StepSize::Auto {
+            return Err(refuse(
+                "time",
+                "dt",
+                "is \"auto\", the implicit step has no step-size criterion yet (give a number)"
+                    .into(),
+            ));
+        }
         Ok(())
     }
 
