@@ -1,6 +1,7 @@
 //! Shared helpers of the integration tests.
 #![allow(dead_code)]
 
+use yarnsim::math::Vec2;
 use yarnsim::scene::{
     AttractorSpec, GridSpec, Integrator, Material, Obstacle, PinMotionKind, PinSpec, StepSize,
     TimeSpec, TransferScheme, TransferSpec, WallMode, Walls, YarnEnd, YarnScene, YarnSpec,
@@ -259,3 +260,13 @@ direction = [1.0, 0.0]
 length = 0.5
 vertices = 20
 "#;
+
+/// Free fall of the grid scheme from rest after `n` substeps of `dt` under
+/// `g` (symplectic or backward Euler on the grid, no elastic force): the
+/// centre of mass `c0 + dt^2 g n (n + 1) / 2` and the velocity `n dt g`.
+pub fn grid_free_fall(c0: Vec2, g: Vec2, dt: f64, n: u64) -> (Vec2, Vec2) {
+    (
+        c0 + g * (dt * dt * (n * (n + 1)) as f64 / 2.0),
+        g * (n as f64 * dt),
+    )
+}
