@@ -258,13 +258,7 @@ fn implicit_scenes_outside_its_scope_are_refused_naming_the_field() {
             "plasticity = true",
             "material.plasticity",
         ),
-        ("mode = \"none\"", "mode = \"sticky\"", "walls.mode"),
         ("dt = 1e-3\n", "dt = \"auto\"\n", "time.dt"),
-        (
-            "end = \"start\"\n",
-            "end = \"start\"\nmotion = \"line\"\nvelocity = [0.1, 0.0]\n",
-            "pins[0].motion",
-        ),
     ];
     for (from, to, field) in cases {
         let text = base.replace(from, to);
@@ -275,10 +269,19 @@ fn implicit_scenes_outside_its_scope_are_refused_naming_the_field() {
         assert!(m.contains(field) && m.contains("implicit"), "{field}: {m}");
     }
     let with = |extra: &str| YarnScene::from_toml_str(&format!("{base}{extra}"));
-    let m = with("[[obstacles]]\ncenter = [0.2, 0.2]\nradius = 0.05\n")
-        .expect_err("obstacles")
-        .to_string();
-    assert!(m.contains("obstacles"), "{m}");
+    // walls, obstacles and moving pins are in scope
+    for (from, to) in [
+        ("mode = \"none\"", "mode = \"sticky\""),
+        (
+            "end = \"start\"\n",
+            "end = \"start\"\nmotion = \"line\"\nvelocity = [0.1, 0.0]\n",
+        ),
+    ] {
+        let text = base.replace(from, to);
+        assert_ne!(text, base, "{to}: the edit did not apply");
+        YarnScene::from_toml_str(&text).unwrap_or_else(|e| panic!("{to}: {e}"));
+    }
+    with("[[obstacles]]\ncenter = [0.2, 0.2]\nradius = 0.05\n").expect("an obstacle is in scope");
     let m = with("[attractor]\nactive = true\n")
         .expect_err("attractor")
         .to_string();

@@ -6,6 +6,11 @@
 //! on blocks near one. Obstacle friction, pooled over the contact nodes of
 //! a cross-section, runs after the parallel pass on the contact nodes it
 //! collected, in a fixed order.
+//!
+//! The implicit step runs the update without the obstacles and walls
+//! ([`GridForces::without_boundaries`]) and applies the same laws to its
+//! solved velocities ([`boundaries`], with the masses [`record_masses`]
+//! kept from the scatter).
 
 use rayon::prelude::*;
 
@@ -26,6 +31,22 @@ pub struct GridForces<'a> {
     pub obstacles: &'a [Obstacle],
     pub walls: WallMode,
     pub wall_cells: usize,
+}
+
+impl GridForces<'_> {
+    /// The same settings without obstacles and walls.
+    pub fn without_boundaries(&self) -> Self {
+        GridForces {
+            obstacles: &[],
+            walls: WallMode::None,
+            ..self.clone()
+        }
+    }
+
+    /// Whether an obstacle or a wall acts.
+    pub fn has_boundaries(&self) -> bool {
+        !self.obstacles.is_empty() || self.walls != WallMode::None
+    }
 }
 
 /// One band (block row) of a scatter buffer, as the grid update reads and
@@ -83,29 +104,171 @@ pub fn grid_update(grid: &mut Grid, dt: f64, ext: &GridForces, flip: bool) {
                 grid_band::<false>(bi, band, &mut srcs, ctx, contacts)
             }
         });
-    if contacts.iter().any(|c| !c.is_empty()) {
-        let (walls, cells, n) = (ext.walls, ext.wall_cells, geom.n);
-        obstacle_friction(
-            ext.obstacles,
-            &wedges,
-            &contacts,
-            &mut grid.node,
-            flip,
-            &mut |c, out| {
-                if walls != WallMode::None {
-                    let v = Vec2::new(out[0], out[1]);
-                    let w = wall_velocity(walls, cells, n, c.ij[0] as usize, c.ij[1] as usize, v);
-                    let d = w - v;
-                    out[0] = w.x;
-                    out[1] = w.y;
-                    if flip {
-                        out[2] += d.x;
-                        out[3] += d.y;
-                    }
-                }
-            },
-        );
+    pooled_friction(ext, &wedges, &contacts, &mut grid.node, geom.n, flip);
+    grid.contacts = contacts;
+}
+
+/// The pooled friction pass ([`obstacle_friction`]) on the contact nodes
+/// `contacts`, and the walls again on every node it changed.
+fn pooled_friction(
+    ext: &GridForces,
+    wedges: &WedgeTable,
+    contacts: &[Vec<ContactNode>],
+    node: &mut [Node],
+    n: usize,
+    flip: bool,
+) {
+    if contacts.iter().all(|c| c.is_empty()) {
+        return;
     }
+    let (walls, cells) = (ext.walls, ext.wall_cells);
+    obstacle_friction(
+        ext.obstacles,
+        wedges,
+        contacts,
+        node,
+        flip,
+        &mut |c, out| {
+            if walls != WallMode::None {
+                let v = Vec2::new(out[0], out[1]);
+                let w = wall_velocity(walls, cells, n, c.ij[0] as usize, c.ij[1] as usize, v);
+                let d = w - v;
+                out[0] = w.x;
+                out[1] = w.y;
+                if flip {
+                    out[2] += d.x;
+                    out[3] += d.y;
+                }
+            }
+        },
+    );
+}
+
+/// Whether an obstacle (within the contact's reach) and the walls reach
+/// window block `b`.
+#[inline(always)]
+fn block_near(geom: &GridGeom, ext: &GridForces, b: usize) -> (bool, bool) {
+    let (i0, j0) = geom.block_origin(b);
+    let cells = ext.wall_cells;
+    let dx = geom.dx;
+    // contact reaches nodes up to the particles' stencil (1.5 cells) plus
+    // the contact margin outside an obstacle
+    let reach = 2.0 * dx;
+    let lo = Vec2::new(i0 as f64, j0 as f64) * dx;
+    let hi = lo + Vec2::new((BLOCK - 1) as f64, (BLOCK - 1) as f64) * dx;
+    let near_obstacle = ext.obstacles.iter().any(|o| {
+        let c = Vec2::from(o.center);
+        let q = Vec2::new(c.x.clamp(lo.x, hi.x), c.y.clamp(lo.y, hi.y));
+        (q - c).norm() < o.radius + reach
+    });
+    let near_wall = ext.walls != WallMode::None
+        && (i0 < cells || j0 < cells || i0 + BLOCK + cells > geom.n || j0 + BLOCK + cells > geom.n);
+    (near_obstacle, near_wall)
+}
+
+/// The normal part of every obstacle's contact at node `index` (grid
+/// coordinates `ij`, position `xi`, mass `m`, touching fraction
+/// `touching`) on its velocity `v`, each contact recorded in `contacts`
+/// for the friction pass.
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+fn obstacle_contacts(
+    ext: &GridForces,
+    wedges: &WedgeTable,
+    index: usize,
+    ij: [usize; 2],
+    xi: Vec2,
+    v: &mut Vec2,
+    m: f64,
+    touching: f64,
+    contacts: &mut Vec<ContactNode>,
+) {
+    for (oi, o) in ext.obstacles.iter().enumerate() {
+        if let Some((share, normal, impulse)) = obstacle_normal(o, xi, v, m, touching) {
+            contacts.push(ContactNode {
+                index,
+                ij: [ij[0] as u32, ij[1] as u32],
+                wedge: wedges.wedge(oi, normal),
+                share,
+                mass: share * m,
+                impulse,
+                normal,
+            });
+        }
+    }
+}
+
+/// Node mass and contact mass (lanes [`M`], [`MC`]) of every node of the
+/// active blocks, block by block in `grid.active` order, [`BLOCK`]^2 per
+/// block, summed over the scatter buffers as [`grid_update`] sums them:
+/// call after the scatter and before the grid update consumes the buffers,
+/// for [`boundaries`].
+pub fn record_masses(grid: &Grid, out: &mut Vec<[f64; 2]>) {
+    let geom = grid.geom;
+    out.clear();
+    for &b in &grid.active {
+        let b = b as usize;
+        for idx in geom.block_nodes(b) {
+            let (mut m, mut mc) = (0.0, 0.0);
+            for s in grid.buffers.iter().filter(|s| s.touched[b]) {
+                m += s.node[idx][M];
+                mc += s.node[idx][MC];
+            }
+            out.push([m, mc]);
+        }
+    }
+}
+
+/// The obstacle and wall laws of [`grid_update`] (normal law, pooled
+/// Coulomb friction, walls, in that order) on the node velocities already
+/// in `grid`: the implicit step's, after its solve. `masses` from
+/// [`record_masses`] of this substep. With `flip` every change is added to
+/// the node's velocity change too. Serial, in block order.
+pub fn boundaries(grid: &mut Grid, masses: &[[f64; 2]], ext: &GridForces, flip: bool) {
+    if !ext.has_boundaries() {
+        return;
+    }
+    let geom = grid.geom;
+    let wedges = WedgeTable::new(ext.obstacles, geom.dx);
+    let mut contacts = std::mem::take(&mut grid.contacts);
+    contacts.iter_mut().for_each(Vec::clear);
+    if contacts.is_empty() {
+        contacts.push(Vec::new());
+    }
+    let list = &mut contacts[0];
+    for (k, &b) in grid.active.iter().enumerate() {
+        let b = b as usize;
+        let (near_obstacle, near_wall) = block_near(&geom, ext, b);
+        if !(near_obstacle || near_wall) {
+            continue;
+        }
+        let (i0, j0) = geom.block_origin(b);
+        let block = &masses[k * BLOCK * BLOCK..(k + 1) * BLOCK * BLOCK];
+        for (n, (idx, &[m, mc])) in geom.block_nodes(b).zip(block).enumerate() {
+            if m <= 0.0 {
+                continue;
+            }
+            let (i, j) = (i0 + n / BLOCK, j0 + n % BLOCK);
+            let out = &mut grid.node[idx];
+            let v0 = Vec2::new(out[0], out[1]);
+            let mut v = v0;
+            if near_obstacle {
+                let xi = Vec2::new(i as f64, j as f64) * geom.dx;
+                let touching = mc * (1.0 / m);
+                obstacle_contacts(ext, &wedges, idx, [i, j], xi, &mut v, m, touching, list);
+            }
+            if near_wall {
+                v = wall_velocity(ext.walls, ext.wall_cells, geom.n, i, j, v);
+            }
+            out[0] = v.x;
+            out[1] = v.y;
+            if flip {
+                out[2] += v.x - v0.x;
+                out[3] += v.y - v0.y;
+            }
+        }
+    }
+    pooled_friction(ext, &wedges, &contacts, &mut grid.node, geom.n, flip);
     grid.contacts = contacts;
 }
 
@@ -120,11 +283,6 @@ multiversion! {
     ) {
         let BandCtx { is_active, geom, ext, .. } = *ctx;
         let band_base = bi * geom.stride * BLOCK;
-        let cells = ext.wall_cells;
-        let dx = geom.dx;
-        // contact reaches nodes up to the particles' stencil (1.5 cells) plus
-        // the contact margin outside an obstacle
-        let reach = 2.0 * dx;
         for bj in 0..geom.nbj {
             let b = bi * geom.nbj + bj;
             if !is_active[b] {
@@ -140,18 +298,7 @@ multiversion! {
                 }
             }
             let srcs = &srcs[..nsrc];
-            let lo = Vec2::new(i0 as f64, j0 as f64) * dx;
-            let hi = lo + Vec2::new((BLOCK - 1) as f64, (BLOCK - 1) as f64) * dx;
-            let near_obstacle = ext.obstacles.iter().any(|o| {
-                let c = Vec2::from(o.center);
-                let q = Vec2::new(c.x.clamp(lo.x, hi.x), c.y.clamp(lo.y, hi.y));
-                (q - c).norm() < o.radius + reach
-            });
-            let near_wall = ext.walls != WallMode::None
-                && (i0 < cells
-                    || j0 < cells
-                    || i0 + BLOCK + cells > geom.n
-                    || j0 + BLOCK + cells > geom.n);
+            let (near_obstacle, near_wall) = block_near(geom, ext, b);
             let blk = BlockAt { bj, i0, j0, near_wall };
             if near_obstacle {
                 update_block::<FLIP, true>(&blk, band_base, band, buffers, srcs, ctx, contacts);
@@ -228,21 +375,18 @@ fn update_block<const FLIP: bool, const NEAR: bool>(
                 }
                 if NEAR {
                     let touching = acc[MC] * inv_m;
-                    for (oi, o) in ext.obstacles.iter().enumerate() {
-                        if let Some((share, normal, impulse)) =
-                            obstacle_normal(o, xi, &mut v, acc[M], touching)
-                        {
-                            contacts.push(ContactNode {
-                                index: band_base + row + c,
-                                ij: [i as u32, j as u32],
-                                wedge: wedges.wedge(oi, normal),
-                                share,
-                                mass: share * acc[M],
-                                impulse,
-                                normal,
-                            });
-                        }
-                    }
+                    let index = band_base + row + c;
+                    obstacle_contacts(
+                        ext,
+                        wedges,
+                        index,
+                        [i, j],
+                        xi,
+                        &mut v,
+                        acc[M],
+                        touching,
+                        contacts,
+                    );
                 }
             }
             if near_wall {

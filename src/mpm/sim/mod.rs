@@ -568,11 +568,17 @@ impl YarnSim {
                 &pin_entries,
             )
         });
+        // implicit: v* without obstacles and walls; they act on the solved velocities
+        let (interior, mut masses) = (ext.without_boundaries(), Vec::new());
+        let ext_update = if implicit { &interior } else { &ext };
+        if implicit && ext.has_boundaries() {
+            grid_update::record_masses(&self.grid, &mut masses);
+        }
         if let Some(f) = &mut self.fields {
             f.record_masses(&self.grid);
-            grid_update::grid_update(&mut f.grid, dt, &ext, flip);
+            grid_update::grid_update(&mut f.grid, dt, ext_update, flip);
         }
-        grid_update::grid_update(&mut self.grid, dt, &ext, flip);
+        grid_update::grid_update(&mut self.grid, dt, ext_update, flip);
         if let Some(problem) = &mut problem {
             let out = ImplicitOut {
                 grid: &mut self.grid,
@@ -588,6 +594,7 @@ impl YarnSim {
                 self.failed = Some(e.clone());
                 return Err(e);
             }
+            grid_update::boundaries(&mut self.grid, &masses, &ext, flip);
         } else if !self.pins.is_empty() {
             pins::constrain_grid(
                 &pin_entries,

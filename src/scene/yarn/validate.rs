@@ -74,14 +74,15 @@ impl YarnScene {
     }
 
     /// `integrator = "implicit"` runs only scenes whose energy is pure
-    /// fibre stretch and whose boundaries are fixed pins
-    /// ([`crate::mpm::implicit`]); anything else is refused naming the field.
+    /// fibre stretch, in one velocity field ([`crate::mpm::implicit`]; pins,
+    /// obstacles and walls act as in the explicit step); anything else is
+    /// refused naming the field.
     fn validate_implicit(&self, text: Option<&str>) -> Result<(), SceneError> {
         if self.time.integrator != Integrator::Implicit {
             return Ok(());
         }
         let why = "the implicit integrator (time.integrator = \"implicit\") models only pure \
-                   fibre stretch with fixed pins";
+                   fibre stretch in one velocity field";
         let refuse = |table: &str, key: &str, what: String| SceneError::Invalid {
             field: if table.is_empty() {
                 key.to_string()
@@ -118,46 +119,12 @@ impl YarnScene {
                 "is true, the implicit step has no return mapping (needs false)".into(),
             ));
         }
-        if self.walls.mode != WallMode::None {
-            return Err(refuse(
-                "walls",
-                "mode",
-                format!(
-                    "is {:?}, the implicit step has no wall constraints (needs \"none\")",
-                    self.walls.mode
-                ),
-            ));
-        }
-        if !self.obstacles.is_empty() {
-            return Err(refuse(
-                "",
-                "obstacles",
-                format!(
-                    "{} obstacles given, the implicit step has no contact",
-                    self.obstacles.len()
-                ),
-            ));
-        }
         if self.attractor.active && self.attractor.strength != 0.0 {
             return Err(refuse(
                 "attractor",
                 "active",
                 "is true, the implicit step has no attractor energy (needs false)".into(),
             ));
-        }
-        if let Some(i) = self
-            .pins
-            .iter()
-            .position(|p| p.motion != PinMotionKind::Fixed)
-        {
-            return Err(SceneError::Invalid {
-                field: format!("pins[{i}].motion"),
-                line: table_line(text, "[[pins]]", i),
-                message: format!(
-                    "is {:?}, the implicit step holds only fixed pins: {why}; use integrator = \"explicit\"",
-                    self.pins[i].motion
-                ),
-            });
         }
         let yarns: usize = self.yarns.iter().map(|y| y.count as usize).sum();
         let mut held = vec![false; yarns];
