@@ -6,7 +6,7 @@
 
 mod common;
 
-use common::scene;
+use common::{capstan_threshold, scene};
 use yarnsim::math::{perp, Mat2, Vec2};
 use yarnsim::scene::{SceneError, TransferScheme, WallMode, YarnScene};
 use yarnsim::testing::{
@@ -17,44 +17,6 @@ use yarnsim::testing::{
 use yarnsim::YarnSim;
 
 // ---- capstan ---------------------------------------------------------------
-
-/// Heavy-rope capstan: tension at the heavy end of the wrapped half circle
-/// for friction `mu`, from dT/ds = mu T / R + w (mu sin psi - cos psi),
-/// psi = pi - s / R, T(0) = w l1 (RK4 in 2000 steps).
-fn capstan_tension(mu: f64, r: f64, w: f64, l1: f64) -> f64 {
-    let f = |s: f64, t: f64| {
-        let psi = std::f64::consts::PI - s / r;
-        mu * t / r + w * (mu * psi.sin() - psi.cos())
-    };
-    let n = 2000;
-    let h = std::f64::consts::PI * r / n as f64;
-    let mut t = w * l1;
-    for i in 0..n {
-        let s = i as f64 * h;
-        let k1 = f(s, t);
-        let k2 = f(s + h / 2.0, t + h / 2.0 * k1);
-        let k3 = f(s + h / 2.0, t + h / 2.0 * k2);
-        let k4 = f(s + h, t + h * k3);
-        t += h / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4);
-    }
-    t
-}
-
-/// The friction coefficient at which the heavy-rope capstan just holds
-/// hanging lengths `l1` and `l2` over a half circle of radius `r`
-/// (bisection on `T(pi R) = w l2`; independent of `w`).
-fn capstan_threshold(r: f64, l1: f64, l2: f64) -> f64 {
-    let (mut lo, mut hi) = (0.0, 5.0);
-    for _ in 0..60 {
-        let mid = 0.5 * (lo + hi);
-        if capstan_tension(mid, r, 1.0, l1) < l2 {
-            lo = mid;
-        } else {
-            hi = mid;
-        }
-    }
-    0.5 * (lo + hi)
-}
 
 /// The material of every built-in scene (`reference_material`) without its
 /// bending: k = 1000, gamma = 500, E = 1000, fibre friction 0.05,
