@@ -205,7 +205,8 @@ pub enum Integrator {
     /// Backward Euler on the grid velocities as a minimisation (Gast,
     /// Schroeder, Stomakhin, Jiang, Teran 2015, "Optimization integrator for
     /// large time steps", IEEE TVCG 21(10)), [`crate::mpm::implicit`]: only
-    /// for pure fibre stretch with fixed pins and one velocity field; a
+    /// for pure fibre stretch in one velocity field (pins, obstacles and
+    /// walls act as in the explicit step); a
     /// scene outside that scope is refused at load naming the field, never
     /// run with the explicit step instead.
     Implicit,
