@@ -12,7 +12,7 @@ mod common;
 
 use std::time::Instant;
 
-use common::{capstan_threshold, pin_end, straight, SceneBuilder};
+use common::{capstan_threshold, on_threads, pin_end, straight, SceneBuilder};
 use yarnsim::math::Vec2;
 use yarnsim::scene::{Integrator, Material, PinMotionKind, StepSize, WallMode, YarnEnd, YarnScene};
 use yarnsim::testing::{capstan_toml, Capstan, CAPSTAN_PURE_STRING};
@@ -136,6 +136,36 @@ fn capstan_threshold_under_backward_euler_at_10x_the_explicit_dt() {
         dt: 1e-3,
         ..CAPSTAN_PURE_STRING
     });
+}
+
+/// The capstan with slip walls under the implicit integrator (the
+/// boundary pass is serial, in block order): bit-identical states with 1
+/// and 2 threads.
+#[test]
+fn boundaries_give_the_same_bits_for_one_and_two_threads() {
+    let setup = Capstan {
+        dt: 1e-3,
+        ..CAPSTAN_PURE_STRING
+    };
+    let text =
+        capstan_toml(0.1, 0.1, 0.3, 0.3, &setup).replace("mode = \"none\"", "mode = \"slip\"");
+    let s = with_integrator(
+        YarnScene::from_toml_str(&text).unwrap(),
+        Integrator::Implicit,
+        1e-3,
+    );
+    assert_eq!(s.walls.mode, WallMode::Slip);
+    let run = |threads: usize| {
+        on_threads(threads, || {
+            let mut sim = YarnSim::new(&s).unwrap();
+            sim.steps_n(60).unwrap();
+            (sim.save_state(), sim.implicit_stats())
+        })
+    };
+    let (a, sa) = run(1);
+    let (b, sb) = run(2);
+    assert_eq!(sa, sb);
+    assert!(a == b, "states differ");
 }
 
 // ---- incline ---------------------------------------------------------------
