@@ -26,6 +26,18 @@ pub struct Settings {
     pub cg_tol: f64,
     /// Line-search halvings before the step fails.
     pub max_halvings: usize,
+    /// The CG preconditioner.
+    pub precond: Precond,
+}
+
+/// The CG preconditioner of the Newton systems.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Precond {
+    /// `diag H`.
+    Jacobi,
+    /// The fibre stretch exactly, the rest by its diagonal
+    /// ([`super::precond`]).
+    Stiff,
 }
 
 impl Default for Settings {
@@ -37,6 +49,7 @@ impl Default for Settings {
             max_cg: 2000,
             cg_tol: 1e-4,
             max_halvings: 40,
+            precond: Precond::Stiff,
         }
     }
 }
@@ -148,17 +161,30 @@ pub fn solve(p: &Problem, s: &Settings) -> Result<Solution, String> {
 /// Hessian is indefinite for compressed segments): with the iterate so
 /// far, or the preconditioned steepest descent when that is the first.
 fn pcg(p: &Problem, v: &[Vec2], g: &[Vec2], s: &Settings) -> (Vec<Vec2>, usize) {
-    let diag = p.diagonal(v);
-    // z = Pi D^-1 Pi^T r, and |Pi^T r| (the residual that can vanish)
+    let stiff = (s.precond == Precond::Stiff)
+        .then(|| super::precond::StiffPrecond::new(&p.diagonal_rest(v), &p.stiff_rows(v)));
+    let diag = if stiff.is_some() {
+        Vec::new()
+    } else {
+        p.diagonal(v)
+    };
+    // z = Pi P^-1 Pi^T r, and |Pi^T r| (the residual that can vanish)
     let precond = |r: &[Vec2]| -> (Vec<Vec2>, f64) {
         let mut r = r.to_vec();
         p.project_dual(&mut r);
         let norm = dot(&r, &r).sqrt();
-        let mut z: Vec<Vec2> = r
-            .iter()
-            .zip(&diag)
-            .map(|(r, d)| Vec2::new(r.x / d.x, r.y / d.y))
-            .collect();
+        let mut z: Vec<Vec2> = match &stiff {
+            Some(sp) => {
+                let mut z = vec![Vec2::zeros(); r.len()];
+                sp.apply(&r, &mut z);
+                z
+            }
+            None => r
+                .iter()
+                .zip(&diag)
+                .map(|(r, d)| Vec2::new(r.x / d.x, r.y / d.y))
+                .collect(),
+        };
         p.project(&mut z);
         (z, norm)
     };
