@@ -54,7 +54,7 @@ pub struct StiffPrecond {
     coef: Vec<Vec2>,
     bw: usize,
     /// Lower band of the Cholesky factor of `S_a`: row `i`, entry
-    /// `i * (bw + 1) + (i - j)` holds `L[i][j]`.
+    /// `i * (MAX_BAND + 1) + (i - j)` holds `L[i][j]`.
     chol: Vec<f64>,
 }
 
@@ -97,10 +97,12 @@ impl StiffPrecond {
         let mut acc = vec![0.0f64; n];
         let mut mark = vec![false; n];
         let mut touched: Vec<usize> = Vec::new();
-        let mut band_entries: Vec<Vec<(usize, f64)>> = vec![Vec::new(); n];
-        let mut comp = vec![0.0f64; n];
+        // `S_a` in a band of the full cap's width (the factor uses `bw`)
+        let w = MAX_BAND + 1;
+        let mut chol = vec![0.0; n * w];
         let mut bw = 0usize;
         for s in 0..n {
+            let mut comp = 0.0;
             for e in start[s]..start[s + 1] {
                 let i = node[e] as usize;
                 let b = coef[e].component_mul(&inv_d[i]);
@@ -113,7 +115,6 @@ impl StiffPrecond {
                     acc[t] += b.dot(&bt);
                 }
             }
-            touched.sort_unstable();
             for &t in &touched {
                 let g = acc[t];
                 acc[t] = 0.0;
@@ -122,23 +123,16 @@ impl StiffPrecond {
                 if near {
                     if t <= s {
                         bw = bw.max(s - t);
-                        band_entries[s].push((t, g));
+                        chol[s * w + (s - t)] = g;
                     }
                 } else {
-                    comp[s] += g.abs();
+                    comp += g.abs();
                 }
             }
             touched.clear();
+            chol[s * w] += 1.0 / rows[s].c + comp;
         }
-        let w = bw + 1;
-        let mut chol = vec![0.0; n * w];
-        for s in 0..n {
-            for &(t, g) in &band_entries[s] {
-                chol[s * w + (s - t)] += g;
-            }
-            chol[s * w] += 1.0 / rows[s].c + comp[s];
-        }
-        factor_band(&mut chol, n, bw);
+        factor_band(&mut chol, n, bw, w);
         StiffPrecond {
             inv_d,
             start,
@@ -167,7 +161,7 @@ impl StiffPrecond {
                     .sum()
             })
             .collect();
-        solve_band(&self.chol, n, self.bw, &mut u);
+        solve_band(&self.chol, n, self.bw, MAX_BAND + 1, &mut u);
         for (s, u) in u.iter().enumerate() {
             for e in self.start[s]..self.start[s + 1] {
                 let i = self.node[e] as usize;
@@ -178,11 +172,10 @@ impl StiffPrecond {
 }
 
 /// In-place banded Cholesky `A = L L^T` (lower band, half-width `bw`, row
-/// `i` at `a[i * (bw + 1)..]`, entry `i - j`). A pivot that round-off made
+/// `i` at `a[i * w..]`, `w > bw`, entry `i - j`). A pivot that round-off made
 /// non-positive is replaced by a tiny positive one (the matrix is SPD by
 /// construction).
-fn factor_band(a: &mut [f64], n: usize, bw: usize) {
-    let w = bw + 1;
+fn factor_band(a: &mut [f64], n: usize, bw: usize, w: usize) {
     for i in 0..n {
         let j0 = i.saturating_sub(bw);
         for j in j0..=i {
@@ -201,8 +194,7 @@ fn factor_band(a: &mut [f64], n: usize, bw: usize) {
 }
 
 /// Solves `L L^T x = b` in place with the factor of [`factor_band`].
-fn solve_band(l: &[f64], n: usize, bw: usize, b: &mut [f64]) {
-    let w = bw + 1;
+fn solve_band(l: &[f64], n: usize, bw: usize, w: usize, b: &mut [f64]) {
     for i in 0..n {
         let mut s = b[i];
         for k in i.saturating_sub(bw)..i {
