@@ -27,6 +27,10 @@ fn chain_scene(k: f64, integrator: &str, dt: &str) -> YarnScene {
 /// crossings of the free end), wall seconds per simulated second, and the
 /// Newton and CG iterations per substep (0 for the explicit step).
 fn period_error(s: &YarnScene) -> (f64, f64, f64, f64) {
+    yarnsim::pool::on_pool(|| period_error_here(s))
+}
+
+fn period_error_here(s: &YarnScene) -> (f64, f64, f64, f64) {
     let mut sim = YarnSim::new(s).unwrap();
     let period = hanging_chain_period();
     let mut z = ZeroCrossings::new(sim.yarn_endpoints(0).1.x - 0.5);
