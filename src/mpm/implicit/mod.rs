@@ -23,6 +23,7 @@
 //! [`newton`].
 
 pub mod newton;
+pub mod precond;
 #[cfg(test)]
 mod tests;
 
@@ -31,7 +32,7 @@ use super::particles::{Particles, NONE};
 use super::pins::PinEntry;
 use crate::math::Vec2;
 
-pub use newton::{solve, Settings, Solution, SolveStats};
+pub use newton::{solve, Precond, Settings, Solution, SolveStats};
 
 /// One vertex's 3x3 stencil in unknown indices ([`NONE`]: a node without
 /// mass, weight 0).
@@ -264,6 +265,72 @@ impl Problem {
                 u.x * u.x + t * (1.0 - u.x * u.x),
                 u.y * u.y + t * (1.0 - u.y * u.y),
             ) * s.c;
+            kd[s.left] += k;
+            kd[s.left + 1] += k;
+        }
+        let dt2 = self.dt * self.dt;
+        let mut out: Vec<Vec2> = self.mass.iter().map(|&m| Vec2::new(m, m)).collect();
+        for (w, k) in self.weights.iter().zip(&kd) {
+            for n in 0..9 {
+                if w.node[n] != NONE {
+                    out[w.node[n] as usize] += k * (dt2 * w.w[n] * w.w[n]);
+                }
+            }
+        }
+        out
+    }
+
+    /// The stiff rows of the fibre stretch at `v` for [`precond`]: per
+    /// segment `b_n = dt (w_right,n - w_left,n) u` and `c`, grouped by yarn.
+    pub fn stiff_rows(&self, v: &[Vec2]) -> Vec<precond::StiffRow> {
+        let x = self.positions(v);
+        let mut rows = Vec::with_capacity(self.springs.len());
+        let mut group = 0u32;
+        let mut prev: Option<usize> = None;
+        for s in &self.springs {
+            if prev.is_some_and(|p| p + 1 != s.left) {
+                group += 1;
+            }
+            prev = Some(s.left);
+            let e = x[s.left + 1] - x[s.left];
+            let l = e.norm();
+            if l <= 0.0 {
+                continue;
+            }
+            let u = e / l;
+            let mut entries: Vec<(u32, Vec2)> = Vec::with_capacity(18);
+            for (w, sign) in [
+                (&self.weights[s.left + 1], 1.0),
+                (&self.weights[s.left], -1.0),
+            ] {
+                for n in 0..9 {
+                    if w.node[n] == NONE {
+                        continue;
+                    }
+                    let c = u * (sign * self.dt * w.w[n]);
+                    match entries.iter_mut().find(|(i, _)| *i == w.node[n]) {
+                        Some(e) => e.1 += c,
+                        None => entries.push((w.node[n], c)),
+                    }
+                }
+            }
+            rows.push(precond::StiffRow {
+                group,
+                entries,
+                c: s.c,
+            });
+        }
+        rows
+    }
+
+    /// [`Problem::diagonal`] without the segments' axial part (what
+    /// [`Problem::stiff_rows`] carries).
+    pub fn diagonal_rest(&self, v: &[Vec2]) -> Vec<Vec2> {
+        let x = self.positions(v);
+        let mut kd = vec![Vec2::zeros(); x.len()];
+        for (s, u, l) in self.segments(&x) {
+            let t = (1.0 - s.l0 / l).max(0.0);
+            let k = Vec2::new(t * (1.0 - u.x * u.x), t * (1.0 - u.y * u.y)) * s.c;
             kd[s.left] += k;
             kd[s.left + 1] += k;
         }

@@ -26,6 +26,18 @@ pub struct Settings {
     pub cg_tol: f64,
     /// Line-search halvings before the step fails.
     pub max_halvings: usize,
+    /// The CG preconditioner.
+    pub precond: Precond,
+}
+
+/// The CG preconditioner of the Newton systems.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Precond {
+    /// `diag H`.
+    Jacobi,
+    /// The fibre stretch exactly, the rest by its diagonal
+    /// ([`super::precond`]).
+    Stiff,
 }
 
 impl Default for Settings {
@@ -37,6 +49,7 @@ impl Default for Settings {
             max_cg: 2000,
             cg_tol: 1e-4,
             max_halvings: 40,
+            precond: Precond::Stiff,
         }
     }
 }
@@ -74,6 +87,7 @@ pub fn solve(p: &Problem, s: &Settings) -> Result<Solution, String> {
     let g0 = dot(&g, &g).sqrt();
     let tol = (s.rel_tol * g0).max(s.abs_tol * (mv + p.dt() * p.force_scale()));
     let mut e = p.energy(&v);
+    let mut pre = None;
     loop {
         let gn = dot(&g, &g).sqrt();
         if gn <= tol || gn == 0.0 {
@@ -87,7 +101,8 @@ pub fn solve(p: &Problem, s: &Settings) -> Result<Solution, String> {
             ));
         }
         stats.newton += 1;
-        let (mut d, its) = pcg(p, &v, &g, s);
+        let pre = pre.get_or_insert_with(|| Pre::new(p, &v, s));
+        let (mut d, its) = pcg(p, &v, &g, s, pre);
         stats.cg += its;
         if !p.has_pins() {
             // The exact Newton step changes the momentum by -sum g (K has
@@ -147,18 +162,46 @@ pub fn solve(p: &Problem, s: &Settings) -> Result<Solution, String> {
 /// `d` and the iterations. Stops at negative curvature (the exact spring
 /// Hessian is indefinite for compressed segments): with the iterate so
 /// far, or the preconditioned steepest descent when that is the first.
-fn pcg(p: &Problem, v: &[Vec2], g: &[Vec2], s: &Settings) -> (Vec<Vec2>, usize) {
-    let diag = p.diagonal(v);
-    // z = Pi D^-1 Pi^T r, and |Pi^T r| (the residual that can vanish)
+/// The preconditioner of one solve, built at its first Newton iterate and
+/// kept for the others (any fixed SPD preconditioner keeps CG exact; the
+/// Hessian changes little between Newton iterates).
+enum Pre {
+    Jacobi(Vec<Vec2>),
+    Stiff(super::precond::StiffPrecond),
+}
+
+impl Pre {
+    fn new(p: &Problem, v: &[Vec2], s: &Settings) -> Self {
+        match s.precond {
+            Precond::Jacobi => Pre::Jacobi(p.diagonal(v)),
+            Precond::Stiff => Pre::Stiff(super::precond::StiffPrecond::new(
+                &p.diagonal_rest(v),
+                &p.stiff_rows(v),
+            )),
+        }
+    }
+
+    /// `z = P^-1 r`.
+    fn apply(&self, r: &[Vec2], z: &mut [Vec2]) {
+        match self {
+            Pre::Jacobi(d) => {
+                for ((z, r), d) in z.iter_mut().zip(r).zip(d) {
+                    *z = Vec2::new(r.x / d.x, r.y / d.y);
+                }
+            }
+            Pre::Stiff(sp) => sp.apply(r, z),
+        }
+    }
+}
+
+fn pcg(p: &Problem, v: &[Vec2], g: &[Vec2], s: &Settings, pre: &Pre) -> (Vec<Vec2>, usize) {
+    // z = Pi P^-1 Pi^T r, and |Pi^T r| (the residual that can vanish)
     let precond = |r: &[Vec2]| -> (Vec<Vec2>, f64) {
         let mut r = r.to_vec();
         p.project_dual(&mut r);
         let norm = dot(&r, &r).sqrt();
-        let mut z: Vec<Vec2> = r
-            .iter()
-            .zip(&diag)
-            .map(|(r, d)| Vec2::new(r.x / d.x, r.y / d.y))
-            .collect();
+        let mut z = vec![Vec2::zeros(); r.len()];
+        pre.apply(&r, &mut z);
         p.project(&mut z);
         (z, norm)
     };

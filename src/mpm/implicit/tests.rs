@@ -135,7 +135,19 @@ fn pin_projection_keeps_the_pins_and_solve_reaches_the_constrained_minimum() {
     let mut v = r.vec(p.len(), 1.0);
     p.make_feasible(&mut v);
     assert!((p.apply_a(&v)[0] - Vec2::new(0.1, -0.2)).norm() < 1e-14);
-    let sol = solve(&p, &Settings::default()).unwrap();
+    for precond in [Precond::Jacobi, Precond::Stiff] {
+        let settings = Settings {
+            precond,
+            ..Settings::default()
+        };
+        reaches_the_constrained_minimum(&p, &settings);
+    }
+}
+
+/// The solve with `s` meets the pins, the tolerance, and no feasible
+/// neighbour of its solution is lower.
+fn reaches_the_constrained_minimum(p: &Problem, s: &Settings) {
+    let sol = solve(p, s).unwrap();
     assert!((p.apply_a(&sol.v)[0] - Vec2::new(0.1, -0.2)).norm() < 1e-12);
     let mut g = p.gradient(&sol.v);
     let mut g0 = p.gradient(&{
@@ -156,7 +168,7 @@ fn pin_projection_keeps_the_pins_and_solve_reaches_the_constrained_minimum() {
         assert!(p.energy(&t) >= e, "a feasible neighbour is lower");
     }
     eprintln!(
-        "small problem: {} Newton, {} CG iterations",
-        sol.stats.newton, sol.stats.cg
+        "small problem, {:?}: {} Newton, {} CG iterations",
+        s.precond, sol.stats.newton, sol.stats.cg
     );
 }
