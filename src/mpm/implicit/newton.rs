@@ -1,7 +1,8 @@
 //! Newton's method on `E(v)` ([`super::Problem`]) with a backtracking
 //! (Armijo) line search, each Newton system `H d = -g` solved by conjugate
-//! gradients with a Jacobi preconditioner on the exact Hessian-vector
-//! products, in the subspace that keeps the pins (projected gradient and
+//! gradients with a Jacobi preconditioner on the Hessian-vector products
+//! of the element blocks assembled once per Newton iteration (projected
+//! onto PSD by default, [`super::blocks`]), in the subspace that keeps the pins (projected gradient and
 //! preconditioner `Pi D^-1 Pi^T`). Serial, in a fixed order: the same bits
 //! for any thread count.
 
@@ -14,9 +15,10 @@ pub struct Settings {
     /// Converged when the projected gradient norm is at most this times
     /// its norm at the start (`v = v*` made feasible).
     pub rel_tol: f64,
-    /// ... or at most this times `|M v*| + dt |F|`, `F` the segments'
-    /// forces at 100 % strain (`vol k / l0` each): the round-off floor of
-    /// the gradient, a strain of about this size.
+    /// ... or at most this times `|M v*| + dt |F|`, `F` the elements'
+    /// forces at unit strain ([`Problem::force_scale`]: stretch, shear and
+    /// normal stiffness, bending, attractor): the round-off floor of the
+    /// gradient, a strain of about this size.
     pub abs_tol: f64,
     /// Newton iterations before the step fails.
     pub max_newton: usize,
@@ -26,6 +28,9 @@ pub struct Settings {
     pub cg_tol: f64,
     /// Line-search halvings before the step fails.
     pub max_halvings: usize,
+    /// Project each element block onto the PSD cone (projected Newton);
+    /// `false`: the exact Hessian (CG then stops at negative curvature).
+    pub psd: bool,
 }
 
 impl Default for Settings {
@@ -37,6 +42,7 @@ impl Default for Settings {
             max_cg: 2000,
             cg_tol: 1e-4,
             max_halvings: 40,
+            psd: true,
         }
     }
 }
@@ -89,9 +95,9 @@ pub fn solve(p: &Problem, s: &Settings) -> Result<Solution, String> {
         stats.newton += 1;
         let (mut d, its) = pcg(p, &v, &g, s);
         stats.cg += its;
-        if !p.has_pins() {
-            // The exact Newton step changes the momentum by -sum g (K has
-            // no translation part); put CG's error in that mode right with
+        if !p.has_pins() && !p.has_external() {
+            // The exact Newton step changes the momentum by -sum g (the
+            // elastic blocks have no translation part); put CG's error in that mode right with
             // a uniform velocity, so the momentum is kept to round-off
             // (sum g = 0 at v* and stays so) at any CG tolerance.
             let mass: f64 = p.mass.iter().sum();
@@ -144,11 +150,12 @@ pub fn solve(p: &Problem, s: &Settings) -> Result<Solution, String> {
 }
 
 /// Preconditioned CG on `H d = -g` in the pin-keeping subspace; returns
-/// `d` and the iterations. Stops at negative curvature (the exact spring
-/// Hessian is indefinite for compressed segments): with the iterate so
-/// far, or the preconditioned steepest descent when that is the first.
+/// `d` and the iterations. Stops at negative curvature (only with the
+/// exact, unprojected blocks): with the iterate so far, or the
+/// preconditioned steepest descent when that is the first.
 fn pcg(p: &Problem, v: &[Vec2], g: &[Vec2], s: &Settings) -> (Vec<Vec2>, usize) {
-    let diag = p.diagonal(v);
+    let blocks = p.blocks(v, s.psd);
+    let diag = p.diagonal(&blocks);
     // z = Pi D^-1 Pi^T r, and |Pi^T r| (the residual that can vanish)
     let precond = |r: &[Vec2]| -> (Vec<Vec2>, f64) {
         let mut r = r.to_vec();
@@ -169,7 +176,7 @@ fn pcg(p: &Problem, v: &[Vec2], g: &[Vec2], s: &Settings) -> (Vec<Vec2>, usize) 
     let mut pd = z.clone();
     let mut rz = dot(&r, &z);
     for it in 0..s.max_cg {
-        let hp = p.hess_vec(v, &pd);
+        let hp = p.hess_vec_blocks(&blocks, &pd);
         let curv = dot(&pd, &hp);
         if curv <= 0.0 {
             if it == 0 {

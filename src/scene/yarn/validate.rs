@@ -73,15 +73,15 @@ impl YarnScene {
         Ok(())
     }
 
-    /// `integrator = "implicit"` runs only scenes whose energy is pure
-    /// fibre stretch and whose boundaries are fixed pins
+    /// `integrator = "implicit"` runs the whole yarn energy but only scenes
+    /// without walls or obstacles whose boundaries are fixed pins
     /// ([`crate::mpm::implicit`]); anything else is refused naming the field.
     fn validate_implicit(&self, text: Option<&str>) -> Result<(), SceneError> {
         if self.time.integrator != Integrator::Implicit {
             return Ok(());
         }
-        let why = "the implicit integrator (time.integrator = \"implicit\") models only pure \
-                   fibre stretch with fixed pins";
+        let why = "the implicit integrator (time.integrator = \"implicit\") has no contact \
+                   and holds only fixed pins";
         let refuse = |table: &str, key: &str, what: String| SceneError::Invalid {
             field: if table.is_empty() {
                 key.to_string()
@@ -97,27 +97,6 @@ impl YarnScene {
             }),
             message: format!("{what}: {why}; use integrator = \"explicit\""),
         };
-        let m = &self.material;
-        for (key, value) in [
-            ("gamma", m.gamma),
-            ("youngs_modulus", m.youngs_modulus),
-            ("bending", m.bending),
-        ] {
-            if value != 0.0 {
-                return Err(refuse(
-                    "material",
-                    key,
-                    format!("is {value}, the implicit step has no such energy yet (needs 0)"),
-                ));
-            }
-        }
-        if m.plasticity {
-            return Err(refuse(
-                "material",
-                "plasticity",
-                "is true, the implicit step has no return mapping (needs false)".into(),
-            ));
-        }
         if self.walls.mode != WallMode::None {
             return Err(refuse(
                 "walls",
@@ -136,13 +115,6 @@ impl YarnScene {
                     "{} obstacles given, the implicit step has no contact",
                     self.obstacles.len()
                 ),
-            ));
-        }
-        if self.attractor.active && self.attractor.strength != 0.0 {
-            return Err(refuse(
-                "attractor",
-                "active",
-                "is true, the implicit step has no attractor energy (needs false)".into(),
             ));
         }
         if let Some(i) = self
