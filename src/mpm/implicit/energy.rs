@@ -214,10 +214,7 @@ impl Problem {
             }
         }
         for ((y, a), d) in y.iter_mut().zip(&k.attr).zip(d) {
-            *y += Vec2::new(
-                a[0][0] * d.x + a[0][1] * d.y,
-                a[1][0] * d.x + a[1][1] * d.y,
-            );
+            *y += Vec2::new(a[0][0] * d.x + a[0][1] * d.y, a[1][0] * d.x + a[1][1] * d.y);
         }
         y
     }

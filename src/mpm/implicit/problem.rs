@@ -157,7 +157,12 @@ impl Problem {
                 for b in 0..3 {
                     let n = 3 * a + b;
                     if w.node[n] != NONE {
-                        merge(&mut list, w.node[n], 1, s2 * w.w[n] * st.offset(a, b).dot(&d2));
+                        merge(
+                            &mut list,
+                            w.node[n],
+                            1,
+                            s2 * w.w[n] * st.offset(a, b).dot(&d2),
+                        );
                     }
                 }
             }
@@ -276,10 +281,9 @@ impl Problem {
             .iter()
             .map(|b| (self.bending * b.inv_len * b.inv_len).powi(2))
             .sum();
-        let a: f64 = self
-            .attractor
-            .as_ref()
-            .map_or(0.0, |a| self.mass.iter().map(|m| (m * a.strength).powi(2)).sum());
+        let a: f64 = self.attractor.as_ref().map_or(0.0, |a| {
+            self.mass.iter().map(|m| (m * a.strength).powi(2)).sum()
+        });
         (q + b + a).sqrt()
     }
 

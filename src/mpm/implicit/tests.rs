@@ -26,7 +26,9 @@ impl Lcg {
         s * (self.next() - 0.5)
     }
     fn vec(&mut self, n: usize, s: f64) -> Vec<Vec2> {
-        (0..n).map(|_| Vec2::new(self.sym(s), self.sym(s))).collect()
+        (0..n)
+            .map(|_| Vec2::new(self.sym(s), self.sym(s)))
+            .collect()
     }
 }
 
@@ -160,7 +162,12 @@ fn stress_and_bending_gradient_are_the_explicit_force_laws() {
         // stretched, sheared, compressed (r22 < 1, some below R22_MIN) and
         // inverted frames, and fully random ones
         let g = if k % 2 == 0 {
-            frame(r.sym(7.0), 0.5 + r.next(), r.sym(1.0), 1.2 * r.next() - 0.05)
+            frame(
+                r.sym(7.0),
+                0.5 + r.next(),
+                r.sym(1.0),
+                1.2 * r.next() - 0.05,
+            )
         } else {
             Mat2::new(r.sym(3.0), r.sym(3.0), r.sym(3.0), r.sym(3.0))
         };
@@ -179,7 +186,10 @@ fn stress_and_bending_gradient_are_the_explicit_force_laws() {
     }
     assert!(compressed > 500, "{compressed}");
     // same operations: 1e-13 relative at most (bitwise in practice)
-    assert!(worst <= 1e-13, "quad gradient vs frame_gradient: {worst:.3e}");
+    assert!(
+        worst <= 1e-13,
+        "quad gradient vs frame_gradient: {worst:.3e}"
+    );
 
     // bending: the summed vertex gradients are minus vertex_forces
     let n = 12;
@@ -204,7 +214,14 @@ fn stress_and_bending_gradient_are_the_explicit_force_laws() {
     for j in 1..n - 1 {
         let x = &vert.x;
         let gj = bend_gradient(
-            [x[j - 1].x, x[j - 1].y, x[j].x, x[j].y, x[j + 1].x, x[j + 1].y],
+            [
+                x[j - 1].x,
+                x[j - 1].y,
+                x[j].x,
+                x[j].y,
+                x[j + 1].x,
+                x[j + 1].y,
+            ],
             b,
             vert.bend[j].kappa0,
             vert.bend[j].inv_len,
@@ -258,7 +275,10 @@ fn hessian_vector_product_matches_central_differences_of_the_gradient() {
         .iter()
         .map(|d| qr(&Mat2::new(d[0], d[2], d[1], d[3])).r22 / 0.05)
         .collect();
-    assert!(r22.iter().any(|&r| r < 0.95) && r22.iter().any(|&r| r > 1.0), "{r22:?}");
+    assert!(
+        r22.iter().any(|&r| r < 0.95) && r22.iter().any(|&r| r > 1.0),
+        "{r22:?}"
+    );
     let d = r.vec(p.len(), 1.0);
     let h = 1e-6;
     let a: Vec<Vec2> = v.iter().zip(&d).map(|(v, d)| v + d * h).collect();
@@ -310,7 +330,12 @@ fn psd_projection_keeps_pd_blocks_and_removes_negative_curvature() {
     let mut r = Lcg(9);
     let (mut pd, mut indefinite) = (0, 0);
     for k in 0..400 {
-        let g = frame(r.sym(7.0), 0.8 + 0.4 * r.next(), r.sym(0.6), 0.8 + 0.3 * r.next());
+        let g = frame(
+            r.sym(7.0),
+            0.8 + 0.4 * r.next(),
+            r.sym(0.6),
+            0.8 + 0.3 * r.next(),
+        );
         let l0 = 0.05;
         let d = g * l0;
         let mut h = jacobian([d[(0, 0)], d[(1, 0)], d[(0, 1)], d[(1, 1)]], |x| {
@@ -352,7 +377,10 @@ fn psd_projection_keeps_pd_blocks_and_removes_negative_curvature() {
             assert!(lp.iter().all(|&l| l >= -1e-12 * sb), "{lp:?}");
         }
     }
-    assert!(pd > 20 && indefinite > 20, "{pd} PD, {indefinite} indefinite");
+    assert!(
+        pd > 20 && indefinite > 20,
+        "{pd} PD, {indefinite} indefinite"
+    );
 }
 
 #[test]

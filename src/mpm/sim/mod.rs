@@ -554,13 +554,7 @@ impl YarnSim {
                 bending,
                 attractor,
             };
-            super::implicit::Problem::collect(
-                &self.particles,
-                &self.grid,
-                &model,
-                dt,
-                &pin_entries,
-            )
+            super::implicit::Problem::collect(&self.particles, &self.grid, &model, dt, &pin_entries)
         });
         if let Some(f) = &mut self.fields {
             f.record_masses(&self.grid);
