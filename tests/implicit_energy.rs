@@ -136,7 +136,10 @@ fn attractor_pulls_the_yarn_as_the_explicit_step_does() {
 
 /// The cantilever of `yarn_oracles` (200 vertices, B = 1 N m, tip sag
 /// ~1 % of L) under backward Euler at dt `dt`: the tip deflection averaged
-/// over two measured periods of the first mode, against q L_f^4 / (8 B).
+/// over two measured periods of the first mode (as the explicit oracle
+/// test; backward Euler's damping biases this mean at larger dt: +2.7 %
+/// measured at dt 5e-3), against q L_f^4 / (8 B); (tip, oracle, Newton
+/// and CG per substep, wall s per substep).
 fn cantilever(dt: f64, vertices: u32) -> (f64, f64, f64, f64, f64) {
     let (len, b, rho, g) = cantilever_setup();
     let mut s = YarnScene::from_toml_str(&cantilever_toml(vertices)).unwrap();
@@ -165,7 +168,7 @@ fn cantilever(dt: f64, vertices: u32) -> (f64, f64, f64, f64, f64) {
 #[test]
 #[cfg_attr(debug_assertions, ignore = "release-mode test (cargo test --release)")]
 fn cantilever_under_backward_euler_matches_euler_bernoulli() {
-    for dt in [1e-3] {
+    for dt in [1e-3, 2e-3] {
         let (tip, oracle, newton, cg, wall) = cantilever(dt, 200);
         let err = (tip - oracle) / oracle;
         eprintln!(
