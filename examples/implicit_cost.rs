@@ -2,7 +2,8 @@
 //! Newton and CG iterations and wall time per substep, and wall time per
 //! simulated second, for the cantilever of `tests/yarn_oracles.rs` (200
 //! vertices, B = 1 N m) and the built-in material (k 1000, gamma 500,
-//! E 1000, bending 1e-3, plasticity) on two falling yarns. Runs alternate
+//! E 1000, bending 1e-3, plasticity) on two falling yarns pressed together
+//! (3 m/s toward each other, spinning at 2 rad/s). Runs alternate
 //! (explicit, implicit 1e-4, implicit 1e-3, repeated `RUNS` times) and the
 //! medians are printed.
 //!
@@ -12,6 +13,7 @@
 
 use std::time::Instant;
 
+use yarnsim::math::{perp, Vec2};
 use yarnsim::scene::{Integrator, StepSize, YarnScene};
 use yarnsim::testing::cantilever_toml;
 use yarnsim::YarnSim;
@@ -42,13 +44,21 @@ spacing = [0.0, 0.01]
 
 /// One run of `duration` simulated seconds: (wall s per substep, Newton
 /// and CG per substep).
-fn run(base: &YarnScene, implicit: Option<f64>, duration: f64) -> (f64, f64, f64) {
+fn run(base: &YarnScene, implicit: Option<f64>, duration: f64, press: bool) -> (f64, f64, f64) {
     let mut s = base.clone();
     if let Some(dt) = implicit {
         s.time.integrator = Integrator::Implicit;
         s.time.dt = StepSize::Fixed(dt);
     }
     let mut sim = YarnSim::new(&s).unwrap();
+    if press {
+        let c = sim.diagnostics().center_of_mass;
+        let p = sim.particles_mut();
+        for (x, v) in p.vert.x.iter().zip(p.vert.v.iter_mut()) {
+            let toward = if x.y > c.y { -3.0 } else { 3.0 };
+            *v = perp(x - c) * 2.0 + Vec2::new(0.0, toward);
+        }
+    }
     let n = (duration / sim.dt()).round() as u64;
     let t0 = Instant::now();
     sim.steps_n(n).unwrap();
@@ -72,19 +82,21 @@ fn main() {
             "cantilever 200 vertices",
             YarnScene::from_toml_str(&cantilever_toml(200)).unwrap(),
             0.1,
+            false,
         ),
         (
             "built-in material, two yarns",
             YarnScene::from_toml_str(TWO_YARNS).unwrap(),
             0.1,
+            true,
         ),
     ];
-    for (name, scene, duration) in scenes {
+    for (name, scene, duration, press) in scenes {
         let modes = [None, Some(1e-4), Some(1e-3)];
         let mut t: Vec<Vec<(f64, f64, f64)>> = vec![Vec::new(); modes.len()];
         for _ in 0..runs {
             for (k, m) in modes.iter().enumerate() {
-                t[k].push(run(&scene, *m, duration));
+                t[k].push(run(&scene, *m, duration, press));
             }
         }
         let dt_ex = scene.time.dt.fixed().unwrap();

@@ -4,6 +4,9 @@
 //! simulation"): the block's eigen-decomposition by cyclic Jacobi
 //! rotations, negative eigenvalues set to 0.
 
+// small dense blocks and stencils: index loops read as the formulas
+#![allow(clippy::needless_range_loop)]
+
 /// Jacobi sweeps: a symmetric block of size <= 6 converges to round-off in
 /// far fewer (quadratic convergence after the first sweeps).
 const SWEEPS: usize = 12;

@@ -5,6 +5,9 @@
 //! clamps and the `r22 < 1` branch included) and the discrete-elastic-rod
 //! bending gradient of [`crate::mpm::vertex_forces`].
 
+// small dense blocks and stencils: index loops read as the formulas
+#![allow(clippy::needless_range_loop)]
+
 use std::ops::{Add, Div, Mul, Neg, Sub};
 
 use crate::mpm::constitutive::{YarnEnergy, R11_MIN, R22_MIN};

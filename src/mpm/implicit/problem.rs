@@ -5,6 +5,9 @@
 //! c_next)` with `x_k(v) = x_k + sum c_kn v_n`; per node its position for
 //! the attractor.
 
+// small dense blocks and stencils: index loops read as the formulas
+#![allow(clippy::needless_range_loop)]
+
 use super::super::constitutive::YarnEnergy;
 use super::super::grid::{Grid, VX, VY};
 use super::super::particles::{Particles, NONE};
