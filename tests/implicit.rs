@@ -12,7 +12,7 @@ use yarnsim::scene::{Integrator, YarnScene};
 use yarnsim::testing::{hanging_chain_period, hanging_chain_toml, ZeroCrossings, CHAIN_GRAVITY};
 use yarnsim::YarnSim;
 
-/// A bare scene of pure fibre stretch (the implicit step's scope).
+/// A bare scene of pure fibre stretch (the hanging chain's material).
 fn stretch_only() -> SceneBuilder {
     SceneBuilder::bare().material(|m| {
         m.gamma = 0.0;
