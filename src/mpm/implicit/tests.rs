@@ -186,6 +186,7 @@ fn stress_and_bending_gradient_are_the_explicit_force_laws() {
     }
     assert!(compressed > 500, "{compressed}");
     // same operations: 1e-13 relative at most (bitwise in practice)
+    eprintln!("quad gradient vs frame_gradient: {worst:.2e} ({compressed} of 2000 with r22 < 1)");
     assert!(
         worst <= 1e-13,
         "quad gradient vs frame_gradient: {worst:.3e}"
@@ -234,6 +235,7 @@ fn stress_and_bending_gradient_are_the_explicit_force_laws() {
     let fmax = f.iter().map(|f| f.norm()).fold(0.0, f64::max);
     assert!(fmax > 1e-3, "{fmax}");
     // same formula, other summation order: 1e-13 relative
+    eprintln!("bending gradient vs vertex_forces: {:.2e}", rel(&minus, &f));
     assert!(rel(&minus, &f) < 1e-13, "{:.3e}", rel(&minus, &f));
 }
 
@@ -255,6 +257,7 @@ fn gradient_matches_central_differences_of_the_energy() {
         }
         // tolerance 1e-6 relative (central differences: O(h^2) plus round-off)
         let e = rel(&g, &fd);
+        eprintln!("gradient vs central differences (attractor {attractor}): {e:.2e}");
         assert!(e < 1e-6, "gradient relative error {e:.3e}");
         // the elastic part is not negligible
         let m: Vec<Vec2> = (0..v.len())
@@ -292,6 +295,7 @@ fn hessian_vector_product_matches_central_differences_of_the_gradient() {
     let hd = p.hess_vec(&v, &d);
     // tolerance 1e-6 relative
     let e = rel(&hd, &fd);
+    eprintln!("exact Hessian-vector product vs central differences: {e:.2e}");
     assert!(e < 1e-6, "Hessian-vector product relative error {e:.3e}");
     // the elastic part is not negligible in this test
     let md: Vec<Vec2> = d.iter().zip(&p.mass).map(|(d, m)| d * *m).collect();
@@ -377,6 +381,7 @@ fn psd_projection_keeps_pd_blocks_and_removes_negative_curvature() {
             assert!(lp.iter().all(|&l| l >= -1e-12 * sb), "{lp:?}");
         }
     }
+    eprintln!("quadrature blocks: {pd} PD, {indefinite} indefinite of 400");
     assert!(
         pd > 20 && indefinite > 20,
         "{pd} PD, {indefinite} indefinite"
