@@ -120,7 +120,17 @@ fn attractor_pulls_the_yarn_as_the_explicit_step_does() {
     let mut ex = s.clone();
     ex.time.dt = StepSize::Fixed(1e-4);
     let de = run(ex);
-    let di = run(implicit(s, 1e-3));
+    let di = run(implicit(s.clone(), 1e-3));
+    // switched on at run time (no longer refused): the same bits
+    let mut off = implicit(s.clone(), 1e-3);
+    off.attractor.active = false;
+    let mut sim = YarnSim::new(&off).unwrap();
+    let c0 = sim.diagnostics().center_of_mass;
+    let mut a = sim.attractor();
+    a.active = true;
+    sim.set_attractor(a).unwrap();
+    sim.advance(0.05).unwrap();
+    assert_eq!(sim.diagnostics().center_of_mass - c0, di);
     // the acceleration s r / (r + 0.01) toward (0.5, 0.8): about 4.8 m/s^2
     // up at 0.3 m, so about 6e-3 m in 0.05 s
     eprintln!(
