@@ -115,11 +115,14 @@ fn integrator_defaults_to_explicit_and_is_left_out_of_the_toml() {
 
 #[test]
 fn implicit_integrator_outside_its_scope_is_refused_naming_the_field_and_line() {
-    // The minimal scene has a shear and cross-section energy the implicit
-    // step does not model (tests/implicit.rs covers each refusal): refused
-    // at load, not run with the explicit step.
+    // The minimal scene has the default sticky walls the implicit step
+    // does not model (tests/implicit.rs covers each refusal): refused at
+    // load, not run with the explicit step.
     let m = err(&GOOD.replace("dt = 1e-4", "dt = 1e-4\nintegrator = \"implicit\"")).to_string();
-    assert!(m.contains("material.") && m.contains("implicit"), "{m}");
+    assert!(m.contains("walls.mode") && m.contains("implicit"), "{m}");
+    // without walls its whole energy (shear, cross-section, plasticity) is in scope
+    let free = GOOD.replace("dt = 1e-4", "dt = 1e-4\nintegrator = \"implicit\"");
+    YarnScene::from_toml_str(&format!("{free}[walls]\nmode = \"none\"\n")).unwrap();
     // An unknown integrator is a field error too.
     let m = err(&GOOD.replace("dt = 1e-4", "dt = 1e-4\nintegrator = \"rk4\"")).to_string();
     assert!(

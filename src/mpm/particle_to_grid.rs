@@ -101,6 +101,8 @@ struct ScatterCtx<'a> {
     dt: f64,
     bending: f64,
     obstacles: &'a [Obstacle],
+    /// Whether the internal forces are scattered.
+    forces: bool,
     /// Which vertices and quadrature particles scatter into the held field
     /// (empty with one field).
     vert_held: &'a [bool],
@@ -131,11 +133,13 @@ fn split_chunks<T>(v: &mut [T], n: usize) -> Vec<&mut [T]> {
 /// alone too (in lanes that only FLIP reads); `obstacles` are the ones
 /// whose contact mass is marked.
 pub fn scatter(p: &mut Particles, grid: &mut Grid, dt: f64, bending: f64, obstacles: &[Obstacle]) {
-    scatter_fields(p, grid, None, dt, bending, obstacles)
+    scatter_fields(p, grid, None, dt, bending, obstacles, true)
 }
 
 /// [`scatter`] with two fields: the particles `held` names go into its
-/// grid instead (same window, same chunks).
+/// grid instead (same window, same chunks). `with_forces = false`: mass and
+/// momentum only (no vertex, bending or normal force; the vertex forces
+/// `p.vert.f` are left zero), for the implicit step, whose solve adds them.
 pub fn scatter_fields(
     p: &mut Particles,
     grid: &mut Grid,
@@ -143,6 +147,7 @@ pub fn scatter_fields(
     dt: f64,
     bending: f64,
     obstacles: &[Obstacle],
+    with_forces: bool,
 ) {
     // a window that holds every stencil
     let inv_dx = grid.geom.inv_dx;
@@ -174,6 +179,7 @@ pub fn scatter_fields(
         dt,
         bending,
         obstacles,
+        forces: with_forces,
         vert_held,
         quad_held,
     };
@@ -244,7 +250,12 @@ multiversion! {
         }
         let two = bufs.held.is_some();
         let (v0, q0) = (vr.start, qr.start);
-        vertex_forces(vert, &quad.t1, ctx.bending, vr.clone(), fs);
+        if ctx.forces {
+            vertex_forces(vert, &quad.t1, ctx.bending, vr.clone(), fs);
+        } else {
+            fs.fill(Vec2::zeros());
+        }
+        let normal_scale = if ctx.forces { normal_scale } else { 0.0 };
         let (vx, vm) = (&vert.x[vr.clone()], &vert.m[vr.clone()]);
         let (vv, vc) = (&vert.v[vr.clone()], &vert.c[vr]);
         let it = sts.iter_mut().zip(fs.iter()).zip(vx).zip(vm).zip(vv).zip(vc);

@@ -1,11 +1,13 @@
 //! Newton's method on `E(v)` ([`super::Problem`]) with a backtracking
 //! (Armijo) line search, each Newton system `H d = -g` solved by conjugate
-//! gradients with a Jacobi preconditioner on the exact Hessian-vector
-//! products, in the subspace that keeps the pins (projected gradient and
+//! gradients with a Jacobi preconditioner on the Hessian-vector products
+//! of the element blocks assembled once per Newton iteration (projected
+//! onto PSD by default, [`super::blocks`]), in the subspace that keeps the pins (projected gradient and
 //! preconditioner `Pi D^-1 Pi^T`). Serial, in a fixed order: the same bits
 //! for any thread count.
 
-use super::{dot, Problem};
+use super::precond::StiffPrecond;
+use super::{dot, Blocks, Problem};
 use crate::math::Vec2;
 
 /// Tolerances and caps of the solve.
@@ -14,9 +16,10 @@ pub struct Settings {
     /// Converged when the projected gradient norm is at most this times
     /// its norm at the start (`v = v*` made feasible).
     pub rel_tol: f64,
-    /// ... or at most this times `|M v*| + dt |F|`, `F` the segments'
-    /// forces at 100 % strain (`vol k / l0` each): the round-off floor of
-    /// the gradient, a strain of about this size.
+    /// ... or at most this times `|M v*| + dt |F|`, `F` the elements'
+    /// forces at unit strain ([`Problem::force_scale`]: stretch, shear and
+    /// normal stiffness, bending, attractor): the round-off floor of the
+    /// gradient, a strain of about this size.
     pub abs_tol: f64,
     /// Newton iterations before the step fails.
     pub max_newton: usize,
@@ -26,6 +29,9 @@ pub struct Settings {
     pub cg_tol: f64,
     /// Line-search halvings before the step fails.
     pub max_halvings: usize,
+    /// Project each element block onto the PSD cone (projected Newton);
+    /// `false`: the exact Hessian (CG then stops at negative curvature).
+    pub psd: bool,
     /// The CG preconditioner.
     pub precond: Precond,
 }
@@ -36,8 +42,30 @@ pub enum Precond {
     /// `diag H`.
     Jacobi,
     /// The fibre stretch exactly, the rest by its diagonal
-    /// ([`super::precond`]).
+    /// ([`super::precond`]), built at the solve's first Newton iterate and
+    /// kept for the others (any fixed SPD preconditioner keeps CG exact;
+    /// the Hessian changes little between Newton iterates).
     Stiff,
+}
+
+/// The preconditioner of one Newton system.
+enum Pre<'a> {
+    Jacobi(Vec<Vec2>),
+    Stiff(&'a StiffPrecond),
+}
+
+impl Pre<'_> {
+    /// `z = P^-1 r`.
+    fn apply(&self, r: &[Vec2], z: &mut [Vec2]) {
+        match self {
+            Pre::Jacobi(d) => {
+                for ((z, r), d) in z.iter_mut().zip(r).zip(d) {
+                    *z = Vec2::new(r.x / d.x, r.y / d.y);
+                }
+            }
+            Pre::Stiff(sp) => sp.apply(r, z),
+        }
+    }
 }
 
 impl Default for Settings {
@@ -49,6 +77,7 @@ impl Default for Settings {
             max_cg: 2000,
             cg_tol: 1e-4,
             max_halvings: 40,
+            psd: true,
             precond: Precond::Stiff,
         }
     }
@@ -87,7 +116,7 @@ pub fn solve(p: &Problem, s: &Settings) -> Result<Solution, String> {
     let g0 = dot(&g, &g).sqrt();
     let tol = (s.rel_tol * g0).max(s.abs_tol * (mv + p.dt() * p.force_scale()));
     let mut e = p.energy(&v);
-    let mut pre = None;
+    let mut stiff = None;
     loop {
         let gn = dot(&g, &g).sqrt();
         if gn <= tol || gn == 0.0 {
@@ -101,12 +130,19 @@ pub fn solve(p: &Problem, s: &Settings) -> Result<Solution, String> {
             ));
         }
         stats.newton += 1;
-        let pre = pre.get_or_insert_with(|| Pre::new(p, &v, s));
-        let (mut d, its) = pcg(p, &v, &g, s, pre);
+        let blocks = p.blocks(&v, s.psd);
+        let pre = match s.precond {
+            Precond::Jacobi => Pre::Jacobi(p.diagonal(&blocks)),
+            Precond::Stiff => Pre::Stiff(stiff.get_or_insert_with(|| {
+                let rows = p.stiff_rows(&v, &blocks);
+                StiffPrecond::new(&p.diagonal_rest(&blocks, &rows), &rows)
+            })),
+        };
+        let (mut d, its) = pcg(p, &blocks, &g, s, &pre);
         stats.cg += its;
-        if !p.has_pins() {
-            // The exact Newton step changes the momentum by -sum g (K has
-            // no translation part); put CG's error in that mode right with
+        if !p.has_pins() && !p.has_external() {
+            // The exact Newton step changes the momentum by -sum g (the
+            // elastic blocks have no translation part); put CG's error in that mode right with
             // a uniform velocity, so the momentum is kept to round-off
             // (sum g = 0 at v* and stays so) at any CG tolerance.
             let mass: f64 = p.mass.iter().sum();
@@ -159,42 +195,10 @@ pub fn solve(p: &Problem, s: &Settings) -> Result<Solution, String> {
 }
 
 /// Preconditioned CG on `H d = -g` in the pin-keeping subspace; returns
-/// `d` and the iterations. Stops at negative curvature (the exact spring
-/// Hessian is indefinite for compressed segments): with the iterate so
-/// far, or the preconditioned steepest descent when that is the first.
-/// The preconditioner of one solve, built at its first Newton iterate and
-/// kept for the others (any fixed SPD preconditioner keeps CG exact; the
-/// Hessian changes little between Newton iterates).
-enum Pre {
-    Jacobi(Vec<Vec2>),
-    Stiff(super::precond::StiffPrecond),
-}
-
-impl Pre {
-    fn new(p: &Problem, v: &[Vec2], s: &Settings) -> Self {
-        match s.precond {
-            Precond::Jacobi => Pre::Jacobi(p.diagonal(v)),
-            Precond::Stiff => Pre::Stiff(super::precond::StiffPrecond::new(
-                &p.diagonal_rest(v),
-                &p.stiff_rows(v),
-            )),
-        }
-    }
-
-    /// `z = P^-1 r`.
-    fn apply(&self, r: &[Vec2], z: &mut [Vec2]) {
-        match self {
-            Pre::Jacobi(d) => {
-                for ((z, r), d) in z.iter_mut().zip(r).zip(d) {
-                    *z = Vec2::new(r.x / d.x, r.y / d.y);
-                }
-            }
-            Pre::Stiff(sp) => sp.apply(r, z),
-        }
-    }
-}
-
-fn pcg(p: &Problem, v: &[Vec2], g: &[Vec2], s: &Settings, pre: &Pre) -> (Vec<Vec2>, usize) {
+/// `d` and the iterations. Stops at negative curvature (only with the
+/// exact, unprojected blocks): with the iterate so far, or the
+/// preconditioned steepest descent when that is the first.
+fn pcg(p: &Problem, blocks: &Blocks, g: &[Vec2], s: &Settings, pre: &Pre) -> (Vec<Vec2>, usize) {
     // z = Pi P^-1 Pi^T r, and |Pi^T r| (the residual that can vanish)
     let precond = |r: &[Vec2]| -> (Vec<Vec2>, f64) {
         let mut r = r.to_vec();
@@ -212,7 +216,7 @@ fn pcg(p: &Problem, v: &[Vec2], g: &[Vec2], s: &Settings, pre: &Pre) -> (Vec<Vec
     let mut pd = z.clone();
     let mut rz = dot(&r, &z);
     for it in 0..s.max_cg {
-        let hp = p.hess_vec(v, &pd);
+        let hp = p.hess_vec_blocks(blocks, &pd);
         let curv = dot(&pd, &hp);
         if curv <= 0.0 {
             if it == 0 {

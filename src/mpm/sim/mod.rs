@@ -507,12 +507,6 @@ impl YarnSim {
         };
 
         let implicit = self.is_implicit();
-        if implicit && passes.attractor {
-            // validated at load; the attractor can be switched on at run time
-            return Err(SimError::BadInput(
-                "the implicit integrator does not model the attractor: switch it off".into(),
-            ));
-        }
         let transfer = self.transfer;
         let flip = transfer.needs_delta();
         let t0 = Instant::now();
@@ -526,12 +520,8 @@ impl YarnSim {
             .fields
             .as_mut()
             .map(|f| (&mut f.grid, &f.vert_held[..], &f.quad_held[..]));
-        // implicit: the scatter carries momentum only, the fibre forces
-        // enter through the solve
-        let t1_kept = implicit.then(|| {
-            let n = self.particles.quad.t1.len();
-            std::mem::replace(&mut self.particles.quad.t1, vec![Vec2::zeros(); n])
-        });
+        // implicit: the scatter carries momentum only, the internal forces
+        // (and the attractor) enter through the solve
         particle_to_grid::scatter_fields(
             &mut self.particles,
             &mut self.grid,
@@ -539,16 +529,15 @@ impl YarnSim {
             dt,
             bending,
             obstacles,
+            !implicit,
         );
-        if let Some(t1) = t1_kept {
-            self.particles.quad.t1 = t1;
-        }
         let t2 = Instant::now();
+        let attractor = passes
+            .attractor
+            .then_some((self.attractor.position, self.attractor.strength));
         let ext = GridForces {
             gravity: self.gravity,
-            attractor: passes
-                .attractor
-                .then_some((self.attractor.position, self.attractor.strength)),
+            attractor: if implicit { None } else { attractor },
             obstacles,
             walls: self.scene.walls.mode,
             wall_cells: self.scene.walls.cells as usize,
@@ -560,13 +549,12 @@ impl YarnSim {
             pins::stencil_masses(&self.pins, &self.particles.vert, held, self.time + dt)
         };
         let mut problem = implicit.then(|| {
-            super::implicit::Problem::collect(
-                &self.particles,
-                &self.grid,
-                self.energy.k,
-                dt,
-                &pin_entries,
-            )
+            let model = super::implicit::Model {
+                energy: self.energy,
+                bending,
+                attractor,
+            };
+            super::implicit::Problem::collect(&self.particles, &self.grid, &model, dt, &pin_entries)
         });
         // implicit: v* without obstacles and walls; they act on the solved velocities
         let (interior, mut masses) = (ext.without_boundaries(), Vec::new());

@@ -204,9 +204,9 @@ pub enum Integrator {
     Explicit,
     /// Backward Euler on the grid velocities as a minimisation (Gast,
     /// Schroeder, Stomakhin, Jiang, Teran 2015, "Optimization integrator for
-    /// large time steps", IEEE TVCG 21(10)), [`crate::mpm::implicit`]: only
-    /// for pure fibre stretch in one velocity field (pins, obstacles and
-    /// walls act as in the explicit step); a
+    /// large time steps", IEEE TVCG 21(10)), [`crate::mpm::implicit`]: the
+    /// whole yarn energy in one velocity field (pins, obstacles and walls
+    /// act as in the explicit step, after the solve); a
     /// scene outside that scope is refused at load naming the field, never
     /// run with the explicit step instead.
     Implicit,

@@ -73,16 +73,15 @@ impl YarnScene {
         Ok(())
     }
 
-    /// `integrator = "implicit"` runs only scenes whose energy is pure
-    /// fibre stretch, in one velocity field ([`crate::mpm::implicit`]; pins,
-    /// obstacles and walls act as in the explicit step); anything else is
-    /// refused naming the field.
+    /// `integrator = "implicit"` runs the whole yarn energy in one velocity
+    /// field ([`crate::mpm::implicit`]; pins, obstacles and walls act as in
+    /// the explicit step); anything else is refused naming the field.
     fn validate_implicit(&self, text: Option<&str>) -> Result<(), SceneError> {
         if self.time.integrator != Integrator::Implicit {
             return Ok(());
         }
-        let why = "the implicit integrator (time.integrator = \"implicit\") models only pure \
-                   fibre stretch in one velocity field";
+        let why = "the implicit integrator (time.integrator = \"implicit\") runs in one \
+                   velocity field";
         let refuse = |table: &str, key: &str, what: String| SceneError::Invalid {
             field: if table.is_empty() {
                 key.to_string()
@@ -98,34 +97,6 @@ impl YarnScene {
             }),
             message: format!("{what}: {why}; use integrator = \"explicit\""),
         };
-        let m = &self.material;
-        for (key, value) in [
-            ("gamma", m.gamma),
-            ("youngs_modulus", m.youngs_modulus),
-            ("bending", m.bending),
-        ] {
-            if value != 0.0 {
-                return Err(refuse(
-                    "material",
-                    key,
-                    format!("is {value}, the implicit step has no such energy yet (needs 0)"),
-                ));
-            }
-        }
-        if m.plasticity {
-            return Err(refuse(
-                "material",
-                "plasticity",
-                "is true, the implicit step has no return mapping (needs false)".into(),
-            ));
-        }
-        if self.attractor.active && self.attractor.strength != 0.0 {
-            return Err(refuse(
-                "attractor",
-                "active",
-                "is true, the implicit step has no attractor energy (needs false)".into(),
-            ));
-        }
         let yarns: usize = self.yarns.iter().map(|y| y.count as usize).sum();
         let mut held = vec![false; yarns];
         for p in &self.pins {
