@@ -87,7 +87,11 @@ pub fn stepping_of(scene: &YarnScene) -> Stepping {
         StepSize::Fixed(dt) => Stepping::Fixed(dt),
         StepSize::Auto => Stepping::Auto {
             safety: scene.time.safety.unwrap_or(DEFAULT_SAFETY),
-            dt_max: scene.time.dt_max.unwrap_or(f64::INFINITY),
+            // implicit: no stability cap, so the frame time by default
+            dt_max: scene.time.dt_max.unwrap_or(match scene.time.integrator {
+                Integrator::Implicit => scene.time.frame_dt,
+                Integrator::Explicit => f64::INFINITY,
+            }),
         },
     }
 }
