@@ -190,8 +190,10 @@ impl YarnSim {
     }
     /// The adaptive substep of the current state:
     /// `min(safety * stable_dt, dt_max)` ([`YarnSim::stable_dt`]: the
-    /// elastic-wave plus particle-speed CFL bound and the bending bound);
-    /// with a fixed `dt`, safety [`DEFAULT_SAFETY`] and no cap.
+    /// elastic-wave plus particle-speed CFL bound and the bending bound;
+    /// under the implicit integrator the advection limit alone, `dt_max`
+    /// defaulting to `frame_dt`); with a fixed `dt`, safety
+    /// [`DEFAULT_SAFETY`] and no cap.
     pub fn auto_dt(&self) -> f64 {
         let (safety, dt_max) = match self.stepping {
             Stepping::Auto { safety, dt_max } => (safety, dt_max),
