@@ -4,11 +4,16 @@
 //! on stdout per run.
 //!
 //! ```text
-//! cargo run --release --example peers_chain -- chain VERTICES GRID DT
-//! cargo run --release --example peers_chain -- cantilever VERTICES
-//! cargo run --release --example peers_chain -- capstan R L1 L2 MU
-//! cargo run --release --example peers_chain -- bundle DURATION
+//! cargo run --release --example peers_chain -- chain VERTICES GRID DT [INTEGRATOR]
+//! cargo run --release --example peers_chain -- cantilever VERTICES [INTEGRATOR]
+//! cargo run --release --example peers_chain -- capstan R L1 L2 MU [INTEGRATOR]
+//! cargo run --release --example peers_chain -- bundle DURATION [INTEGRATOR]
 //! ```
+//!
+//! `INTEGRATOR` is `explicit` (the default) or `implicit` (the scene's
+//! `[time] integrator`). A scene the implicit integrator refuses prints
+//! `{"ok": false, "refused": "<the scene error>"}` and exits 0, so the
+//! driver records the refusal instead of failing.
 //!
 //! * `chain`: the hanging chain of the oracle test (L = 0.8 m pinned at the
 //!   top, k = 2000, no bending, started in the first mode shape
@@ -29,7 +34,7 @@
 use std::time::Instant;
 
 use yarnsim::scene::builtin::yarn_reference;
-use yarnsim::scene::YarnScene;
+use yarnsim::scene::{Integrator, YarnScene};
 use yarnsim::testing::{
     cantilever_setup, cantilever_toml, capstan_toml, capstan_vertices, hanging_chain_period,
     hanging_chain_toml, two_periods_about_mean, ZeroCrossings, CAPSTAN_PURE_STRING,
@@ -43,6 +48,47 @@ fn scene(text: &str) -> YarnScene {
     })
 }
 
+/// A JSON string literal of `s`.
+fn json_str(s: &str) -> String {
+    let mut out = String::from("\"");
+    for c in s.chars() {
+        match c {
+            '"' => out.push_str("\\\""),
+            '\\' => out.push_str("\\\\"),
+            '\n' => out.push_str("\\n"),
+            c if (c as u32) < 0x20 => out.push_str(&format!("\\u{:04x}", c as u32)),
+            c => out.push(c),
+        }
+    }
+    out.push('"');
+    out
+}
+
+/// The simulation of `s` under `integrator`; a scene it refuses prints the
+/// refusal as the run's JSON line and ends the process (status 0).
+fn sim_with(mut s: YarnScene, integrator: Integrator) -> YarnSim {
+    s.time.integrator = integrator;
+    YarnSim::new(&s).unwrap_or_else(|e| {
+        println!(
+            "{{\"ok\": false, \"refused\": {}}}",
+            json_str(&e.to_string())
+        );
+        std::process::exit(0)
+    })
+}
+
+/// The optional trailing `INTEGRATOR` argument at `i`.
+fn integrator(args: &[String], i: usize) -> Integrator {
+    match args.get(i).map(String::as_str) {
+        None | Some("explicit") => Integrator::Explicit,
+        Some("implicit") => Integrator::Implicit,
+        Some(x) => {
+            eprintln!("INTEGRATOR must be explicit or implicit, got {x:?}");
+            std::process::exit(2)
+        }
+    }
+}
+
 fn arg<T: std::str::FromStr>(args: &[String], i: usize, name: &str) -> T {
     args.get(i).and_then(|s| s.parse().ok()).unwrap_or_else(|| {
         eprintln!("missing or invalid argument {name}");
@@ -50,9 +96,9 @@ fn arg<T: std::str::FromStr>(args: &[String], i: usize, name: &str) -> T {
     })
 }
 
-fn chain(vertices: u32, grid: u32, dt: &str) -> String {
+fn chain(vertices: u32, grid: u32, dt: &str, integ: Integrator) -> String {
     let s = scene(&hanging_chain_toml(vertices, grid, dt));
-    let mut sim = YarnSim::new(&s).unwrap();
+    let mut sim = sim_with(s, integ);
     let duration = 3.4;
     let mut crossings = ZeroCrossings::new(sim.yarn_endpoints(0).1.x - 0.5);
     let mut ok = true;
@@ -79,10 +125,10 @@ fn chain(vertices: u32, grid: u32, dt: &str) -> String {
     )
 }
 
-fn cantilever(vertices: u32) -> String {
+fn cantilever(vertices: u32, integ: Integrator) -> String {
     let (len, b, rho, g) = cantilever_setup();
     let s = scene(&cantilever_toml(vertices));
-    let mut sim = YarnSim::new(&s).unwrap();
+    let mut sim = sim_with(s, integ);
     let free = len - 0.5 * len / (vertices - 1) as f64;
     let oracle = rho * g * free.powi(4) / (8.0 * b);
     let omega1 = 1.8751f64.powi(2) * (b / (rho * free.powi(4))).sqrt();
@@ -112,11 +158,11 @@ fn cantilever(vertices: u32) -> String {
     )
 }
 
-fn capstan(r: f64, l1: f64, l2: f64, mu: f64) -> String {
+fn capstan(r: f64, l1: f64, l2: f64, mu: f64, integ: Integrator) -> String {
     let c = CAPSTAN_PURE_STRING;
     let vertices = capstan_vertices(r, l1, l2, c.res);
     let s = scene(&capstan_toml(r, l1, l2, mu, &c));
-    let mut sim = YarnSim::new(&s).unwrap();
+    let mut sim = sim_with(s, integ);
     let t0 = Instant::now();
     let mut ok = sim.advance(0.2).is_ok();
     let (a0, b0) = sim.yarn_endpoints(0);
@@ -146,9 +192,8 @@ fn capstan(r: f64, l1: f64, l2: f64, mu: f64) -> String {
     )
 }
 
-fn bundle(duration: f64) -> String {
-    let s = yarn_reference();
-    let mut sim = YarnSim::new(&s).unwrap();
+fn bundle(duration: f64, integ: Integrator) -> String {
+    let mut sim = sim_with(yarn_reference(), integ);
     let t0 = Instant::now();
     let ok = sim.advance(duration).is_ok();
     let wall = t0.elapsed().as_secs_f64();
@@ -183,15 +228,17 @@ fn main() {
             arg(&args, 1, "VERTICES"),
             arg(&args, 2, "GRID"),
             &arg::<String>(&args, 3, "DT"),
+            integrator(&args, 4),
         ),
-        Some("cantilever") => cantilever(arg(&args, 1, "VERTICES")),
+        Some("cantilever") => cantilever(arg(&args, 1, "VERTICES"), integrator(&args, 2)),
         Some("capstan") => capstan(
             arg(&args, 1, "R"),
             arg(&args, 2, "L1"),
             arg(&args, 3, "L2"),
             arg(&args, 4, "MU"),
+            integrator(&args, 5),
         ),
-        Some("bundle") => bundle(arg(&args, 1, "DURATION")),
+        Some("bundle") => bundle(arg(&args, 1, "DURATION"), integrator(&args, 2)),
         _ => {
             eprintln!("usage: peers_chain chain|cantilever|capstan|bundle ARGS (see the source)");
             std::process::exit(2)

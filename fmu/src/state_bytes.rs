@@ -17,7 +17,8 @@ pub const STATE_MAGICS: [&[u8; 8]; 2] = [YARN_STATE_MAGIC, MASS_SPRING_STATE_MAG
 /// `transfer.flip_ratio` override, the pin inputs and the pin force sums.
 /// Version 3: the YarnBundle part no longer repeats gravity and the
 /// attractor, which only the library's state bytes hold.
-pub const STATE_VERSION: u32 = 3;
+/// Version 4: the YarnBundle part holds the `integrator` override.
+pub const STATE_VERSION: u32 = 4;
 
 pub(crate) const STATE_HEADER: usize = 8 + 4 + 8 + 8;
 

@@ -11,7 +11,7 @@ use common::*;
 use yarnsim::massspring::scenes::wire;
 use YarnBundle::ffi::*;
 use YarnBundle::model::{self as neutral, Dependency, VarType, Variable, VR_SUBSTEPS};
-use YarnBundle::yarn::variables::{self as model, VR_SCENE};
+use YarnBundle::yarn::variables::{self as model, VR_INTEGRATOR, VR_SCENE};
 
 /// How a variable is changed in the test.
 #[derive(Clone, Debug)]
@@ -39,7 +39,8 @@ fn apply(f: &Fmu, vr: u32, c: &Change) -> fmi2Status {
     }
 }
 
-/// A different, valid value for each input and parameter.
+/// A different, valid value for each input and parameter (`None`: none
+/// that the yarn scenes here accept).
 fn change_of(v: &Variable, alt_scene: &str) -> Option<Change> {
     let start = v.start.as_deref().unwrap_or("");
     Some(match v.ty {
@@ -60,6 +61,10 @@ fn change_of(v: &Variable, alt_scene: &str) -> Option<Change> {
         VarType::String if v.name == "transfer.scheme" => {
             Change::Str(if start == "flip" { "apic" } else { "flip" }.into())
         }
+        // the small and driven scenes are outside the implicit step's
+        // scope (refused at initialization); tests/integrator.rs checks
+        // that the integrator changes no output at initialization
+        VarType::String if v.vr == VR_INTEGRATOR => return None,
         VarType::String => Change::Str("symplectic-euler".into()),
     })
 }
@@ -147,12 +152,14 @@ fn check_initial_with(
         .iter()
         .filter(|v| matches!(v.causality, "input" | "parameter"))
     {
+        let Some(c) = change_of(v, alt_scene) else {
+            continue;
+        };
         let g = new();
         if v.vr == VR_SCENE {
             std::fs::write(g.dir.join(alt_scene), alt_text).unwrap();
         }
         enter(&g);
-        let c = change_of(v, alt_scene).unwrap();
         assert_eq!(apply(&g, v.vr, &c), fmi2OK, "{} {:?}", v.name, g.lines());
         let now = g.get_real(&outs).unwrap();
         for (k, &o) in outs.iter().enumerate() {

@@ -36,6 +36,19 @@
 //! current largest particle speed, so at initialization it is the elastic
 //! bound of a scene at rest, a necessary condition, not a guarantee.
 //!
+//! **Implicit integrator** (`[time] integrator = "implicit"`, backward
+//! Euler on the grid velocities, [`crate::mpm::implicit`]): the elastic
+//! forces enter the solve, so neither the elastic-wave nor the bending
+//! bound applies. What remains is advection: a particle must not cross
+//! more than one cell per substep (the gather's check), so
+//! [`YarnSim::stable_dt`] is `COURANT dx / |v|max` ([`implicit_stable_dt`];
+//! infinite at rest) and `dt = "auto"` takes `min(safety * dx / |v|max,
+//! dt_max)`, `dt_max` defaulting to the scene's `frame_dt` under the
+//! implicit integrator (no default cap under the explicit one). Accuracy,
+//! not stability, decides a good cap: backward Euler damps and slows a
+//! mode of angular frequency `omega` by terms in `(omega dt)^2` (measured on
+//! the hanging chain in `tests/implicit.rs`).
+//!
 //! `[time] dt = "auto"` applies the bound in every substep instead:
 //! [`YarnSim::auto_dt`] is `min(safety * stable_dt, dt_max)` of the state
 //! the substep starts from (default safety
@@ -69,6 +82,13 @@ pub fn stable_dt(m: &Material, dx: f64, v_max: f64) -> f64 {
     }
 }
 
+/// The implicit integrator's substep bound in s: the advection limit
+/// `COURANT dx / |v|max` alone (infinite for `v_max = 0`); the elastic and
+/// bending bounds of [`stable_dt`] are for the explicit step only.
+pub fn implicit_stable_dt(dx: f64, v_max: f64) -> f64 {
+    COURANT * dx / v_max.abs()
+}
+
 impl YarnSim {
     /// The largest particle speed now, in m/s (vertices and quadrature
     /// particles). A parallel maximum: the same value for any thread count
@@ -87,9 +107,13 @@ impl YarnSim {
 
     /// The stable substep bound of the current state
     /// ([`stable_dt`] with this scene's material, grid and the current
-    /// largest particle speed). The simulation's own `dt()` should not
-    /// exceed it.
+    /// largest particle speed; under the implicit integrator
+    /// [`implicit_stable_dt`], the advection limit alone). The
+    /// simulation's own `dt()` should not exceed it.
     pub fn stable_dt(&self) -> f64 {
+        if self.is_implicit() {
+            return implicit_stable_dt(self.grid_geom().dx, self.max_speed());
+        }
         stable_dt(
             &self.scene().material,
             self.grid_geom().dx,

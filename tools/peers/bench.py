@@ -13,8 +13,10 @@ round the tools take turns (the order rotates from round to round) and the
 wall time is the median over the rounds; errors are deterministic. The
 capstan threshold is a bisection (slides at 0.7 mu*, holds at 1.4 mu*, then
 five halvings: a bracket of 2.2 % of mu*; yarnsim's test does three) and the bundle a single window; both run
-once. `--quick` (under a minute) runs the coarsest chain and cantilever of
-each tool, once, and writes `peers_quick.csv` / `.svg` into `--out` (default
+once. yarnsim runs under both integrators (`mpm-explicit`, `mpm-implicit`);
+a scene the implicit integrator refuses is a row with ok=False and the
+refusal in `note`. `--quick` (under a minute) runs the coarsest chain and
+cantilever of each tool (and the implicit chain at 25 vertices, dt 1e-2), once, and writes `peers_quick.csv` / `.svg` into `--out` (default
 for quick: the system temp directory) instead of `peers.csv` / `.svg`.
 """
 
@@ -61,6 +63,15 @@ def cases(quick):
         c.append(("yarnsim", "mpm-explicit", "chain",
                   f"{v} vertices, {g}^2, dt {dt.strip(chr(34))}",
                   lambda v=v, g=g, dt=dt: yarnsim_rope.chain(v, g, dt)))
+    # backward Euler (`integrator = "implicit"`): 10x and 100x the explicit
+    # step, and dt "auto" (the advection limit capped by dt_max = frame_dt)
+    ch_im = [(25, 16)] if quick else [(25, 16), (50, 32), (100, 64)]
+    dts_im = ["1e-2"] if quick else ["1e-3", "1e-2", '"auto"']
+    for v, g in ch_im:
+        for dt in dts_im:
+            c.append(("yarnsim", "mpm-implicit", "chain",
+                      f"{v} vertices, {g}^2, dt {dt.strip(chr(34))}",
+                      lambda v=v, g=g, dt=dt: yarnsim_rope.chain(v, g, dt, "implicit")))
     ca_mj = [25] if quick else [25, 50, 100]
     ca_el = [] if quick else [25, 50]
     ca_ys = [] if quick else [100, 200]
@@ -73,6 +84,11 @@ def cases(quick):
     for v in ca_ys:
         c.append(("yarnsim", "mpm-explicit", "cantilever", f"{v} vertices, 64^2, dt 5e-5",
                   lambda v=v: yarnsim_rope.cantilever(v)))
+    # the same scenes under the implicit integrator: recorded as ok=False
+    # with the refusal in `note` while it does not model bending
+    for v in ca_ys:
+        c.append(("yarnsim", "mpm-implicit", "cantilever", f"{v} vertices, 64^2, dt 5e-5",
+                  lambda v=v: yarnsim_rope.cantilever(v, "implicit")))
     return c
 
 
@@ -91,8 +107,12 @@ def interleave(cs, rounds):
                     i = queues[t].pop(0)
                     res = cs[i][4]()
                     results[i].append(res)
-                    print(f"  round {r + 1} {cs[i][0]:10s} {cs[i][2]:10s} {cs[i][3]:28s} "
-                          f"error {res['error']:+.4%} wall {res['wall_s']:.3f} s "
+                    if "refused" in res:
+                        print(f"  round {r + 1} {cs[i][0]:10s} {cs[i][1]:12s} {cs[i][2]:10s} "
+                              f"{cs[i][3]:28s} refused: {res['refused']}", flush=True)
+                        continue
+                    print(f"  round {r + 1} {cs[i][0]:10s} {cs[i][1]:12s} {cs[i][2]:10s} "
+                          f"{cs[i][3]:28s} error {res['error']:+.4%} wall {res['wall_s']:.3f} s "
                           f"for {res['sim_s']:.3f} s", flush=True)
     return results
 
@@ -116,15 +136,20 @@ def capstan(tool, slides, setting, integrator, rows):
         return s
 
     lo, hi = 0.7 * mu_star, 1.4 * mu_star
-    if not run(lo) or run(hi):
-        ok = False
-    else:
-        for _ in range(5):
-            mid = 0.5 * (lo + hi)
-            if run(mid):
-                lo = mid
-            else:
-                hi = mid
+    try:
+        if not run(lo) or run(hi):
+            ok = False
+        else:
+            for _ in range(5):
+                mid = 0.5 * (lo + hi)
+                if run(mid):
+                    lo = mid
+                else:
+                    hi = mid
+    except yarnsim_rope.Refused as e:
+        print(f"  capstan {tool:10s} {integrator} {setting}: refused: {e}", flush=True)
+        rows.append(refused_row(tool, integrator, "capstan", setting, str(e)))
+        return
     mu = 0.5 * (lo + hi)
     err = (mu - mu_star) / mu_star
     print(f"  capstan {tool:10s} {setting}: mu* {mu_star:.4f}, threshold in [{lo:.4f}, {hi:.4f}], "
@@ -137,15 +162,28 @@ def capstan(tool, slides, setting, integrator, rows):
                           f"{(hi - mu_star) / mu_star:+.1%}]"))
 
 
+def refused_row(tool, integrator, case, setting, note):
+    """A run the scene validation refused: ok=False, the refusal in note."""
+    nan = float("nan")
+    return dict(tool=tool, integrator=integrator, case=case, setting=setting, error=nan,
+                wall_s_per_sim_s=nan, wall_s=nan, sim_s=nan, rounds=1, ok=False, note=note)
+
+
 def bundle(rows, duration):
     b = O.BUNDLE
     for tool, integ, setting, fn in [
         ("yarnsim", "mpm-explicit", "256^2, dt 4e-5 (yarn-reference)",
          lambda: yarnsim_rope.bundle(duration)),
+        ("yarnsim", "mpm-implicit", "256^2, dt 4e-5 (yarn-reference)",
+         lambda: yarnsim_rope.bundle(duration, "implicit")),
         ("mujoco", "discrete", "CG, dt 1e-3, r 1.9 mm, planar (y armature 1e6)",
          lambda: mujoco_rope.bundle(duration)),
     ]:
         res = fn()
+        if "refused" in res:
+            print(f"  bundle {tool:10s} {integ} {setting}: refused: {res['refused']}", flush=True)
+            rows.append(refused_row(tool, integ, "bundle", setting, res["refused"]))
+            continue
         m = bundle_metrics.describe(res["yarns"], b)
         if "out_of_plane" in res:
             m += f"; out-of-plane drift {res['out_of_plane']:.2e} m"
@@ -209,11 +247,15 @@ def main():
         sim = rs[0]["sim_s"]
         rows.append(dict(tool=tool, integrator=integ, case=case, setting=setting,
                          error=rs[0]["error"], wall_s_per_sim_s=wall / sim, wall_s=wall,
-                         sim_s=sim, rounds=len(rs), ok=all(r["ok"] for r in rs), note=""))
+                         sim_s=sim, rounds=len(rs), ok=all(r["ok"] for r in rs),
+                         note=rs[0].get("note", "")))
     if not a.quick:
         capstan("yarnsim", lambda mu: yarnsim_rope.capstan_slides(
             O.CAPSTAN["radius"], O.CAPSTAN["l1"], O.CAPSTAN["l2"], mu),
             "184 vertices, 128^2, dt 1e-4", "mpm-explicit", rows)
+        capstan("yarnsim", lambda mu: yarnsim_rope.capstan_slides(
+            O.CAPSTAN["radius"], O.CAPSTAN["l1"], O.CAPSTAN["l2"], mu, "implicit"),
+            "184 vertices, 128^2, dt 1e-4", "mpm-implicit", rows)
         capstan("pyelastica", lambda mu: elastica_rope.capstan_slides(70, mu),
                 "70 elements, dt 5e-5, c_v 50", "position-verlet", rows)
         for n in (50, 100):
@@ -221,9 +263,10 @@ def main():
                     f"{n} elements, dt 1e-3", "discrete", rows)
         if not a.skip_bundle:
             bundle(rows, a.bundle_duration)
-    # ratios against yarnsim's first setting of the same case (same run)
+    # ratios against yarnsim's first explicit setting of the same case (same run)
     for r in rows:
-        ref = next((x for x in rows if x["tool"] == "yarnsim" and x["case"] == r["case"]), None)
+        ref = next((x for x in rows if x["tool"] == "yarnsim" and x["integrator"] == "mpm-explicit"
+                    and x["case"] == r["case"]), None)
         r["wall_vs_yarnsim"] = (r["wall_s_per_sim_s"] / ref["wall_s_per_sim_s"]
                                 if ref and ref["wall_s_per_sim_s"] > 0 else float("nan"))
     os.makedirs(out, exist_ok=True)

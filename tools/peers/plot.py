@@ -4,6 +4,8 @@ simulated second) as a plain SVG, one line per tool, integrator and case."""
 import math
 
 COLORS = {"yarnsim": "#1f77b4", "mujoco": "#d62728", "pyelastica": "#2ca02c"}
+# a tool's other integrators (by (tool, integrator)); default: COLORS[tool]
+INTEGRATOR_COLORS = {("yarnsim", "mpm-implicit"): "#9467bd"}
 DASH = {"chain": "", "cantilever": "6,3", "capstan": "2,2"}
 MARK = {"chain": "circle", "cantilever": "square", "capstan": "diamond"}
 
@@ -55,7 +57,7 @@ def work_precision(rows, path, title):
     ly_leg = mt + 10
     for (tool, integ, case), rs in sorted(groups.items()):
         rs = sorted(rs, key=lambda r: r["wall_s_per_sim_s"])
-        col = COLORS.get(tool, "black")
+        col = INTEGRATOR_COLORS.get((tool, integ), COLORS.get(tool, "black"))
         xy = [(X(r["wall_s_per_sim_s"]), Y(abs(r["error"]))) for r in rs]
         if len(xy) > 1:
             d = " ".join(f"{x:.1f},{y:.1f}" for x, y in xy)

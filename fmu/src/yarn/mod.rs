@@ -5,10 +5,9 @@
 
 use std::path::Path;
 
-use yarnsim::math::Vec2;
 use yarnsim::mpm::state::DynamicState;
 use yarnsim::mpm::{Diagnostics, SimError, YarnSim};
-use yarnsim::scene::{TransferScheme, YarnScene};
+use yarnsim::scene::{Integrator, TransferScheme, YarnScene};
 
 use crate::fmu_model::{
     refuse, Checkpoint, FmuModel, ModelError, ModelResult, ModelState, ParamCheck, SetContext,
@@ -20,6 +19,7 @@ use crate::state_bytes::{Reader, Writer};
 pub mod arrays;
 mod forces;
 mod inputs;
+mod state;
 pub mod variables;
 
 pub use forces::PinForces;
@@ -35,6 +35,8 @@ pub struct Config {
     pub plasticity: Option<bool>,
     /// `transfer.scheme`.
     pub scheme: Option<TransferScheme>,
+    /// `integrator` (`time.integrator`).
+    pub integrator: Option<Integrator>,
 }
 
 impl Default for Config {
@@ -44,6 +46,7 @@ impl Default for Config {
             reals: [None; YARN_REAL_PARAMETERS],
             plasticity: None,
             scheme: None,
+            integrator: None,
         }
     }
 }
@@ -70,6 +73,9 @@ fn effective_scene(base: &YarnScene, config: &Config) -> YarnScene {
     }
     if let Some(t) = config.scheme {
         s.transfer.scheme = t;
+    }
+    if let Some(i) = config.integrator {
+        s.time.integrator = i;
     }
     s
 }
@@ -170,10 +176,23 @@ impl YarnModel {
     ) -> ModelResult<bool> {
         let mut changed = false;
         for (&vr, v) in vrs.iter().zip(vals) {
-            if vr != VR_SCENE && vr != VR_TRANSFER_SCHEME {
+            if vr != VR_SCENE && vr != VR_TRANSFER_SCHEME && vr != VR_INTEGRATOR {
                 return refuse(format!("value reference {vr} is not a String parameter"));
             }
             param_ok(vr)?;
+            if vr == VR_INTEGRATOR {
+                let Some(v) = v else {
+                    return refuse("integrator is a null pointer");
+                };
+                let Some(i) = parse_integrator(v) else {
+                    return refuse(format!(
+                        "integrator = {v:?} is not an integrator: use \"explicit\" or \"implicit\""
+                    ));
+                };
+                changed |= self.config.integrator != Some(i);
+                self.config.integrator = Some(i);
+                continue;
+            }
             if vr == VR_TRANSFER_SCHEME {
                 let Some(v) = v else {
                     return refuse("transfer.scheme is a null pointer");
@@ -254,132 +273,6 @@ impl YarnModel {
         self.forces.clone_from(&s.forces);
         self.diag = None;
         Ok(())
-    }
-
-    /// A saved state's part of a serialized FMU state: the pin inputs, the
-    /// parameters, the scene text and the library's own state bytes (which
-    /// carry their own header and checksum; encoded by this model's
-    /// simulation when it runs the state's scene, else by one built for
-    /// it).
-    pub fn write(&self, s: &YarnState, w: &mut Writer) -> Result<(), String> {
-        // Gravity and the attractor are in the library's state bytes.
-        for p in &s.inputs.pins {
-            w.f64(p.position[0]);
-            w.f64(p.position[1]);
-            w.f64(p.velocity[0]);
-            w.f64(p.velocity[1]);
-        }
-        w.bytes(s.config.scene_path.as_bytes());
-        for v in s.config.reals {
-            w.opt_f64(v);
-        }
-        w.u8(s.config.plasticity.is_some() as u8);
-        w.u8(s.config.plasticity.unwrap_or(false) as u8);
-        w.u8(match s.config.scheme {
-            None => 0,
-            Some(TransferScheme::Flip) => 1,
-            Some(TransferScheme::Apic) => 2,
-        });
-        w.u64(s.forces.substeps);
-        w.f64(s.forces.weight);
-        for f in &s.forces.sum {
-            w.f64(f.x);
-            w.f64(f.y);
-        }
-        w.bytes(s.base.to_toml_string().as_bytes());
-        let scene = s.scene();
-        let built;
-        let sim = if *self.sim.scene() == scene {
-            &self.sim
-        } else {
-            built = YarnSim::new(&scene).map_err(|e| format!("stored scene: {e}"))?;
-            &built
-        };
-        w.bytes_with(sim.state_size(), |out| sim.encode_state_into(&s.sim, out))
-            .map_err(|e| e.to_string())
-    }
-
-    /// Reads what [`Self::write`] wrote; the library's state bytes are
-    /// checked and decoded by `current`'s simulation when it runs the
-    /// stored scene with the stored parameters, else by one built for them.
-    pub fn read(r: &mut Reader, current: &YarnModel, yarns: usize) -> Result<YarnState, String> {
-        let mut inputs = Inputs {
-            pins: current.inputs.pins.clone(),
-        };
-        // The pins are the bundled scene's (the `scene` parameter keeps them).
-        for p in &mut inputs.pins {
-            p.position = [r.f64()?, r.f64()?];
-            p.velocity = [r.f64()?, r.f64()?];
-        }
-        inputs.check().map_err(|e| e.0)?;
-        let scene_path = r.string()?;
-        let mut reals = [None; YARN_REAL_PARAMETERS];
-        for v in &mut reals {
-            *v = r.opt_f64()?;
-        }
-        let has_p = r.bool()?;
-        let p = r.bool()?;
-        let scheme = match r.u8()? {
-            0 => None,
-            1 => Some(TransferScheme::Flip),
-            2 => Some(TransferScheme::Apic),
-            b => return Err(format!("bad transfer scheme byte {b}")),
-        };
-        if let Some((i, v)) = reals.iter().enumerate().find_map(|(i, v)| {
-            let (_, f) = yarn_real_parameters().nth(i).unwrap();
-            v.filter(|v| !(0.0..=f.max).contains(v)).map(|v| (i, v))
-        }) {
-            return Err(format!("stored parameter {i} = {v} is out of range"));
-        }
-        let config = Config {
-            scene_path,
-            reals,
-            plasticity: has_p.then_some(p),
-            scheme,
-        };
-        let substeps = r.u64()?;
-        let weight = r.f64()?;
-        if !(weight.is_finite() && weight >= 0.0) {
-            return Err(format!("bad pin force weight {weight}"));
-        }
-        let mut sum = Vec::with_capacity(current.forces.sum.len());
-        for _ in 0..current.forces.sum.len() {
-            sum.push(Vec2::new(r.f64()?, r.f64()?));
-        }
-        let forces = PinForces {
-            sum,
-            substeps,
-            weight,
-        };
-        let scene_text = r.string()?;
-        let sim_bytes = r.bytes()?;
-        r.finish()?;
-        let base = if scene_text == current.base.to_toml_string() {
-            current.base.clone()
-        } else {
-            YarnScene::from_toml_str(&scene_text).map_err(|e| format!("stored scene: {e}"))?
-        };
-        let scene = effective_scene(&base, &config);
-        let sim = if *current.sim.scene() == scene {
-            current.sim.decode_state(sim_bytes)
-        } else {
-            let sim = YarnSim::new(&scene).map_err(|e| format!("stored scene: {e}"))?;
-            if sim.num_yarns() != yarns {
-                return Err(format!(
-                    "state has {} yarns, this FMU {yarns}",
-                    sim.num_yarns()
-                ));
-            }
-            sim.decode_state(sim_bytes)
-        }
-        .map_err(|e| e.to_string())?;
-        Ok(YarnState {
-            config,
-            base,
-            inputs,
-            forces,
-            sim,
-        })
     }
 }
 
@@ -522,6 +415,9 @@ impl FmuModel for YarnModel {
             VR_SCENE => Some(self.config.scene_path.as_str()),
             VR_TRANSFER_SCHEME => Some(scheme_name(
                 self.config.scheme.unwrap_or(self.base.transfer.scheme),
+            )),
+            VR_INTEGRATOR => Some(integrator_name(
+                self.config.integrator.unwrap_or(self.base.time.integrator),
             )),
             _ => None,
         }

@@ -6,7 +6,7 @@
 //! the scene the FMU runs: the number of yarns fixes the outputs, the
 //! scene's material, substep and inputs give the start values.
 
-use yarnsim::scene::{PinMotionKind, StepSize, TransferScheme, YarnScene};
+use yarnsim::scene::{Integrator, PinMotionKind, StepSize, TransferScheme, YarnScene};
 
 use crate::model::*;
 use Causality::{Input, Parameter};
@@ -15,7 +15,7 @@ use Causality::{Input, Parameter};
 pub const MODEL_IDENTIFIER: &str = "YarnBundle";
 
 /// Bumped whenever the variable layout changes; part of the GUID.
-pub const INTERFACE_VERSION: u32 = 3;
+pub const INTERFACE_VERSION: u32 = 4;
 
 // Value references. They are unique across all types.
 pub const VR_ATTRACTOR_X: u32 = 1;
@@ -40,6 +40,9 @@ pub const VR_MAX_STRETCH: u32 = 102;
 pub const VR_SCENE: u32 = 300; // String
 /// `transfer.scheme` (String parameter, `"flip"` or `"apic"`).
 pub const VR_TRANSFER_SCHEME: u32 = 301;
+/// `integrator` (String parameter, `"explicit"` or `"implicit"`: the
+/// scene's `time.integrator`).
+pub const VR_INTEGRATOR: u32 = 302;
 /// `yarn[i].left.x` has `VR_YARN_BASE + 4 i`, then `left.y`, `right.x`, `right.y`.
 pub const VR_YARN_BASE: u32 = 1000;
 /// Pin `i` (`[[pins]]` order) has `VR_PIN_BASE + 8 i + k`: k = 0..3 the
@@ -86,6 +89,23 @@ pub fn parse_scheme(s: &str) -> Option<TransferScheme> {
     }
 }
 
+/// The name of an integrator as the scene and `integrator` write it.
+pub fn integrator_name(i: Integrator) -> &'static str {
+    match i {
+        Integrator::Explicit => "explicit",
+        Integrator::Implicit => "implicit",
+    }
+}
+
+/// The integrator of an `integrator` value.
+pub fn parse_integrator(s: &str) -> Option<Integrator> {
+    match s {
+        "explicit" => Some(Integrator::Explicit),
+        "implicit" => Some(Integrator::Implicit),
+        _ => None,
+    }
+}
+
 /// Sets the scene's `time.dt` from the `dt` parameter: 0 is `"auto"` (the
 /// scene's `safety` and `dt_max` kept), a positive value a fixed substep
 /// (`safety` and `dt_max`, which only `"auto"` takes, dropped).
@@ -103,7 +123,7 @@ fn set_dt(s: &mut YarnScene, v: f64) {
 /// ([`COMMON_VARIABLES`]) and the per-yarn outputs ([`yarn_outputs`]), in
 /// `ModelVariables` order. The Real parameters read and override the scene
 /// through their [`SceneField`].
-pub static YARN_VARIABLES: [VarSpec<YarnScene>; 20] = [
+pub static YARN_VARIABLES: [VarSpec<YarnScene>; 21] = [
     var(Input, "attractor.x", VR_ATTRACTOR_X, Some("m"), Start::Real(|s| s.attractor.position[0]), "Attractor position x"),
     var(Input, "attractor.y", VR_ATTRACTOR_Y, Some("m"), Start::Real(|s| s.attractor.position[1]), "Attractor position y"),
     var(Input, "attractor.strength", VR_ATTRACTOR_STRENGTH, Some("m/s2"), Start::Real(|s| s.attractor.strength), "Attractor acceleration magnitude, 0 to 1e6"),
@@ -120,6 +140,7 @@ pub static YARN_VARIABLES: [VarSpec<YarnScene>; 20] = [
     var(Parameter, "material.plasticity", VR_PLASTICITY, None, Start::Bool(|s| s.material.plasticity), "Mohr-Coulomb return mapping on or off"),
     var(Parameter, "transfer.scheme", VR_TRANSFER_SCHEME, None, Start::Name(|s| scheme_name(s.transfer.scheme)), "Particle velocity update of grid-to-particle: flip (FLIP/APIC blend by transfer.flip_ratio) or apic"),
     var(Parameter, "transfer.flip_ratio", VR_FLIP_RATIO, None, Start::Scene(SceneField { get: |s| s.transfer.flip_ratio, set: |s, v| s.transfer.flip_ratio = v, positive: false, max: 1.0 }), "FLIP ratio in [0, 1] of the flip scheme (1: pure FLIP; ignored by apic)"),
+    var(Parameter, "integrator", VR_INTEGRATOR, None, Start::Name(|s| integrator_name(s.time.integrator)), "Time integrator of the grid velocities (the scene's time.integrator): explicit (symplectic Euler) or implicit (backward Euler, Newton on the grid velocities; only for pure fibre stretch with fixed pins: another scene is refused with fmi2Error at the end of initialization, the log naming the scene field; a Newton solve that fails in a step gives fmi2Discard)"),
     var(Parameter, "scene", VR_SCENE, None, Start::Text(SCENE_FILE), "Scene file: a path relative to the FMU's resources folder, or absolute; it must create as many yarns as the bundled scene and have its pins (same number, same input pins)"),
     output("kinetic_energy", VR_KINETIC_ENERGY, Some("J"), "Kinetic energy (per unit depth)"),
     output("elastic_energy", VR_ELASTIC_ENERGY, Some("J"), "Elastic energy (per unit depth)"),

@@ -87,7 +87,11 @@ pub fn stepping_of(scene: &YarnScene) -> Stepping {
         StepSize::Fixed(dt) => Stepping::Fixed(dt),
         StepSize::Auto => Stepping::Auto {
             safety: scene.time.safety.unwrap_or(DEFAULT_SAFETY),
-            dt_max: scene.time.dt_max.unwrap_or(f64::INFINITY),
+            // implicit: no stability cap, so the frame time by default
+            dt_max: scene.time.dt_max.unwrap_or(match scene.time.integrator {
+                Integrator::Implicit => scene.time.frame_dt,
+                Integrator::Explicit => f64::INFINITY,
+            }),
         },
     }
 }
@@ -186,8 +190,10 @@ impl YarnSim {
     }
     /// The adaptive substep of the current state:
     /// `min(safety * stable_dt, dt_max)` ([`YarnSim::stable_dt`]: the
-    /// elastic-wave plus particle-speed CFL bound and the bending bound);
-    /// with a fixed `dt`, safety [`DEFAULT_SAFETY`] and no cap.
+    /// elastic-wave plus particle-speed CFL bound and the bending bound;
+    /// under the implicit integrator the advection limit alone, `dt_max`
+    /// defaulting to `frame_dt`); with a fixed `dt`, safety
+    /// [`DEFAULT_SAFETY`] and no cap.
     pub fn auto_dt(&self) -> f64 {
         let (safety, dt_max) = match self.stepping {
             Stepping::Auto { safety, dt_max } => (safety, dt_max),

@@ -113,14 +113,6 @@ impl YarnScene {
                     .into(),
             ));
         }
-        if self.time.dt == StepSize::Auto {
-            return Err(refuse(
-                "time",
-                "dt",
-                "is \"auto\", the implicit step has no step-size criterion yet (give a number)"
-                    .into(),
-            ));
-        }
         Ok(())
     }
 
