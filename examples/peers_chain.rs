@@ -4,10 +4,10 @@
 //! on stdout per run.
 //!
 //! ```text
-//! cargo run --release --example peers_chain -- chain VERTICES GRID DT [INTEGRATOR]
-//! cargo run --release --example peers_chain -- cantilever VERTICES [INTEGRATOR]
-//! cargo run --release --example peers_chain -- capstan R L1 L2 MU [INTEGRATOR]
-//! cargo run --release --example peers_chain -- bundle DURATION [INTEGRATOR]
+//! cargo run --release --example peers_chain -- chain VERTICES GRID DT [INTEGRATOR [K]]
+//! cargo run --release --example peers_chain -- cantilever VERTICES [INTEGRATOR [DT]]
+//! cargo run --release --example peers_chain -- capstan R L1 L2 MU [INTEGRATOR [DT]]
+//! cargo run --release --example peers_chain -- bundle DURATION [INTEGRATOR [DT]]
 //! ```
 //!
 //! `INTEGRATOR` is `explicit` (the default) or `implicit` (the scene's
@@ -19,22 +19,31 @@
 //!   top, k = 2000, no bending, started in the first mode shape
 //!   `u = A J0(j01 sqrt(z / L))`, A = 0.02 m), run for 3.4 s; the period is
 //!   twice the mean spacing of the free end's zero crossings (interpolated
-//!   within the substep). `DT` is a TOML value (`1e-4` or `"auto"`).
+//!   within the substep). `DT` is a TOML value (`1e-4` or `"auto"`); `K`
+//!   replaces the fibre stiffness (e.g. `2e5`: a nearly inextensible
+//!   rope, strain at the top 0.004 %).
 //! * `cantilever`: the Euler-Bernoulli cantilever of the oracle test
 //!   (L = 0.5 m, B = 1, rho = 1, 64^2, dt 5e-5, two vertices pinned), the tip
-//!   deflection averaged over two measured periods of the first mode.
+//!   deflection averaged over two measured periods of the first mode;
+//!   `DT` replaces the substep.
 //! * `capstan`: the bending-free yarn over a half circle (128^2, dt 1e-4,
 //!   g = 2) loaded for 0.2 s, then up to 1 s more: slid if a free end moved
-//!   vertically by more than 0.5 % of its hanging length.
+//!   vertically by more than 0.5 % of its hanging length; `DT` replaces
+//!   the substep.
 //! * `bundle`: the built-in `yarn-reference` scene for `DURATION` s; prints
-//!   every yarn's vertex positions for the driver's common metrics.
+//!   every yarn's vertex positions for the driver's common metrics; `DT`
+//!   replaces the substep (4e-5).
 //!
-//! Threads: set `RAYON_NUM_THREADS=1` for one thread.
+//! Threads: set `RAYON_NUM_THREADS=1` for one thread. The whole run steps
+//! on one rayon worker (`yarnsim::pool::on_pool`), as a program's own
+//! stepping loop should: calling `YarnSim::step` from a thread outside the
+//! pool hands each substep over and back (a thread wake-up per substep,
+//! which doubled the chain's wall time here).
 
 use std::time::Instant;
 
 use yarnsim::scene::builtin::yarn_reference;
-use yarnsim::scene::{Integrator, YarnScene};
+use yarnsim::scene::{Integrator, StepSize, YarnScene};
 use yarnsim::testing::{
     cantilever_setup, cantilever_toml, capstan_toml, capstan_vertices, hanging_chain_period,
     hanging_chain_toml, two_periods_about_mean, ZeroCrossings, CAPSTAN_PURE_STRING,
@@ -89,6 +98,11 @@ fn integrator(args: &[String], i: usize) -> Integrator {
     }
 }
 
+/// The optional argument at `i` (absent: `None`).
+fn opt<T: std::str::FromStr>(args: &[String], i: usize, name: &str) -> Option<T> {
+    args.get(i).map(|_| arg(args, i, name))
+}
+
 fn arg<T: std::str::FromStr>(args: &[String], i: usize, name: &str) -> T {
     args.get(i).and_then(|s| s.parse().ok()).unwrap_or_else(|| {
         eprintln!("missing or invalid argument {name}");
@@ -96,8 +110,11 @@ fn arg<T: std::str::FromStr>(args: &[String], i: usize, name: &str) -> T {
     })
 }
 
-fn chain(vertices: u32, grid: u32, dt: &str, integ: Integrator) -> String {
-    let s = scene(&hanging_chain_toml(vertices, grid, dt));
+fn chain(vertices: u32, grid: u32, dt: &str, integ: Integrator, k: Option<f64>) -> String {
+    let mut s = scene(&hanging_chain_toml(vertices, grid, dt));
+    if let Some(k) = k {
+        s.material.k = k;
+    }
     let mut sim = sim_with(s, integ);
     let duration = 3.4;
     let mut crossings = ZeroCrossings::new(sim.yarn_endpoints(0).1.x - 0.5);
@@ -125,9 +142,12 @@ fn chain(vertices: u32, grid: u32, dt: &str, integ: Integrator) -> String {
     )
 }
 
-fn cantilever(vertices: u32, integ: Integrator) -> String {
+fn cantilever(vertices: u32, integ: Integrator, dt: Option<f64>) -> String {
     let (len, b, rho, g) = cantilever_setup();
-    let s = scene(&cantilever_toml(vertices));
+    let mut s = scene(&cantilever_toml(vertices));
+    if let Some(dt) = dt {
+        s.time.dt = StepSize::Fixed(dt);
+    }
     let mut sim = sim_with(s, integ);
     let free = len - 0.5 * len / (vertices - 1) as f64;
     let oracle = rho * g * free.powi(4) / (8.0 * b);
@@ -158,8 +178,11 @@ fn cantilever(vertices: u32, integ: Integrator) -> String {
     )
 }
 
-fn capstan(r: f64, l1: f64, l2: f64, mu: f64, integ: Integrator) -> String {
-    let c = CAPSTAN_PURE_STRING;
+fn capstan(r: f64, l1: f64, l2: f64, mu: f64, integ: Integrator, dt: Option<f64>) -> String {
+    let mut c = CAPSTAN_PURE_STRING;
+    if let Some(dt) = dt {
+        c.dt = dt;
+    }
     let vertices = capstan_vertices(r, l1, l2, c.res);
     let s = scene(&capstan_toml(r, l1, l2, mu, &c));
     let mut sim = sim_with(s, integ);
@@ -192,8 +215,12 @@ fn capstan(r: f64, l1: f64, l2: f64, mu: f64, integ: Integrator) -> String {
     )
 }
 
-fn bundle(duration: f64, integ: Integrator) -> String {
-    let mut sim = sim_with(yarn_reference(), integ);
+fn bundle(duration: f64, integ: Integrator, dt: Option<f64>) -> String {
+    let mut s = yarn_reference();
+    if let Some(dt) = dt {
+        s.time.dt = StepSize::Fixed(dt);
+    }
+    let mut sim = sim_with(s, integ);
     let t0 = Instant::now();
     let ok = sim.advance(duration).is_ok();
     let wall = t0.elapsed().as_secs_f64();
@@ -223,26 +250,37 @@ fn bundle(duration: f64, integ: Integrator) -> String {
 
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
-    let out = match args.first().map(String::as_str) {
+    // the whole run on one rayon worker: one hand-off, not one per substep
+    let out = yarnsim::pool::on_pool(|| match args.first().map(String::as_str) {
         Some("chain") => chain(
             arg(&args, 1, "VERTICES"),
             arg(&args, 2, "GRID"),
             &arg::<String>(&args, 3, "DT"),
             integrator(&args, 4),
+            opt(&args, 5, "K"),
         ),
-        Some("cantilever") => cantilever(arg(&args, 1, "VERTICES"), integrator(&args, 2)),
+        Some("cantilever") => cantilever(
+            arg(&args, 1, "VERTICES"),
+            integrator(&args, 2),
+            opt(&args, 3, "DT"),
+        ),
         Some("capstan") => capstan(
             arg(&args, 1, "R"),
             arg(&args, 2, "L1"),
             arg(&args, 3, "L2"),
             arg(&args, 4, "MU"),
             integrator(&args, 5),
+            opt(&args, 6, "DT"),
         ),
-        Some("bundle") => bundle(arg(&args, 1, "DURATION"), integrator(&args, 2)),
+        Some("bundle") => bundle(
+            arg(&args, 1, "DURATION"),
+            integrator(&args, 2),
+            opt(&args, 3, "DT"),
+        ),
         _ => {
             eprintln!("usage: peers_chain chain|cantilever|capstan|bundle ARGS (see the source)");
             std::process::exit(2)
         }
-    };
+    });
     println!("{out}");
 }

@@ -5,7 +5,8 @@ import math
 
 COLORS = {"yarnsim": "#1f77b4", "mujoco": "#d62728", "pyelastica": "#2ca02c"}
 # a tool's other integrators (by (tool, integrator)); default: COLORS[tool]
-INTEGRATOR_COLORS = {("yarnsim", "mpm-implicit"): "#9467bd"}
+INTEGRATOR_COLORS = {("yarnsim", "mpm-implicit"): "#9467bd",
+                     ("yarnsim", "mpm-implicit-k2e5"): "#ff7f0e"}
 DASH = {"chain": "", "cantilever": "6,3", "capstan": "2,2"}
 MARK = {"chain": "circle", "cantilever": "square", "capstan": "diamond"}
 

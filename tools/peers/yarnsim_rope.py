@@ -36,35 +36,44 @@ def _refused(res):
                 refused=res["refused"])
 
 
-def chain(vertices, grid, dt, integrator="explicit"):
-    """The hanging chain; `integrator` "explicit" or "implicit"."""
-    return _refused(_run("chain", vertices, grid, dt, integrator))
+def _opt(*args):
+    """The trailing optional arguments up to the last one given."""
+    args = list(args)
+    while args and args[-1] is None:
+        args.pop()
+    return args
 
 
-def cantilever(vertices, integrator="explicit"):
-    return _refused(_run("cantilever", vertices, integrator))
+def chain(vertices, grid, dt, integrator="explicit", k=None):
+    """The hanging chain; `integrator` "explicit" or "implicit"; `k`
+    replaces the fibre stiffness (2000)."""
+    return _refused(_run("chain", vertices, grid, dt, *_opt(integrator, k)))
 
 
-def capstan(r, l1, l2, mu, integrator="explicit"):
+def cantilever(vertices, integrator="explicit", dt=None):
+    return _refused(_run("cantilever", vertices, *_opt(integrator, dt)))
+
+
+def capstan(r, l1, l2, mu, integrator="explicit", dt=None):
     """One capstan run: the example's JSON (or the refusal, see `_refused`)."""
-    return _refused(_run("capstan", r, l1, l2, mu, integrator))
+    return _refused(_run("capstan", r, l1, l2, mu, *_opt(integrator, dt)))
 
 
 class Refused(Exception):
     """The scene validation refused the run (the message is its text)."""
 
 
-def capstan_slides(r, l1, l2, mu, integrator="explicit"):
+def capstan_slides(r, l1, l2, mu, integrator="explicit", dt=None):
     """(slid, wall_s, sim_s) of one capstan run; raises `Refused` when the
     scene is refused."""
-    res = capstan(r, l1, l2, mu, integrator)
+    res = capstan(r, l1, l2, mu, integrator, dt)
     if "refused" in res:
         raise Refused(res["refused"])
     return res.get("slid", False) or not res["ok"], res["wall_s"], res["sim_s"]
 
 
-def bundle(duration, integrator="explicit"):
-    res = _refused(_run("bundle", duration, integrator))
+def bundle(duration, integrator="explicit", dt=None):
+    res = _refused(_run("bundle", duration, *_opt(integrator, dt)))
     if "yarns" in res:
         import numpy as np
         res["yarns"] = [np.array(y) for y in res["yarns"]]
