@@ -115,14 +115,24 @@ fn integrator_defaults_to_explicit_and_is_left_out_of_the_toml() {
 
 #[test]
 fn implicit_integrator_outside_its_scope_is_refused_naming_the_field_and_line() {
-    // The minimal scene has the default sticky walls the implicit step
-    // does not model (tests/implicit.rs covers each refusal): refused at
-    // load, not run with the explicit step.
-    let m = err(&GOOD.replace("dt = 1e-4", "dt = 1e-4\nintegrator = \"implicit\"")).to_string();
-    assert!(m.contains("walls.mode") && m.contains("implicit"), "{m}");
-    // without walls its whole energy (shear, cross-section, plasticity) is in scope
-    let free = GOOD.replace("dt = 1e-4", "dt = 1e-4\nintegrator = \"implicit\"");
-    YarnScene::from_toml_str(&format!("{free}[walls]\nmode = \"none\"\n")).unwrap();
+    // The minimal scene (whole energy, plasticity, sticky walls) is in
+    // scope; a pinned yarn beside a free one (two velocity fields) is
+    // refused at load naming the field and its line, not run with the
+    // explicit step (tests/implicit.rs covers the scope).
+    let implicit = GOOD.replace("dt = 1e-4", "dt = 1e-4\nintegrator = \"implicit\"");
+    YarnScene::from_toml_str(&implicit).unwrap();
+    let mixed = format!(
+        "{implicit}[[yarns]]\npoints = [[0.2, 0.3], [0.4, 0.3]]\nvertices = 5\n\
+         [[pins]]\nyarn = 0\nend = \"start\"\n"
+    );
+    let m = err(&mixed).to_string();
+    let line = mixed.lines().position(|l| l == "[[pins]]").unwrap() + 1;
+    assert!(
+        m.contains("`pins`")
+            && m.contains("two velocity fields")
+            && m.contains(&format!("line {line}")),
+        "{m}"
+    );
     // An unknown integrator is a field error too.
     let m = err(&GOOD.replace("dt = 1e-4", "dt = 1e-4\nintegrator = \"rk4\"")).to_string();
     assert!(
