@@ -34,6 +34,16 @@ const SETTLE: f64 = 0.1;
 /// fibre friction `c_f` and no bending, gravity g tilted by `theta`
 /// (downhill along +x), dt 1e-4.
 fn incline(theta: f64, c_f: f64, scheme: TransferScheme) -> YarnSim {
+    incline_stepped(theta, c_f, scheme, EXPLICIT)
+}
+
+/// The explicit step of the incline scenes: `[time]` lines.
+const EXPLICIT: &str = "dt = 1e-4";
+/// Backward Euler at 10x the explicit step.
+const IMPLICIT: &str = "dt = 1e-3\nintegrator = \"implicit\"";
+
+/// [`incline`] with the `[time]` lines `time`.
+fn incline_stepped(theta: f64, c_f: f64, scheme: TransferScheme, time: &str) -> YarnSim {
     let res = 128;
     let dx = 1.0 / res as f64;
     let bed_n = (0.8 / (0.5 * dx)).round() as u32 + 1;
@@ -56,7 +66,7 @@ count = {bed_n}
         y = 0.4 + dx
     );
     let gravity = [G * theta.sin(), -G * theta.cos()];
-    YarnSim::new(&yarn_scene(gravity, res, scheme, c_f, &yarns)).unwrap()
+    YarnSim::new(&yarn_scene_stepped(gravity, res, scheme, c_f, &yarns, time)).unwrap()
 }
 
 /// A scene of the built-in material with fibre friction `c_f`, no bending,
@@ -69,6 +79,18 @@ fn yarn_scene(
     c_f: f64,
     yarns: &str,
 ) -> yarnsim::YarnScene {
+    yarn_scene_stepped(gravity, res, scheme, c_f, yarns, EXPLICIT)
+}
+
+/// [`yarn_scene`] with the `[time]` lines `time`.
+fn yarn_scene_stepped(
+    gravity: [f64; 2],
+    res: u32,
+    scheme: TransferScheme,
+    c_f: f64,
+    yarns: &str,
+    time: &str,
+) -> yarnsim::YarnScene {
     let scheme = match scheme {
         TransferScheme::Flip => "flip",
         TransferScheme::Apic => "apic",
@@ -79,7 +101,7 @@ gravity = [{}, {}]
 [grid]
 resolution = {res}
 [time]
-dt = 1e-4
+{time}
 [transfer]
 scheme = "{scheme}"
 [material]
@@ -99,7 +121,18 @@ mode = "none"
 /// Downhill displacements of the top yarn's centre at the times `ts`
 /// (increasing) after settling.
 fn slips<const N: usize>(theta: f64, c_f: f64, scheme: TransferScheme, ts: [f64; N]) -> [f64; N] {
-    let mut sim = incline(theta, c_f, scheme);
+    slips_stepped(theta, c_f, scheme, ts, EXPLICIT)
+}
+
+/// [`slips`] with the `[time]` lines `time`.
+fn slips_stepped<const N: usize>(
+    theta: f64,
+    c_f: f64,
+    scheme: TransferScheme,
+    ts: [f64; N],
+    time: &str,
+) -> [f64; N] {
+    let mut sim = incline_stepped(theta, c_f, scheme, time);
     sim.advance(SETTLE).unwrap();
     let centre = |sim: &YarnSim| {
         let (a, b) = sim.yarn_endpoints(1);
@@ -299,4 +332,49 @@ count = 3
         );
         assert!(worst < 1e-12, "{scheme:?}: momentum balance {worst:.3e}");
     }
+}
+
+/// Backward Euler at 10x the explicit step (dt 1e-3) with two velocity
+/// fields (the bed held, the top yarn free; one solve per field, the
+/// fields' Coulomb contact after them, as in the explicit step): the top
+/// yarn holds at tan theta = 0.9 c_f and slides at 1.1 c_f (threshold
+/// within 10 %), and at tan theta = 2 c_f slides at `g (sin theta - c_f
+/// cos theta)` within 5 %.
+#[test]
+#[cfg_attr(debug_assertions, ignore = "release-mode test (cargo test --release)")]
+fn implicit_two_field_incline_holds_below_and_slides_above_its_friction() {
+    let c_f: f64 = 0.2;
+    let slides = |k: f64| {
+        let [s] = slips_stepped((k * c_f).atan(), c_f, TransferScheme::Flip, [0.5], IMPLICIT);
+        eprintln!("implicit incline tan theta = {k} c_f: slip {s:.3e} m in 0.5 s");
+        s > 5e-3
+    };
+    assert!(!slides(0.9), "slid at tan theta = 0.9 c_f");
+    assert!(slides(1.1), "held at tan theta = 1.1 c_f");
+    let theta = (2.0 * c_f).atan();
+    let t = 0.3;
+    let [half, full] = slips_stepped(theta, c_f, TransferScheme::Flip, [0.5 * t, t], IMPLICIT);
+    let a = 4.0 * (full - 2.0 * half) / (t * t);
+    let law = G * (theta.sin() - c_f * theta.cos());
+    eprintln!(
+        "implicit incline tan theta = 2 c_f: acceleration {a:.4} m/s^2, law {law:.4} ({:+.2} %)",
+        100.0 * (a - law) / law
+    );
+    assert!((a - law).abs() <= 0.05 * law, "acceleration {a}, law {law}");
+}
+
+/// The two-field scene under backward Euler gives the same bits for 1 and
+/// 2 threads.
+#[test]
+fn implicit_two_fields_are_bit_identical_for_one_and_two_threads() {
+    let n = if cfg!(debug_assertions) { 3 } else { 30 };
+    let run = |threads: usize| {
+        on_threads(threads, || {
+            let mut sim = incline_stepped(0.3f64.atan(), 0.2, TransferScheme::Flip, IMPLICIT);
+            assert!(sim.has_two_fields());
+            sim.steps_n(n).unwrap();
+            sim.save_state()
+        })
+    };
+    assert!(run(1) == run(2), "states differ");
 }

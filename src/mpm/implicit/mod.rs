@@ -71,7 +71,7 @@ pub struct Problem {
     /// Pin constraint rows (weights in unknown indices) and targets.
     rows: Vec<(Weights, Vec2, usize)>,
     /// Cholesky factor (lower, row-major) of `S = A M^-1 A^T`.
-    chol: Vec<f64>,
+    chol: pins::PinFactor,
 }
 
 /// `sum a_i . b_i`.

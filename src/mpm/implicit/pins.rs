@@ -26,43 +26,15 @@ impl Problem {
                     }
                 }
                 s[a * n + b] = sum;
+                s[b * n + a] = sum;
             }
         }
-        for j in 0..n {
-            let mut d = s[j * n + j];
-            for k in 0..j {
-                d -= s[j * n + k] * s[j * n + k];
-            }
-            let d = d.max(1e-300).sqrt();
-            s[j * n + j] = d;
-            for i in j + 1..n {
-                let mut v = s[i * n + j];
-                for k in 0..j {
-                    v -= s[i * n + k] * s[j * n + k];
-                }
-                s[i * n + j] = v / d;
-            }
-        }
-        self.chol = s;
+        self.chol = PinFactor::new(s, n);
     }
 
-    /// `S^-1 b` per component.
+    /// `S^-1 b` per component (on the independent rows; see [`PinFactor`]).
     fn solve_s(&self, b: &mut [Vec2]) {
-        let (n, l) = (self.rows.len(), &self.chol);
-        for i in 0..n {
-            for k in 0..i {
-                let t = b[k] * l[i * n + k];
-                b[i] -= t;
-            }
-            b[i] /= l[i * n + i];
-        }
-        for i in (0..n).rev() {
-            for k in i + 1..n {
-                let t = b[k] * l[k * n + i];
-                b[i] -= t;
-            }
-            b[i] /= l[i * n + i];
-        }
+        self.chol.solve(b);
     }
 
     /// `A x` (each pinned vertex's interpolated value).
@@ -145,4 +117,93 @@ pub(super) fn interp(w: &Weights, v: &[Vec2]) -> Vec2 {
         }
     }
     s
+}
+
+/// Cholesky factor of `S = A M^-1 A^T` with diagonal pivoting (Golub and
+/// Van Loan, "Matrix Computations", 4.2.8): rows that depend on the others
+/// (more pinned vertices than the nodes under them can tell apart, e.g. a
+/// bed pinned at every vertex, two vertices per cell) are left out once
+/// the largest remaining pivot is round-off (1e-10 of the largest
+/// diagonal), and get a multiplier of 0; the independent rows get the exact
+/// solution (the rows are consistent: every pinned vertex follows its
+/// pin's one motion).
+#[derive(Clone, Debug, Default)]
+pub struct PinFactor {
+    /// `L` (lower, row-major, `n x n`) of the permuted `S`.
+    l: Vec<f64>,
+    /// Row `k` of the factor is row `perm[k]` of `S`.
+    perm: Vec<usize>,
+    /// Independent rows (the first `rank` of the permutation).
+    rank: usize,
+}
+
+impl PinFactor {
+    fn new(mut s: Vec<f64>, n: usize) -> Self {
+        let mut perm: Vec<usize> = (0..n).collect();
+        let top = (0..n).map(|i| s[i * n + i]).fold(0.0, f64::max);
+        let mut rank = n;
+        for j in 0..n {
+            // the largest remaining pivot
+            let (mut best, mut bd) = (j, f64::NEG_INFINITY);
+            for i in j..n {
+                let d = s[i * n + i];
+                if d > bd {
+                    (best, bd) = (i, d);
+                }
+            }
+            if bd <= 1e-10 * top {
+                rank = j;
+                break;
+            }
+            if best != j {
+                perm.swap(j, best);
+                for c in 0..n {
+                    s.swap(j * n + c, best * n + c);
+                }
+                for r in 0..n {
+                    s.swap(r * n + j, r * n + best);
+                }
+            }
+            let d = s[j * n + j].sqrt();
+            s[j * n + j] = d;
+            for i in j + 1..n {
+                s[i * n + j] /= d;
+            }
+            // the trailing block less the new column's outer product
+            for i in j + 1..n {
+                let lij = s[i * n + j];
+                for k in j + 1..n {
+                    s[i * n + k] -= lij * s[k * n + j];
+                }
+            }
+        }
+        PinFactor { l: s, perm, rank }
+    }
+
+    /// `b <- S^+ b` on the independent rows (the others 0).
+    fn solve(&self, b: &mut [Vec2]) {
+        let n = self.perm.len();
+        let (l, r) = (&self.l, self.rank);
+        let mut y: Vec<Vec2> = self.perm.iter().map(|&p| b[p]).collect();
+        for i in 0..r {
+            for k in 0..i {
+                let t = y[k] * l[i * n + k];
+                y[i] -= t;
+            }
+            y[i] /= l[i * n + i];
+        }
+        for y in &mut y[r..] {
+            *y = Vec2::zeros();
+        }
+        for i in (0..r).rev() {
+            for k in i + 1..r {
+                let t = y[k] * l[k * n + i];
+                y[i] -= t;
+            }
+            y[i] /= l[i * n + i];
+        }
+        for (k, &p) in self.perm.iter().enumerate() {
+            b[p] = y[k];
+        }
+    }
 }

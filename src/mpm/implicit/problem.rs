@@ -101,6 +101,25 @@ impl Problem {
     /// before the grid update (which consumes the buffers the masses are
     /// read from). `v*` is read later ([`Problem::read_vstar`]).
     pub fn collect(p: &Particles, grid: &Grid, model: &Model, dt: f64, pins: &[PinEntry]) -> Self {
+        Self::collect_field(p, grid, model, dt, pins, None)
+    }
+
+    /// [`Problem::collect`] of one velocity field of a two-field scene
+    /// ([`crate::mpm::fields`]): `only = Some((vert_held, quad_held,
+    /// held))` keeps the vertices and quadrature particles whose flag is
+    /// `held` (their grid is `grid`); the others are no part of this
+    /// problem (the energy has no element across the fields: a yarn is
+    /// wholly held or wholly free).
+    pub fn collect_field(
+        p: &Particles,
+        grid: &Grid,
+        model: &Model,
+        dt: f64,
+        pins: &[PinEntry],
+        only: Option<(&[bool], &[bool], bool)>,
+    ) -> Self {
+        let keep_vert = |i: usize| only.is_none_or(|(v, _, h)| v[i] == h);
+        let keep_quad = |i: usize| only.is_none_or(|(_, q, h)| q[i] == h);
         let geom = grid.geom;
         let mut map = vec![NONE; geom.storage()];
         let mut nodes = Vec::new();
@@ -137,15 +156,23 @@ impl Problem {
             }
             w
         };
-        let vw: Vec<Weights> = p.vert.stencil.iter().map(&mut stencil).collect();
-        let qw: Vec<Weights> = p.quad.stencil.iter().map(&mut stencil).collect();
+        let none = Weights {
+            node: [NONE; 9],
+            w: [0.0; 9],
+        };
+        let vw: Vec<Weights> = (p.vert.stencil.iter().enumerate())
+            .map(|(i, st)| if keep_vert(i) { stencil(st) } else { none })
+            .collect();
+        let qw: Vec<Weights> = (p.quad.stencil.iter().enumerate())
+            .map(|(i, st)| if keep_quad(i) { stencil(st) } else { none })
+            .collect();
         let (q, x) = (&p.quad, &p.vert.x);
         // c2 per unit of w (o . d2): dt 4 / dx (o = (x_n - x_q) / dx)
         let s2 = dt * 4.0 * geom.inv_dx;
         let mut quads = Vec::with_capacity(q.l0.len());
         let mut quad_terms = Vec::new();
         let mut list: Vec<(u32, [f64; 2])> = Vec::with_capacity(27);
-        for k in 0..q.l0.len() {
+        for k in (0..q.l0.len()).filter(|&k| keep_quad(k)) {
             list.clear();
             let l = q.left[k] as usize;
             let d2 = q.d[k].column(1).into_owned();
@@ -192,7 +219,7 @@ impl Problem {
         if model.bending > 0.0 {
             let mut list: Vec<(u32, [f64; 3])> = Vec::with_capacity(27);
             for (j, rest) in p.vert.bend.iter().enumerate() {
-                if rest.inv_len == 0.0 {
+                if rest.inv_len == 0.0 || !keep_vert(j) {
                     continue;
                 }
                 list.clear();
@@ -251,7 +278,7 @@ impl Problem {
             bend_terms,
             attractor,
             rows,
-            chol: Vec::new(),
+            chol: Default::default(),
         };
         prob.factor();
         prob

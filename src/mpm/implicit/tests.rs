@@ -142,7 +142,7 @@ fn problem(pinned: bool, attractor: bool) -> Problem {
         bend_terms,
         attractor,
         rows,
-        chol: Vec::new(),
+        chol: Default::default(),
     };
     p.factor();
     p

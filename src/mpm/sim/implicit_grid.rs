@@ -2,7 +2,10 @@
 //! substep calls it.
 
 use super::super::grid::Grid;
-use super::super::implicit;
+use super::super::grid_update::{self, GridForces};
+use super::super::implicit::{self, Model, Problem};
+use super::super::pins::PinEntry;
+use super::YarnSim;
 use crate::math::Vec2;
 
 /// Cost of the implicit substeps (`[time] integrator = "implicit"`) since
@@ -23,10 +26,12 @@ pub(super) struct ImplicitOut<'a> {
     pub stats: &'a mut ImplicitStats,
 }
 
-/// The implicit grid update: solves for the grid velocities
-/// ([`implicit::solve`]) from `v*` and writes them (and, for FLIP, the
-/// change they add) to the grid; the pins' forces from the solve's
-/// multipliers. `Err`: why the solve failed.
+/// The implicit grid update of one velocity field: solves for the grid
+/// velocities ([`implicit::solve`]) from `v*` and writes them (and, for
+/// FLIP, the change they add) to the grid; adds the pins' forces from the
+/// solve's multipliers to `pin_reactions` (which the caller clears and
+/// sizes) and the iterations to `stats` (the caller counts the substep).
+/// `Err`: why the solve failed.
 pub(super) fn implicit_grid(
     problem: &mut implicit::Problem,
     out: ImplicitOut,
@@ -45,15 +50,80 @@ pub(super) fn implicit_grid(
             [v.x, v.y, 0.0, 0.0]
         };
     }
-    out.pin_reactions.clear();
-    out.pin_reactions.resize(n_pins, Vec2::zeros());
+    debug_assert_eq!(out.pin_reactions.len(), n_pins);
     for (pin, j) in problem.row_pins().zip(&sol.impulses) {
         out.pin_reactions[pin] += j / dt;
     }
     let st = out.stats;
-    st.substeps += 1;
     st.newton += sol.stats.newton as u64;
     st.cg += sol.stats.cg as u64;
     st.max_newton = st.max_newton.max(sol.stats.newton as u64);
+    Ok(())
+}
+
+impl YarnSim {
+    /// The implicit substep's problems, one per velocity field (a yarn is
+    /// wholly in one, so the energy has no element across them): the only
+    /// field's, or the free field's then the held field's (with the pins).
+    /// Call after the scatter, before the grid update.
+    pub(super) fn implicit_problems(
+        &self,
+        model: &Model,
+        dt: f64,
+        pin_entries: &[PinEntry],
+    ) -> Vec<Problem> {
+        let p = &self.particles;
+        match &self.fields {
+            None => vec![Problem::collect(p, &self.grid, model, dt, pin_entries)],
+            Some(f) => {
+                let (v, q) = (&f.vert_held[..], &f.quad_held[..]);
+                let free = Some((v, q, false));
+                let held = Some((v, q, true));
+                vec![
+                    Problem::collect_field(p, &self.grid, model, dt, &[], free),
+                    Problem::collect_field(p, &f.grid, model, dt, pin_entries, held),
+                ]
+            }
+        }
+    }
+}
+
+/// What [`implicit_solve`] writes: the (free) field's grid, the held
+/// field's with two fields, the pins' forces and the cost.
+pub(super) struct ImplicitFields<'a> {
+    pub grid: &'a mut Grid,
+    pub held: Option<&'a mut Grid>,
+    pub pin_reactions: &'a mut Vec<Vec2>,
+    pub stats: &'a mut ImplicitStats,
+}
+
+/// Solves each field's problem ([`implicit_grid`]; `problems` as
+/// [`YarnSim::implicit_problems`] made them), then the obstacle and wall
+/// laws act on its solved velocities (`masses`: each field's `(M, MC)`
+/// from before the grid update); the pins' forces from the multipliers.
+/// `Err`: why a solve failed.
+pub(super) fn implicit_solve(
+    problems: &mut [Problem],
+    out: ImplicitFields,
+    masses: [&[[f64; 2]]; 2],
+    ext: &GridForces,
+    flip: bool,
+) -> Result<(), String> {
+    let n_pins = out.pin_reactions.len();
+    out.pin_reactions
+        .iter_mut()
+        .for_each(|r| *r = Vec2::zeros());
+    let mut grids = [Some(out.grid), out.held];
+    for ((problem, grid), m) in problems.iter_mut().zip(&mut grids).zip(masses) {
+        let grid = grid.as_deref_mut().expect("one grid per problem");
+        let o = ImplicitOut {
+            grid: &mut *grid,
+            pin_reactions: &mut *out.pin_reactions,
+            stats: &mut *out.stats,
+        };
+        implicit_grid(problem, o, n_pins, flip)?;
+        grid_update::boundaries(grid, m, ext, flip);
+    }
+    out.stats.substeps += 1;
     Ok(())
 }

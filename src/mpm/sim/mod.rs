@@ -25,7 +25,7 @@ use crate::scene::{
 };
 pub use diagnostics::Diagnostics;
 pub use implicit_grid::ImplicitStats;
-use implicit_grid::{implicit_grid, ImplicitOut};
+use implicit_grid::{implicit_solve, ImplicitFields};
 pub use stats::{DtStats, PassTimes, Passes};
 
 pub use super::attractor::Attractor;
@@ -554,32 +554,42 @@ impl YarnSim {
             let held = self.fields.as_ref().map_or(&self.grid, |f| &f.grid);
             pins::stencil_masses(&self.pins, &self.particles.vert, held, self.time + dt)
         };
-        let mut problem = implicit.then(|| {
+        let mut problems = if implicit {
             let model = super::implicit::Model {
                 energy: self.energy,
                 bending,
                 attractor,
             };
-            super::implicit::Problem::collect(&self.particles, &self.grid, &model, dt, &pin_entries)
-        });
+            self.implicit_problems(&model, dt, &pin_entries)
+        } else {
+            Vec::new()
+        };
         // implicit: v* without obstacles and walls; they act on the solved velocities
-        let (interior, mut masses) = (ext.without_boundaries(), Vec::new());
+        let (interior, mut masses, mut held_masses) =
+            (ext.without_boundaries(), Vec::new(), Vec::new());
         let ext_update = if implicit { &interior } else { &ext };
         if implicit && ext.has_boundaries() {
             grid_update::record_masses(&self.grid, &mut masses);
+            if let Some(f) = &self.fields {
+                grid_update::record_masses(&f.grid, &mut held_masses);
+            }
         }
         if let Some(f) = &mut self.fields {
             f.record_masses(&self.grid);
             grid_update::grid_update(&mut f.grid, dt, ext_update, flip);
         }
         grid_update::grid_update(&mut self.grid, dt, ext_update, flip);
-        if let Some(problem) = &mut problem {
-            let out = ImplicitOut {
+        if implicit {
+            self.pin_reactions.resize(self.pins.len(), Vec2::zeros());
+            let out = ImplicitFields {
                 grid: &mut self.grid,
+                held: self.fields.as_mut().map(|f| &mut f.grid),
                 pin_reactions: &mut self.pin_reactions,
                 stats: &mut self.implicit_stats,
             };
-            if let Err(what) = implicit_grid(problem, out, self.pins.len(), flip) {
+            if let Err(what) =
+                implicit_solve(&mut problems, out, [&masses, &held_masses], &ext, flip)
+            {
                 let e = SimError::NonFinite {
                     step: self.steps + 1,
                     time: self.time + dt,
@@ -588,7 +598,6 @@ impl YarnSim {
                 self.failed = Some(e.clone());
                 return Err(e);
             }
-            grid_update::boundaries(&mut self.grid, &masses, &ext, flip);
         } else if !self.pins.is_empty() {
             pins::constrain_grid(
                 &pin_entries,

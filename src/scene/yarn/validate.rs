@@ -68,51 +68,7 @@ impl YarnScene {
         }
         self.validate_pins(text)?;
         self.validate_time(text)?;
-        self.validate_implicit(text)?;
         overlap::check_yarns_clear_of_obstacles(self, text)?;
-        Ok(())
-    }
-
-    /// `integrator = "implicit"` runs the whole yarn energy in one velocity
-    /// field ([`crate::mpm::implicit`]; pins, obstacles and walls act as in
-    /// the explicit step); anything else is refused naming the field.
-    fn validate_implicit(&self, text: Option<&str>) -> Result<(), SceneError> {
-        if self.time.integrator != Integrator::Implicit {
-            return Ok(());
-        }
-        let why = "the implicit integrator (time.integrator = \"implicit\") runs in one \
-                   velocity field";
-        let refuse = |table: &str, key: &str, what: String| SceneError::Invalid {
-            field: if table.is_empty() {
-                key.to_string()
-            } else {
-                format!("{table}.{key}")
-            },
-            line: text.and_then(|text| {
-                if table.is_empty() {
-                    table_line(Some(text), &format!("[[{key}]]"), 0)
-                } else {
-                    key_line(text, &format!("[{table}]"), key)
-                }
-            }),
-            message: format!("{what}: {why}; use integrator = \"explicit\""),
-        };
-        let yarns: usize = self.yarns.iter().map(|y| y.count as usize).sum();
-        let mut held = vec![false; yarns];
-        for p in &self.pins {
-            if let Some(h) = held.get_mut(p.yarn as usize) {
-                *h = true;
-            }
-        }
-        if held.iter().any(|&h| h) && !held.iter().all(|&h| h) {
-            return Err(refuse(
-                "",
-                "pins",
-                "some yarns are pinned and some free, which needs two velocity fields with \
-                 contact between them; the implicit step has one field"
-                    .into(),
-            ));
-        }
         Ok(())
     }
 
