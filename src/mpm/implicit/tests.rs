@@ -98,15 +98,17 @@ fn problem(pinned: bool, attractor: bool) -> Problem {
         ];
         let start = bend_terms.len() as u32;
         for n in 0..14 {
+            // vertex coefficients c_k, as edge coefficients a = differences
+            let c = [r.sym(2e-3), r.sym(2e-3), r.sym(2e-3)];
             bend_terms.push(BendTerm {
                 node: ((3 * k + 2 * n + 1) % nn) as u32,
-                c: [r.sym(2e-3), r.sym(2e-3), r.sym(2e-3)],
+                a: [c[1] - c[0], c[2] - c[1]],
             });
         }
         bends.push(BendElem {
             kappa0: 0.1 * k as f64 - 0.2,
             inv_len: 1.0 / l0,
-            x,
+            e: [x[1] - x[0], x[2] - x[1]],
             start,
             end: bend_terms.len() as u32,
         });
@@ -308,7 +310,7 @@ fn hessian_vector_product_matches_central_differences_of_the_gradient() {
             k.quad.iter_mut().for_each(|b| *b = [[0.0; 4]; 4]);
         }
         if part != 1 {
-            k.bend.iter_mut().for_each(|b| *b = [[0.0; 6]; 6]);
+            k.bend.iter_mut().for_each(|b| *b = [[0.0; 4]; 4]);
         }
         if part != 2 {
             k.attr.iter_mut().for_each(|b| *b = [[0.0; 2]; 2]);
