@@ -19,11 +19,13 @@ pub fn eigen_sym<const N: usize>(a: &[[f64; N]; N]) -> ([f64; N], [[f64; N]; N])
         row[i] = 1.0;
     }
     for _ in 0..SWEEPS {
-        let off: f64 = (0..N)
-            .flat_map(|i| (0..N).filter(move |&j| j != i).map(move |j| (i, j)))
-            .map(|(i, j)| a[i][j] * a[i][j])
-            .sum();
-        let diag: f64 = (0..N).map(|i| a[i][i] * a[i][i]).sum();
+        let (mut off, mut diag) = (0.0, 0.0);
+        for i in 0..N {
+            diag += a[i][i] * a[i][i];
+            for j in i + 1..N {
+                off += 2.0 * a[i][j] * a[i][j];
+            }
+        }
         // off-diagonal at 1e-13 of the diagonal (in norm): the eigenvalues
         // to about that of the block's size
         if off <= 1e-26 * diag || off == 0.0 {
@@ -31,7 +33,8 @@ pub fn eigen_sym<const N: usize>(a: &[[f64; N]; N]) -> ([f64; N], [[f64; N]; N])
         }
         for p in 0..N {
             for q in p + 1..N {
-                if a[p][q] == 0.0 {
+                // an entry below round-off of the block needs no rotation
+                if a[p][q] * a[p][q] <= 1e-34 * diag {
                     continue;
                 }
                 // the rotation that zeroes a[p][q] (Golub, Van Loan 8.5)
@@ -80,6 +83,14 @@ pub fn project_psd<const N: usize>(a: &[[f64; N]; N]) -> [[f64; N]; N] {
     if positive_definite(a) {
         return *a;
     }
+    project_psd_eigen(a)
+}
+
+/// [`project_psd`] without the Cholesky test: for blocks that are never
+/// positive definite (the bending blocks: `kappa` is invariant under a
+/// rotation and a scaling of both edges, so their curvature along the
+/// rotation is 0 and the block is singular or indefinite).
+pub fn project_psd_eigen<const N: usize>(a: &[[f64; N]; N]) -> [[f64; N]; N] {
     let (l, v) = eigen_sym(a);
     if l.iter().all(|&l| l >= 0.0) {
         return *a;

@@ -2,7 +2,7 @@
 //! numbers, optionally projected onto PSD) and the matrix-free `H d` and
 //! Jacobi diagonal from them.
 
-use super::blocks::{mul, project_psd, symmetrize};
+use super::blocks::{mul, project_psd, project_psd_eigen, symmetrize};
 use super::dual::{bend_gradient_edges, jacobian, quad_gradient};
 use super::precond::StiffRow;
 use super::problem::{BendElem, QuadElem};
@@ -24,6 +24,38 @@ pub struct Blocks {
 #[inline]
 fn phi(r: f64, s: f64) -> f64 {
     s * (r - 0.01 * (r + 0.01).ln())
+}
+
+/// The exact block of a pure fibre stretch (`gamma = normal = 0`: `psi =
+/// k/2 (|d1| / l0 - 1)^2`, nothing in `d2`), in closed form: `vol k / l0^2
+/// [u u^T + (1 - l0 / L) (I - u u^T)]` in `d1` (`L = |d1|`, `u = d1 / L`),
+/// the transverse coefficient clamped at 0 when `psd` (its eigenvalues are
+/// the two coefficients). `None` where the stress clamps `r11` (then the
+/// dual-number path).
+#[inline]
+pub(super) fn spring_block(
+    k: f64,
+    d: [f64; 4],
+    l0: f64,
+    vol: f64,
+    psd: bool,
+) -> Option<[[f64; 4]; 4]> {
+    let il = 1.0 / l0;
+    let (a, b) = (d[0] * il, d[1] * il);
+    let r11 = (a * a + b * b).sqrt();
+    if r11 < super::super::constitutive::R11_MIN {
+        return None;
+    }
+    let (ux, uy) = (a / r11, b / r11);
+    let s = vol * k * il * il;
+    let t = 1.0 - 1.0 / r11;
+    let t = if psd { t.max(0.0) } else { t };
+    let mut h = [[0.0; 4]; 4];
+    h[0][0] = s * (ux * ux + t * uy * uy);
+    h[1][1] = s * (uy * uy + t * ux * ux);
+    h[0][1] = s * (1.0 - t) * ux * uy;
+    h[1][0] = h[0][1];
+    Some(h)
 }
 
 impl Problem {
@@ -126,11 +158,18 @@ impl Problem {
     /// onto the PSD cone when `psd`.
     pub fn blocks(&self, v: &[Vec2], psd: bool) -> Blocks {
         let e = self.energy;
+        let spring = e.gamma == 0.0 && e.normal == 0.0;
         let quad = self
             .quads
             .iter()
             .map(|q| {
-                let mut h = jacobian(self.quad_d(q, v), |d| quad_gradient(&e, d, q.l0, q.vol));
+                let d = self.quad_d(q, v);
+                if spring {
+                    if let Some(h) = spring_block(e.k, d, q.l0, q.vol, psd) {
+                        return h;
+                    }
+                }
+                let mut h = jacobian(d, |d| quad_gradient(&e, d, q.l0, q.vol));
                 symmetrize(&mut h);
                 if psd {
                     project_psd(&h)
@@ -149,7 +188,7 @@ impl Problem {
                 });
                 symmetrize(&mut h);
                 if psd {
-                    project_psd(&h)
+                    project_psd_eigen(&h)
                 } else {
                     h
                 }

@@ -447,3 +447,44 @@ fn pin_projection_keeps_the_pins_and_solve_reaches_the_constrained_minimum() {
         );
     }
 }
+
+/// The closed-form block of a pure fibre stretch is the dual-number
+/// Jacobian of the stress (to 1e-12 of the block) on stretched and
+/// compressed random frames, and its projection is the PSD projection of
+/// that Jacobian (to 1e-12).
+#[test]
+fn spring_block_is_the_exact_and_the_projected_block() {
+    let e = YarnEnergy {
+        k: 2e5,
+        gamma: 0.0,
+        normal: 0.0,
+        friction: 0.0,
+    };
+    let mut r = Lcg(5);
+    let (l0, vol) = (0.01, 1e-4);
+    let mut compressed = 0;
+    for _ in 0..200 {
+        let a = r.sym(7.0);
+        let len = l0 * (0.5 + r.next());
+        compressed += (len < l0) as usize;
+        let d = [len * a.cos(), len * a.sin(), r.sym(0.02), r.sym(0.02)];
+        let mut h = jacobian(d, |d| quad_gradient(&e, d, l0, vol));
+        symmetrize(&mut h);
+        let scale = vol * e.k / (l0 * l0);
+        for psd in [false, true] {
+            let want = if psd { project_psd(&h) } else { h };
+            let got = energy::spring_block(e.k, d, l0, vol, psd).unwrap();
+            for i in 0..4 {
+                for j in 0..4 {
+                    assert!(
+                        (got[i][j] - want[i][j]).abs() <= 1e-12 * scale,
+                        "psd {psd} ({i}, {j}): {} vs {}",
+                        got[i][j],
+                        want[i][j]
+                    );
+                }
+            }
+        }
+    }
+    assert!(compressed > 50 && compressed < 150, "{compressed}");
+}
