@@ -2,7 +2,7 @@
 //! numbers, optionally projected onto PSD) and the matrix-free `H d` and
 //! Jacobi diagonal from them.
 
-use super::blocks::{mul, project_psd, project_psd_eigen, symmetrize};
+use super::blocks::{mul, project_bend, project_psd, symmetrize};
 use super::dual::{bend_gradient_edges, jacobian, quad_gradient};
 use super::precond::StiffRow;
 use super::problem::{BendElem, QuadElem};
@@ -183,12 +183,11 @@ impl Problem {
             .bends
             .iter()
             .map(|b| {
-                let mut h = jacobian(self.bend_e(b, v), |e| {
-                    bend_gradient_edges(e, bs, b.kappa0, b.inv_len)
-                });
+                let e = self.bend_e(b, v);
+                let mut h = jacobian(e, |e| bend_gradient_edges(e, bs, b.kappa0, b.inv_len));
                 symmetrize(&mut h);
                 if psd {
-                    project_psd_eigen(&h)
+                    project_bend(&h, e, bend_gradient_edges(e, bs, b.kappa0, b.inv_len))
                 } else {
                     h
                 }
