@@ -2,7 +2,8 @@
 //! the positive semi-definite cone (projected Newton: Teran, Sifakis,
 //! Irving, Fedkiw 2005, "Robust quasistatic finite elements and flesh
 //! simulation"): the block's eigen-decomposition by cyclic Jacobi
-//! rotations, negative eigenvalues set to 0.
+//! rotations, negative eigenvalues set to 0; the bending blocks by their
+//! closed-form eigen-structure ([`project_bend`]).
 
 // small dense blocks and stencils: index loops read as the formulas
 #![allow(clippy::needless_range_loop)]

@@ -1,6 +1,7 @@
 //! `E(v)`, its gradient, the per-element Hessian blocks (exact by dual
-//! numbers, optionally projected onto PSD) and the matrix-free `H d` and
-//! Jacobi diagonal from them.
+//! numbers or, for a pure fibre stretch, in closed form; optionally
+//! projected onto PSD) and the matrix-free `H d` and Jacobi diagonal from
+//! them.
 
 use super::blocks::{mul, project_bend, project_psd, symmetrize};
 use super::dual::{bend_gradient_edges, jacobian, quad_gradient};
