@@ -179,7 +179,7 @@ pub fn project_bend(h: &[[f64; 4]; 4], e: [f64; 4], f: [f64; 4]) -> [[f64; 4]; 4
         } else {
             beta * beta / (root - 0.5 * nu)
         };
-        if !(l > 0.0) {
+        if l.is_nan() || l <= 0.0 {
             continue;
         }
         let w = 1.0 / (l * l + beta * beta).sqrt();
