@@ -181,21 +181,20 @@ pub fn quad_gradient<T: Real>(e: &YarnEnergy, d: [T; 4], l0: f64, vol: f64) -> [
     [p[0] * s, p[2] * s, p[1] * s, p[3] * s]
 }
 
-/// `dE/d(x_prev, x_j, x_next)` of the bending energy
-/// `B / 2 (kappa - kappa0)^2 inv_len` at one interior vertex (positions
-/// `[x_prev.x, x_prev.y, x_j.x, ..., x_next.y]`); zero at a fully folded
-/// joint or a zero-length edge, as the explicit force.
+/// `dE/d(e1, e2)` of the bending energy `B / 2 (kappa - kappa0)^2 inv_len`
+/// at one interior vertex in its edges `e1 = x_j - x_prev`, `e2 = x_next -
+/// x_j` (`[e1.x, e1.y, e2.x, e2.y]`); zero at a fully folded joint or a
+/// zero-length edge, as the explicit force.
 #[inline(always)]
-pub fn bend_gradient<T: Real>(x: [T; 6], b: f64, kappa0: f64, inv_len: f64) -> [T; 6] {
-    let (e1x, e1y) = (x[2] - x[0], x[3] - x[1]);
-    let (e2x, e2y) = (x[4] - x[2], x[5] - x[3]);
+pub fn bend_gradient_edges<T: Real>(e: [T; 4], b: f64, kappa0: f64, inv_len: f64) -> [T; 4] {
+    let [e1x, e1y, e2x, e2y] = e;
     let n1 = (e1x * e1x + e1y * e1y).sqrt();
     let n2 = (e2x * e2x + e2y * e2y).sqrt();
     let c = e1x * e2y - e1y * e2x;
     let d = n1 * n2 + (e1x * e2x + e1y * e2y);
     let zero = T::cst(0.0);
     if !(inv_len != 0.0 && d.val() > 0.0 && n1.val() > 0.0 && n2.val() > 0.0) {
-        return [zero; 6];
+        return [zero; 4];
     }
     let kappa = T::cst(2.0) * c / d;
     let tau = T::cst(b) * (kappa - T::cst(kappa0)) * T::cst(inv_len);
@@ -205,6 +204,16 @@ pub fn bend_gradient<T: Real>(x: [T; 6], b: f64, kappa0: f64, inv_len: f64) -> [
     let g1y = (-e2x * d - (e1y * r1 + e2y) * c) * s;
     let g2x = (-e1y * d - (e2x * r2 + e1x) * c) * s;
     let g2y = (e1x * d - (e2y * r2 + e1y) * c) * s;
+    [g1x, g1y, g2x, g2y]
+}
+
+/// `dE/d(x_prev, x_j, x_next)` of the same energy (positions
+/// `[x_prev.x, x_prev.y, x_j.x, ..., x_next.y]`): [`bend_gradient_edges`]
+/// mapped through `e1 = x_j - x_prev`, `e2 = x_next - x_j`.
+#[inline(always)]
+pub fn bend_gradient<T: Real>(x: [T; 6], b: f64, kappa0: f64, inv_len: f64) -> [T; 6] {
+    let e = [x[2] - x[0], x[3] - x[1], x[4] - x[2], x[5] - x[3]];
+    let [g1x, g1y, g2x, g2y] = bend_gradient_edges(e, b, kappa0, inv_len);
     [-g1x, -g1y, g1x - g2x, g1y - g2y, g2x, g2y]
 }
 

@@ -1,21 +1,22 @@
 //! `E(v)`, its gradient, the per-element Hessian blocks (exact by dual
-//! numbers, optionally projected onto PSD) and the matrix-free `H d` and
-//! Jacobi diagonal from them.
+//! numbers or, for a pure fibre stretch, in closed form; optionally
+//! projected onto PSD) and the matrix-free `H d` and Jacobi diagonal from
+//! them.
 
-use super::blocks::{mul, project_psd, symmetrize};
-use super::dual::{bend_gradient, jacobian, quad_gradient};
+use super::blocks::{mul, project_bend, project_psd, symmetrize};
+use super::dual::{bend_gradient_edges, jacobian, quad_gradient};
 use super::precond::StiffRow;
 use super::problem::{BendElem, QuadElem};
 use super::Problem;
 use crate::math::{Mat2, Vec2};
 
 /// The Hessian of `Psi` in element coordinates at one `v`: per quadrature
-/// particle in `(d1, d2)`, per bending vertex in its three positions, per
-/// node the attractor's (times `m dt^2`, in `v`).
+/// particle in `(d1, d2)`, per bending vertex in its edges `(e1, e2)`,
+/// per node the attractor's (times `m dt^2`, in `v`).
 #[derive(Clone, Debug, Default)]
 pub struct Blocks {
     pub quad: Vec<[[f64; 4]; 4]>,
-    pub bend: Vec<[[f64; 6]; 6]>,
+    pub bend: Vec<[[f64; 4]; 4]>,
     pub attr: Vec<[[f64; 2]; 2]>,
 }
 
@@ -24,6 +25,38 @@ pub struct Blocks {
 #[inline]
 fn phi(r: f64, s: f64) -> f64 {
     s * (r - 0.01 * (r + 0.01).ln())
+}
+
+/// The exact block of a pure fibre stretch (`gamma = normal = 0`: `psi =
+/// k/2 (|d1| / l0 - 1)^2`, nothing in `d2`), in closed form: `vol k / l0^2
+/// [u u^T + (1 - l0 / L) (I - u u^T)]` in `d1` (`L = |d1|`, `u = d1 / L`),
+/// the transverse coefficient clamped at 0 when `psd` (its eigenvalues are
+/// the two coefficients). `None` where the stress clamps `r11` (then the
+/// dual-number path).
+#[inline]
+pub(super) fn spring_block(
+    k: f64,
+    d: [f64; 4],
+    l0: f64,
+    vol: f64,
+    psd: bool,
+) -> Option<[[f64; 4]; 4]> {
+    let il = 1.0 / l0;
+    let (a, b) = (d[0] * il, d[1] * il);
+    let r11 = (a * a + b * b).sqrt();
+    if r11 < super::super::constitutive::R11_MIN {
+        return None;
+    }
+    let (ux, uy) = (a / r11, b / r11);
+    let s = vol * k * il * il;
+    let t = 1.0 - 1.0 / r11;
+    let t = if psd { t.max(0.0) } else { t };
+    let mut h = [[0.0; 4]; 4];
+    h[0][0] = s * (ux * ux + t * uy * uy);
+    h[1][1] = s * (uy * uy + t * ux * ux);
+    h[0][1] = s * (1.0 - t) * ux * uy;
+    h[1][0] = h[0][1];
+    Some(h)
 }
 
 impl Problem {
@@ -39,17 +72,16 @@ impl Problem {
         [d1.x, d1.y, d2.x, d2.y]
     }
 
-    /// The three positions of bending vertex `b` at `v`.
+    /// The edges `(e1, e2)` of bending vertex `b` at `v`.
     #[inline]
-    fn bend_x(&self, b: &BendElem, v: &[Vec2]) -> [f64; 6] {
-        let mut x = b.x;
+    fn bend_e(&self, b: &BendElem, v: &[Vec2]) -> [f64; 4] {
+        let [mut e1, mut e2] = b.e;
         for t in &self.bend_terms[b.start as usize..b.end as usize] {
             let vn = v[t.node as usize];
-            for (x, c) in x.iter_mut().zip(t.c) {
-                *x += vn * c;
-            }
+            e1 += vn * t.a[0];
+            e2 += vn * t.a[1];
         }
-        [x[0].x, x[0].y, x[1].x, x[1].y, x[2].x, x[2].y]
+        [e1.x, e1.y, e2.x, e2.y]
     }
 
     /// The frames `(d1, d2)` of the quadrature particles at `v`.
@@ -76,9 +108,8 @@ impl Problem {
             .bends
             .iter()
             .map(|b| {
-                let x = self.bend_x(b, v);
-                let e1 = Vec2::new(x[2] - x[0], x[3] - x[1]);
-                let e2 = Vec2::new(x[4] - x[2], x[5] - x[3]);
+                let e = self.bend_e(b, v);
+                let (e1, e2) = (Vec2::new(e[0], e[1]), Vec2::new(e[2], e[3]));
                 let dk = super::super::bending::curvature(e1, e2) - b.kappa0;
                 0.5 * self.bending * dk * dk * b.inv_len
             })
@@ -109,12 +140,10 @@ impl Problem {
             }
         }
         for b in &self.bends {
-            let f = bend_gradient(self.bend_x(b, v), self.bending, b.kappa0, b.inv_len);
+            let f = bend_gradient_edges(self.bend_e(b, v), self.bending, b.kappa0, b.inv_len);
+            let (f1, f2) = (Vec2::new(f[0], f[1]), Vec2::new(f[2], f[3]));
             for term in &self.bend_terms[b.start as usize..b.end as usize] {
-                let gn = &mut g[term.node as usize];
-                for k in 0..3 {
-                    *gn += Vec2::new(f[2 * k], f[2 * k + 1]) * term.c[k];
-                }
+                g[term.node as usize] += f1 * term.a[0] + f2 * term.a[1];
             }
         }
         if let Some(a) = &self.attractor {
@@ -130,11 +159,18 @@ impl Problem {
     /// onto the PSD cone when `psd`.
     pub fn blocks(&self, v: &[Vec2], psd: bool) -> Blocks {
         let e = self.energy;
+        let spring = e.gamma == 0.0 && e.normal == 0.0;
         let quad = self
             .quads
             .iter()
             .map(|q| {
-                let mut h = jacobian(self.quad_d(q, v), |d| quad_gradient(&e, d, q.l0, q.vol));
+                let d = self.quad_d(q, v);
+                if spring {
+                    if let Some(h) = spring_block(e.k, d, q.l0, q.vol, psd) {
+                        return h;
+                    }
+                }
+                let mut h = jacobian(d, |d| quad_gradient(&e, d, q.l0, q.vol));
                 symmetrize(&mut h);
                 if psd {
                     project_psd(&h)
@@ -148,12 +184,11 @@ impl Problem {
             .bends
             .iter()
             .map(|b| {
-                let mut h = jacobian(self.bend_x(b, v), |x| {
-                    bend_gradient(x, bs, b.kappa0, b.inv_len)
-                });
+                let e = self.bend_e(b, v);
+                let mut h = jacobian(e, |e| bend_gradient_edges(e, bs, b.kappa0, b.inv_len));
                 symmetrize(&mut h);
                 if psd {
-                    project_psd(&h)
+                    project_bend(&h, e, bend_gradient_edges(e, bs, b.kappa0, b.inv_len))
                 } else {
                     h
                 }
@@ -181,7 +216,16 @@ impl Problem {
 
     /// `H d = M d + sum_e J_e^T K_e J_e d` from the blocks.
     pub fn hess_vec_blocks(&self, k: &Blocks, d: &[Vec2]) -> Vec<Vec2> {
-        let mut y: Vec<Vec2> = (0..d.len()).map(|i| d[i] * self.mass[i]).collect();
+        let mut y = vec![Vec2::zeros(); d.len()];
+        self.hess_vec_into(k, d, &mut y);
+        y
+    }
+
+    /// [`Problem::hess_vec_blocks`] into `y` (overwritten).
+    pub fn hess_vec_into(&self, k: &Blocks, d: &[Vec2], y: &mut [Vec2]) {
+        for ((y, d), m) in y.iter_mut().zip(d).zip(&self.mass) {
+            *y = d * *m;
+        }
         for (q, kq) in self.quads.iter().zip(&k.quad) {
             let terms = &self.quad_terms[q.start as usize..q.end as usize];
             let (mut d1, mut d2) = (Vec2::zeros(), Vec2::zeros());
@@ -198,26 +242,21 @@ impl Problem {
         }
         for (b, kb) in self.bends.iter().zip(&k.bend) {
             let terms = &self.bend_terms[b.start as usize..b.end as usize];
-            let mut dx = [0.0; 6];
+            let (mut d1, mut d2) = (Vec2::zeros(), Vec2::zeros());
             for t in terms {
                 let dn = d[t.node as usize];
-                for k in 0..3 {
-                    dx[2 * k] += dn.x * t.c[k];
-                    dx[2 * k + 1] += dn.y * t.c[k];
-                }
+                d1 += dn * t.a[0];
+                d2 += dn * t.a[1];
             }
-            let f = mul(kb, &dx);
+            let f = mul(kb, &[d1.x, d1.y, d2.x, d2.y]);
+            let (f1, f2) = (Vec2::new(f[0], f[1]), Vec2::new(f[2], f[3]));
             for t in terms {
-                let yn = &mut y[t.node as usize];
-                for k in 0..3 {
-                    *yn += Vec2::new(f[2 * k], f[2 * k + 1]) * t.c[k];
-                }
+                y[t.node as usize] += f1 * t.a[0] + f2 * t.a[1];
             }
         }
         for ((y, a), d) in y.iter_mut().zip(&k.attr).zip(d) {
             *y += Vec2::new(a[0][0] * d.x + a[0][1] * d.y, a[1][0] * d.x + a[1][1] * d.y);
         }
-        y
     }
 
     /// The exact `H d` at `v` (unprojected blocks).
@@ -244,13 +283,10 @@ impl Problem {
             for t in &self.bend_terms[b.start as usize..b.end as usize] {
                 let o = &mut out[t.node as usize];
                 for c in 0..2 {
-                    let mut s = 0.0;
-                    for a in 0..3 {
-                        for b in 0..3 {
-                            s += t.c[a] * t.c[b] * kb[2 * a + c][2 * b + c];
-                        }
-                    }
-                    o[c] += s;
+                    let (i, j) = (c, c + 2);
+                    o[c] += t.a[0] * t.a[0] * kb[i][i]
+                        + 2.0 * t.a[0] * t.a[1] * kb[i][j]
+                        + t.a[1] * t.a[1] * kb[j][j];
                 }
             }
         }

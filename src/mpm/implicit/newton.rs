@@ -117,6 +117,7 @@ pub fn solve(p: &Problem, s: &Settings) -> Result<Solution, String> {
     let tol = (s.rel_tol * g0).max(s.abs_tol * (mv + p.dt() * p.force_scale()));
     let mut e = p.energy(&v);
     let mut stiff = None;
+    let mut trial = vec![Vec2::zeros(); v.len()];
     loop {
         let gn = dot(&g, &g).sqrt();
         if gn <= tol || gn == 0.0 {
@@ -157,7 +158,9 @@ pub fn solve(p: &Problem, s: &Settings) -> Result<Solution, String> {
         let mut alpha = 1.0;
         let mut halvings = 0;
         loop {
-            let trial: Vec<Vec2> = v.iter().zip(&d).map(|(v, d)| v + d * alpha).collect();
+            for ((t, v), d) in trial.iter_mut().zip(&v).zip(&d) {
+                *t = v + d * alpha;
+            }
             let et = p.energy(&trial);
             let armijo = et <= e + 1e-4 * alpha * slope;
             // near the solution E changes below its round-off (`L - l0`
@@ -173,7 +176,7 @@ pub fn solve(p: &Problem, s: &Settings) -> Result<Solution, String> {
             };
             if let Some(gt) = gt {
                 if armijo || dot(&gt, &gt).sqrt() < gn {
-                    v = trial;
+                    std::mem::swap(&mut v, &mut trial);
                     e = et;
                     g = gt;
                     impulses = lt;
@@ -197,26 +200,29 @@ pub fn solve(p: &Problem, s: &Settings) -> Result<Solution, String> {
 /// Preconditioned CG on `H d = -g` in the pin-keeping subspace; returns
 /// `d` and the iterations. Stops at negative curvature (only with the
 /// exact, unprojected blocks): with the iterate so far, or the
-/// preconditioned steepest descent when that is the first.
+/// preconditioned steepest descent when that is the first. The work
+/// vectors are allocated once per system.
 fn pcg(p: &Problem, blocks: &Blocks, g: &[Vec2], s: &Settings, pre: &Pre) -> (Vec<Vec2>, usize) {
-    // z = Pi P^-1 Pi^T r, and |Pi^T r| (the residual that can vanish)
-    let precond = |r: &[Vec2]| -> (Vec<Vec2>, f64) {
-        let mut r = r.to_vec();
-        p.project_dual(&mut r);
-        let norm = dot(&r, &r).sqrt();
-        let mut z = vec![Vec2::zeros(); r.len()];
-        pre.apply(&r, &mut z);
-        p.project(&mut z);
-        (z, norm)
-    };
     let n = g.len();
+    // z = Pi P^-1 Pi^T r, and |Pi^T r| (the residual that can vanish)
+    let mut rp = vec![Vec2::zeros(); n];
+    let mut precond = |r: &[Vec2], z: &mut [Vec2]| -> f64 {
+        rp.copy_from_slice(r);
+        p.project_dual(&mut rp);
+        let norm = dot(&rp, &rp).sqrt();
+        pre.apply(&rp, z);
+        p.project(z);
+        norm
+    };
     let mut x = vec![Vec2::zeros(); n];
     let mut r: Vec<Vec2> = g.iter().map(|g| -g).collect();
-    let (mut z, r0) = precond(&r);
+    let mut z = vec![Vec2::zeros(); n];
+    let r0 = precond(&r, &mut z);
     let mut pd = z.clone();
+    let mut hp = vec![Vec2::zeros(); n];
     let mut rz = dot(&r, &z);
     for it in 0..s.max_cg {
-        let hp = p.hess_vec_blocks(blocks, &pd);
+        p.hess_vec_into(blocks, &pd, &mut hp);
         let curv = dot(&pd, &hp);
         if curv <= 0.0 {
             if it == 0 {
@@ -229,11 +235,10 @@ fn pcg(p: &Problem, blocks: &Blocks, g: &[Vec2], s: &Settings, pre: &Pre) -> (Ve
             x[i] += pd[i] * a;
             r[i] -= hp[i] * a;
         }
-        let (zn, rn) = precond(&r);
+        let rn = precond(&r, &mut z);
         if rn <= s.cg_tol * r0 {
             return (x, it + 1);
         }
-        z = zn;
         let rz_new = dot(&r, &z);
         let beta = rz_new / rz;
         rz = rz_new;

@@ -88,8 +88,21 @@ impl Problem {
         if self.rows.is_empty() {
             return Vec::new();
         }
-        let gm: Vec<Vec2> = g.iter().zip(&self.mass).map(|(g, m)| g / *m).collect();
-        let mut l = self.apply_a(&gm);
+        // A M^-1 g without the scaled copy of g
+        let mut l: Vec<Vec2> = self
+            .rows
+            .iter()
+            .map(|(w, _, _)| {
+                let mut s = Vec2::zeros();
+                for n in 0..9 {
+                    if w.node[n] != NONE {
+                        let i = w.node[n] as usize;
+                        s += (g[i] / self.mass[i]) * w.w[n];
+                    }
+                }
+                s
+            })
+            .collect();
         self.solve_s(&mut l);
         let neg: Vec<Vec2> = l.iter().map(|l| -l).collect();
         self.add_at(&neg, false, g);

@@ -1,9 +1,11 @@
 //! The unknowns of one implicit substep and the energy's sparse affine
 //! maps from them: per quadrature particle the merged list of `(node, c1,
 //! c2)` with `d1(v) = d1_0 + sum c1_n v_n`, `d2(v) = d2_old + sum c2_n
-//! v_n`; per bending vertex the merged list of `(node, c_prev, c_j,
-//! c_next)` with `x_k(v) = x_k + sum c_kn v_n`; per node its position for
-//! the attractor.
+//! v_n`; per bending vertex the merged list of `(node, a1, a2)` with the
+//! edges `e1(v) = e1_0 + sum a1_n v_n`, `e2(v) = e2_0 + sum a2_n v_n`
+//! (`a1 = c_j - c_prev`, `a2 = c_next - c_j` from the vertices' stencils:
+//! the energy depends on the edges only, so the block is 4x4 without the
+//! translation modes); per node its position for the attractor.
 
 // small dense blocks and stencils: index loops read as the formulas
 #![allow(clippy::needless_range_loop)]
@@ -46,23 +48,23 @@ pub(super) struct QuadTerm {
     pub c2: f64,
 }
 
-/// One interior vertex's bending: rest curvature, `1 / l`, the three
-/// positions at `v = 0` and its terms `bend_terms[start..end]`.
+/// One interior vertex's bending: rest curvature, `1 / l`, the edges
+/// `(e1, e2)` at `v = 0` and its terms `bend_terms[start..end]`.
 #[derive(Clone, Copy, Debug)]
 pub(super) struct BendElem {
     pub kappa0: f64,
     pub inv_len: f64,
-    pub x: [Vec2; 3],
+    pub e: [Vec2; 2],
     pub start: u32,
     pub end: u32,
 }
 
-/// `(node, c)`: the node's velocity moves vertex `k` of the triple by
-/// `c[k] v_n`.
+/// `(node, a)`: the node's velocity moves edge `k` of the vertex by
+/// `a[k] v_n`.
 #[derive(Clone, Copy, Debug)]
 pub(super) struct BendTerm {
     pub node: u32,
-    pub c: [f64; 3],
+    pub a: [f64; 2],
 }
 
 /// The attractor's node energy `m_i phi(|x_i + dt v_i - p|)`,
@@ -232,11 +234,14 @@ impl Problem {
                     }
                 }
                 let start = bend_terms.len() as u32;
-                bend_terms.extend(list.iter().map(|&(node, c)| BendTerm { node, c }));
+                bend_terms.extend(list.iter().filter_map(|&(node, c)| {
+                    let a = [c[1] - c[0], c[2] - c[1]];
+                    (a != [0.0; 2]).then_some(BendTerm { node, a })
+                }));
                 bends.push(BendElem {
                     kappa0: rest.kappa0,
                     inv_len: rest.inv_len,
-                    x: [x[j - 1], x[j], x[j + 1]],
+                    e: [x[j] - x[j - 1], x[j + 1] - x[j]],
                     start,
                     end: bend_terms.len() as u32,
                 });
