@@ -13,7 +13,7 @@ mod common;
 
 use std::time::Instant;
 
-use common::{capstan_threshold, on_threads, pin_end, straight, SceneBuilder};
+use common::{capstan_threshold, pin_end, straight, SceneBuilder};
 use yarnsim::math::Vec2;
 use yarnsim::scene::{
     Integrator, Material, PinMotionKind, StepSize, TransferScheme, WallMode, YarnEnd, YarnScene,
@@ -195,17 +195,7 @@ fn boundaries_give_the_same_bits_for_one_and_two_threads() {
         1e-3,
     );
     assert_eq!(s.walls.mode, WallMode::Slip);
-    let run = |threads: usize| {
-        on_threads(threads, || {
-            let mut sim = YarnSim::new(&s).unwrap();
-            sim.steps_n(60).unwrap();
-            (sim.save_state(), sim.implicit_stats())
-        })
-    };
-    let (a, sa) = run(1);
-    let (b, sb) = run(2);
-    assert_eq!(sa, sb);
-    assert!(a == b, "states differ");
+    common::same_bits_on_one_and_two_threads(&s, 60);
 }
 
 // ---- incline ---------------------------------------------------------------
