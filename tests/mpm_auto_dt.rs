@@ -5,7 +5,7 @@
 
 mod common;
 
-use common::{bundle, on_threads, SceneBuilder};
+use common::{bundle, SceneBuilder};
 use yarnsim::mpm::Stepping;
 use yarnsim::scene::{builtin, Scene, SceneError, StepSize, WallMode, YarnScene, DEFAULT_SAFETY};
 use yarnsim::YarnSim;
@@ -137,17 +137,11 @@ fn dt_max_caps_the_substep() {
 #[test]
 fn bit_identical_for_one_and_two_threads() {
     let t_end = if cfg!(debug_assertions) { 0.01 } else { 0.1 };
-    let run = |threads: usize| {
-        on_threads(threads, || {
-            let mut sim = YarnSim::new(&small()).unwrap();
-            sim.advance_to(t_end).unwrap();
-            (sim.save_state(), sim.dt_stats())
-        })
-    };
-    let (a, sa) = run(1);
-    let (b, sb) = run(2);
-    assert_eq!(sa, sb);
-    assert!(a == b, "states differ");
+    common::same_on_one_and_two_threads(|| {
+        let mut sim = YarnSim::new(&small()).unwrap();
+        sim.advance_to(t_end).unwrap();
+        (sim.save_state(), sim.dt_stats())
+    });
 }
 
 /// `dt = "auto"`, `safety` and `dt_max` read and write back; bad values

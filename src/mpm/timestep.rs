@@ -42,8 +42,10 @@
 //! bound applies. What remains is advection: a particle must not cross
 //! more than one cell per substep (the gather's check), so
 //! [`YarnSim::stable_dt`] is `COURANT dx / |v|max` ([`implicit_stable_dt`];
-//! infinite at rest) and `dt = "auto"` takes `min(safety * dx / |v|max,
-//! dt_max)`, `dt_max` defaulting to the scene's `frame_dt` under the
+//! infinite at rest) and `dt = "auto"` takes the substep over which the
+//! fastest particle, gaining `|g| dt` from gravity, moves `safety dx`
+//! ([`implicit_auto_dt`]; `safety * dx / |v|max` without gravity), capped
+//! by `dt_max`, `dt_max` defaulting to the scene's `frame_dt` under the
 //! implicit integrator (no default cap under the explicit one). Accuracy,
 //! not stability, decides a good cap: backward Euler damps and slows a
 //! mode of angular frequency `omega` by terms in `(omega dt)^2` (measured on
@@ -87,6 +89,24 @@ pub fn stable_dt(m: &Material, dx: f64, v_max: f64) -> f64 {
 /// bending bounds of [`stable_dt`] are for the explicit step only.
 pub fn implicit_stable_dt(dx: f64, v_max: f64) -> f64 {
     COURANT * dx / v_max.abs()
+}
+
+/// The implicit integrator's adaptive substep in s (`dt = "auto"`, before
+/// the cap): the largest `dt` over which a particle that starts at
+/// `v_max` and gains `accel dt` (m/s^2: gravity) crosses at most
+/// `safety COURANT dx`, `(v_max + accel dt) dt = safety COURANT dx`, i.e.
+/// `dt = 2 h / (v_max + sqrt(v_max^2 + 4 accel h))`, `h = safety COURANT
+/// dx`. The gather checks the speed at the end of the substep: from rest
+/// under gravity `safety * implicit_stable_dt` would take the cap, and a
+/// falling yarn would pass one cell within it. With `accel = 0` it is
+/// `safety * implicit_stable_dt`.
+pub fn implicit_auto_dt(dx: f64, v_max: f64, accel: f64, safety: f64) -> f64 {
+    let v = v_max.abs();
+    if accel == 0.0 {
+        return safety * implicit_stable_dt(dx, v);
+    }
+    let h = safety * COURANT * dx;
+    2.0 * h / (v + (v * v + 4.0 * accel.abs() * h).sqrt())
 }
 
 impl YarnSim {

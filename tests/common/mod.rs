@@ -51,6 +51,32 @@ pub fn on_threads<R: Send>(threads: usize, f: impl FnOnce() -> R + Send) -> R {
         .install(f)
 }
 
+/// `run` on 1 and on 2 threads (each with its own pool): asserts the
+/// same result (states compared with `==`, no dump of their bytes) and
+/// returns it.
+pub fn same_on_one_and_two_threads<S: PartialEq + Send, T: PartialEq + std::fmt::Debug + Send>(
+    run: impl Fn() -> (S, T) + Sync,
+) -> T {
+    let (a, sa) = on_threads(1, &run);
+    let (b, sb) = on_threads(2, &run);
+    assert_eq!(sa, sb);
+    assert!(a == b, "states differ");
+    sa
+}
+
+/// Runs `steps` substeps of `scene` on 1 and on 2 threads and asserts the
+/// same saved state and implicit-solve counts; returns the counts.
+pub fn same_bits_on_one_and_two_threads(
+    scene: &YarnScene,
+    steps: u64,
+) -> yarnsim::mpm::sim::ImplicitStats {
+    same_on_one_and_two_threads(|| {
+        let mut sim = YarnSim::new(scene).unwrap();
+        sim.steps_n(steps).unwrap();
+        (sim.save_state(), sim.implicit_stats())
+    })
+}
+
 /// A yarn scene from TOML text; panics with the loader's message on error.
 pub fn scene(text: &str) -> YarnScene {
     YarnScene::from_toml_str(text).unwrap_or_else(|e| panic!("{e}"))

@@ -191,14 +191,20 @@ impl YarnSim {
     /// The adaptive substep of the current state:
     /// `min(safety * stable_dt, dt_max)` ([`YarnSim::stable_dt`]: the
     /// elastic-wave plus particle-speed CFL bound and the bending bound;
-    /// under the implicit integrator the advection limit alone, `dt_max`
-    /// defaulting to `frame_dt`); with a fixed `dt`, safety
+    /// under the implicit integrator the advection limit alone, with the
+    /// speed gravity adds over the substep, [`super::timestep::implicit_auto_dt`],
+    /// `dt_max` defaulting to `frame_dt`); with a fixed `dt`, safety
     /// [`DEFAULT_SAFETY`] and no cap.
     pub fn auto_dt(&self) -> f64 {
         let (safety, dt_max) = match self.stepping {
             Stepping::Auto { safety, dt_max } => (safety, dt_max),
             Stepping::Fixed(_) => (DEFAULT_SAFETY, f64::INFINITY),
         };
+        if self.is_implicit() {
+            let dx = self.grid_geom().dx;
+            let g = self.gravity().norm();
+            return super::timestep::implicit_auto_dt(dx, self.max_speed(), g, safety).min(dt_max);
+        }
         (safety * self.stable_dt()).min(dt_max)
     }
     /// Count and sizes of the substeps since the last
