@@ -72,7 +72,7 @@ pub struct Problem {
     attractor: Option<AttractorTerm>,
     /// Pin constraint rows (weights in unknown indices) and targets.
     rows: Vec<(Weights, Vec2, usize)>,
-    /// Cholesky factor (lower, row-major) of `S = A M^-1 A^T`.
+    /// Pivoted Cholesky factor of `S = A M^-1 A^T` ([`pins::PinFactor`]).
     chol: pins::PinFactor,
 }
 

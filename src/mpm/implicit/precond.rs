@@ -213,18 +213,8 @@ fn solve_band(l: &[f64], n: usize, bw: usize, w: usize, b: &mut [f64]) {
 
 #[cfg(test)]
 mod tests {
+    use super::super::tests::Lcg;
     use super::*;
-
-    struct Lcg(u64);
-    impl Lcg {
-        fn next(&mut self) -> f64 {
-            self.0 = self
-                .0
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (self.0 >> 11) as f64 / (1u64 << 53) as f64
-        }
-    }
 
     /// `groups` yarns of `per` segments each over `nodes` nodes; segment
     /// `s` of a yarn touches the nodes `offset + 2 s .. + 6` (neighbours

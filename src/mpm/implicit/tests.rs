@@ -13,9 +13,9 @@ use crate::mpm::constitutive::frame_gradient;
 use crate::mpm::particles::NONE;
 
 /// A small deterministic generator (LCG) of numbers in [0, 1).
-struct Lcg(u64);
+pub(super) struct Lcg(pub u64);
 impl Lcg {
-    fn next(&mut self) -> f64 {
+    pub(super) fn next(&mut self) -> f64 {
         self.0 = self
             .0
             .wrapping_mul(6364136223846793005)
