@@ -9,14 +9,24 @@ use super::YarnSim;
 use crate::math::Vec2;
 
 /// Cost of the implicit substeps (`[time] integrator = "implicit"`) since
-/// the start.
+/// the start, the attempts that a cutback undid included
+/// ([`super::cutback`]).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct ImplicitStats {
+    /// Solves that converged.
     pub substeps: u64,
     pub newton: u64,
     pub cg: u64,
     /// Most Newton iterations of one substep.
     pub max_newton: u64,
+    /// Substeps run as two halves ([`super::cutback`]).
+    pub cutbacks: u64,
+    /// Of those, the ones tried first and undone (a failed solve or a
+    /// vertex past a cell); the others were past the advection limit of
+    /// their starting state.
+    pub undone: u64,
+    /// Most halvings of one substep (at most [`super::MAX_CUTBACKS`]).
+    pub deepest_cut: u32,
 }
 
 /// What [`implicit_grid`] writes.

@@ -1,0 +1,131 @@
+//! Step cutback of the implicit substep. A backward Euler substep that
+//! fails (its Newton solve does not converge, or its result moves a vertex
+//! more than one cell, the gather's advection check) is undone and run
+//! again as two substeps of half the size, each under the same rule, at
+//! most [`MAX_CUTBACKS`] halvings deep. A substep longer than the advection
+//! limit of the state it starts from (`timestep::implicit_auto_dt` at
+//! safety 1: the fastest particle, sped up by gravity over the substep,
+//! would pass a cell) is halved without being tried, so a failed solve is
+//! not paid for a step that the speeds already rule out. This is the automatic incrementation
+//! of implicit finite-element codes (cut the increment back when Newton
+//! does not converge) with the advection limit of CFL-rate implicit MPM
+//! (Wang et al. 2020, "Hierarchical optimization time integration for
+//! CFL-rate MPM stepping") as the second criterion. Each outer substep
+//! starts again from its full size: the choice depends on the state only,
+//! so the same inputs give the same substeps (and bits) for any thread
+//! count, and a saved state needs nothing more.
+//!
+//! The explicit integrator has no cutback: there a failed substep is a
+//! diverging run, and the stable step is known before it.
+
+use super::stats::DtStats;
+use super::{SimError, YarnSim};
+use crate::math::Vec2;
+use crate::mpm::particles::Particles;
+use crate::mpm::timestep::implicit_auto_dt;
+
+/// Most halvings of one implicit substep: down to `dt / 32`.
+pub const MAX_CUTBACKS: u32 = 5;
+
+/// What a failed substep may have changed and a retry needs back (the grids
+/// are rebuilt by every substep; the cost counters keep the failed work).
+struct Checkpoint {
+    particles: Particles,
+    pin_reactions: Vec<Vec2>,
+    time: f64,
+    steps: u64,
+    dt_stats: DtStats,
+    frames_stale: bool,
+}
+
+impl Checkpoint {
+    fn of(sim: &YarnSim) -> Self {
+        Checkpoint {
+            particles: sim.particles.clone(),
+            pin_reactions: sim.pin_reactions.clone(),
+            time: sim.time,
+            steps: sim.steps,
+            dt_stats: sim.dt_stats,
+            frames_stale: sim.frames_stale,
+        }
+    }
+
+    fn restore(self, sim: &mut YarnSim) {
+        sim.particles = self.particles;
+        sim.pin_reactions = self.pin_reactions;
+        sim.time = self.time;
+        sim.steps = self.steps;
+        sim.dt_stats = self.dt_stats;
+        sim.frames_stale = self.frames_stale;
+        sim.failed = None;
+    }
+}
+
+impl YarnSim {
+    /// [`YarnSim::step_dt`] on this thread: one substep of `dt`, under the
+    /// implicit integrator with cutbacks; the clock then reads `t + dt`
+    /// however it was divided.
+    pub(super) fn substep(&mut self, dt: f64) -> Result<(), SimError> {
+        if let Some(e) = &self.failed {
+            return Err(e.clone());
+        }
+        if !(dt.is_finite() && dt > 0.0) {
+            return Err(SimError::BadInput(format!(
+                "substep dt {dt} must be finite and > 0"
+            )));
+        }
+        if !self.is_implicit() {
+            return self.substep_once(dt);
+        }
+        let end = self.time + dt;
+        self.cut(dt, 0)?;
+        self.time = end;
+        Ok(())
+    }
+
+    /// `dt` at cutback depth `depth`: as one substep, or, when that fails
+    /// and `depth < MAX_CUTBACKS`, as two halves.
+    fn cut(&mut self, dt: f64, depth: u32) -> Result<(), SimError> {
+        if depth == MAX_CUTBACKS {
+            return self.substep_once(dt).map_err(|e| self.exhausted(e, dt));
+        }
+        if dt <= self.advection_limit() {
+            let keep = Checkpoint::of(self);
+            match self.substep_once(dt) {
+                Err(SimError::NonFinite { .. }) => {
+                    keep.restore(self);
+                    self.implicit_stats.undone += 1;
+                }
+                r => return r,
+            }
+        }
+        let st = &mut self.implicit_stats;
+        st.cutbacks += 1;
+        st.deepest_cut = st.deepest_cut.max(depth + 1);
+        self.cut(0.5 * dt, depth + 1)?;
+        self.cut(0.5 * dt, depth + 1)
+    }
+
+    /// The longest substep from this state whose fastest particle, sped up
+    /// by gravity over it, moves at most one cell.
+    fn advection_limit(&self) -> f64 {
+        let (dx, g) = (self.grid_geom().dx, self.gravity().norm());
+        implicit_auto_dt(dx, self.max_speed(), g, 1.0)
+    }
+
+    /// The error of a substep that failed at the deepest cutback, saying so.
+    fn exhausted(&mut self, e: SimError, dt: f64) -> SimError {
+        let e = match e {
+            SimError::NonFinite { step, time, what } => SimError::NonFinite {
+                step,
+                time,
+                what: format!(
+                    "{what} (after {MAX_CUTBACKS} cutbacks of the implicit substep, to dt {dt:.3e} s)"
+                ),
+            },
+            e => e,
+        };
+        self.failed = Some(e.clone());
+        e
+    }
+}
