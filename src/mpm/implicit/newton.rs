@@ -71,7 +71,7 @@ impl Pre<'_> {
 impl Default for Settings {
     fn default() -> Self {
         Settings {
-            rel_tol: 1e-6,
+            rel_tol: 1e-8,
             abs_tol: 1e-11,
             max_newton: 50,
             max_cg: 2000,
