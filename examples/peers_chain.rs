@@ -91,8 +91,10 @@ fn integrator(args: &[String], i: usize) -> Integrator {
     match args.get(i).map(String::as_str) {
         None | Some("explicit") => Integrator::Explicit,
         Some("implicit") => Integrator::Implicit,
+        Some("implicit-vertices") => Integrator::ImplicitVertices,
+        Some("midpoint-vertices") => Integrator::MidpointVertices,
         Some(x) => {
-            eprintln!("INTEGRATOR must be explicit or implicit, got {x:?}");
+            eprintln!("INTEGRATOR must be explicit, implicit, implicit-vertices or midpoint-vertices, got {x:?}");
             std::process::exit(2)
         }
     }
@@ -122,7 +124,8 @@ fn chain(vertices: u32, grid: u32, dt: &str, integ: Integrator, k: Option<f64>) 
     let t0 = Instant::now();
     while sim.time() < duration {
         let before = sim.time();
-        if sim.step().is_err() {
+        if let Err(e) = sim.step() {
+            eprintln!("{e}");
             ok = false;
             break;
         }
@@ -134,11 +137,12 @@ fn chain(vertices: u32, grid: u32, dt: &str, integ: Integrator, k: Option<f64>) 
     let oracle = hanging_chain_period();
     format!(
         "{{\"ok\": {ok}, \"period\": {period}, \"oracle\": {oracle}, \"error\": {}, \"crossings\": {}, \
-         \"wall_s\": {wall}, \"sim_s\": {}, \"steps\": {}}}",
+         \"wall_s\": {wall}, \"sim_s\": {}, \"steps\": {}, \"newton\": {}}}",
         (period - oracle) / oracle,
         crossings.times.len(),
         sim.time(),
-        sim.steps()
+        sim.steps(),
+        sim.implicit_stats().newton
     )
 }
 
@@ -187,12 +191,22 @@ fn capstan(r: f64, l1: f64, l2: f64, mu: f64, integ: Integrator, dt: Option<f64>
     let s = scene(&capstan_toml(r, l1, l2, mu, &c));
     let mut sim = sim_with(s, integ);
     let t0 = Instant::now();
-    let mut ok = sim.advance(0.2).is_ok();
+    let mut ok = match sim.advance(0.2) {
+        Ok(_) => true,
+        Err(e) => {
+            eprintln!("{e}");
+            false
+        }
+    };
     let (a0, b0) = sim.yarn_endpoints(0);
     let steps = (1.0 / sim.dt()).round() as u64;
     let (mut worst, mut slid) = (0.0f64, false);
     for k in 0..steps {
-        if !ok || sim.step().is_err() {
+        if !ok {
+            break;
+        }
+        if let Err(e) = sim.step() {
+            eprintln!("{e}");
             ok = false;
             break;
         }

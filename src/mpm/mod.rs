@@ -33,6 +33,7 @@ pub mod frames;
 pub mod grid;
 pub mod grid_to_particle;
 pub mod grid_update;
+pub mod gridless;
 pub mod implicit;
 pub mod line_pool;
 pub mod particle_to_grid;

@@ -132,7 +132,7 @@ impl YarnSim {
     /// simulation's own `dt()` should not exceed it.
     pub fn stable_dt(&self) -> f64 {
         if self.is_implicit() {
-            return implicit_stable_dt(self.grid_geom().dx, self.max_speed());
+            return implicit_stable_dt(self.advection_length(), self.max_speed());
         }
         stable_dt(
             &self.scene().material,

@@ -13,7 +13,9 @@ round the tools take turns (the order rotates from round to round) and the
 wall time is the median over the rounds; errors are deterministic. The
 capstan threshold is a bisection (slides at 0.7 mu*, holds at 1.4 mu*, then
 five halvings: a bracket of 2.2 % of mu*; yarnsim's test does three) and the bundle a single window; both run
-once. yarnsim runs under both integrators (`mpm-explicit`, `mpm-implicit`);
+once. yarnsim runs on the grid under both integrators (`mpm-explicit`,
+`mpm-implicit`) and, for the single-yarn oracles, on the vertices without
+the grid (`vertices-implicit`, `vertices-midpoint`);
 a scene the implicit integrator refuses is a row with ok=False and the
 refusal in `note`. `--quick` (under a minute) runs the coarsest chain and
 cantilever of each tool (and the implicit chain at 25 vertices, dt 1e-2), once, and writes `peers_quick.csv` / `.svg` into `--out` (default
@@ -79,6 +81,16 @@ def cases(quick):
             c.append(("yarnsim", "mpm-implicit-k2e5", "chain",
                       f"{v} vertices, {g}^2, dt {dt}, k 2e5",
                       lambda v=v, g=g, dt=dt: yarnsim_rope.chain(v, g, dt, "implicit", 2e5)))
+    # without the grid: one yarn's vertices by backward Euler
+    # (`integrator = "implicit-vertices"`) and the generalized midpoint rule
+    # (`"midpoint-vertices"`, theta 0.55), k = 2e5 as above
+    ch_gl = [(50, "1e-2")] if quick else [(25, "1e-2"), (40, "1e-2"), (50, "1e-2"), (50, "5e-3"),
+                                         (100, "5e-3")]
+    for integ, name in [("midpoint-vertices", "vertices-midpoint"),
+                        ("implicit-vertices", "vertices-implicit")]:
+        for v, dt in ch_gl:
+            c.append(("yarnsim", name, "chain", f"{v} vertices, no grid, dt {dt}, k 2e5",
+                      lambda v=v, dt=dt, integ=integ: yarnsim_rope.chain(v, 16, dt, integ, 2e5)))
     ca_mj = [25] if quick else [25, 50, 100]
     ca_el = [] if quick else [25, 50]
     ca_ys = [] if quick else [100, 200]
@@ -97,6 +109,11 @@ def cases(quick):
         for dt in (1e-3, 2e-3):
             c.append(("yarnsim", "mpm-implicit", "cantilever", f"{v} vertices, 64^2, dt {dt:g}",
                       lambda v=v, dt=dt: yarnsim_rope.cantilever(v, "implicit", dt)))
+    for v in [] if quick else [25, 50]:
+        for dt in (1e-3, 2e-3):
+            c.append(("yarnsim", "vertices-midpoint", "cantilever",
+                      f"{v} vertices, no grid, dt {dt:g}",
+                      lambda v=v, dt=dt: yarnsim_rope.cantilever(v, "midpoint-vertices", dt)))
     return c
 
 
@@ -264,6 +281,11 @@ def main():
         capstan("yarnsim", lambda mu: yarnsim_rope.capstan_slides(
             O.CAPSTAN["radius"], O.CAPSTAN["l1"], O.CAPSTAN["l2"], mu, "implicit", 1e-3),
             "184 vertices, 128^2, dt 1e-3", "mpm-implicit", rows)
+        for integ, name in [("implicit-vertices", "vertices-implicit"),
+                            ("midpoint-vertices", "vertices-midpoint")]:
+            capstan("yarnsim", lambda mu, integ=integ: yarnsim_rope.capstan_slides(
+                O.CAPSTAN["radius"], O.CAPSTAN["l1"], O.CAPSTAN["l2"], mu, integ, 1e-2),
+                "184 vertices, no grid, dt 1e-2", name, rows)
         capstan("pyelastica", lambda mu: elastica_rope.capstan_slides(70, mu),
                 "70 elements, dt 5e-5, c_v 50", "position-verlet", rows)
         for n in (50, 100):

@@ -6,7 +6,9 @@ import math
 COLORS = {"yarnsim": "#1f77b4", "mujoco": "#d62728", "pyelastica": "#2ca02c"}
 # a tool's other integrators (by (tool, integrator)); default: COLORS[tool]
 INTEGRATOR_COLORS = {("yarnsim", "mpm-implicit"): "#9467bd",
-                     ("yarnsim", "mpm-implicit-k2e5"): "#ff7f0e"}
+                     ("yarnsim", "mpm-implicit-k2e5"): "#ff7f0e",
+                     ("yarnsim", "vertices-implicit"): "#8c564b",
+                     ("yarnsim", "vertices-midpoint"): "#e377c2"}
 DASH = {"chain": "", "cantilever": "6,3", "capstan": "2,2"}
 MARK = {"chain": "circle", "cantilever": "square", "capstan": "diamond"}
 

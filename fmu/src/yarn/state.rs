@@ -39,6 +39,8 @@ impl YarnModel {
             None => 0,
             Some(Integrator::Explicit) => 1,
             Some(Integrator::Implicit) => 2,
+            Some(Integrator::ImplicitVertices) => 3,
+            Some(Integrator::MidpointVertices) => 4,
         });
         w.u64(s.forces.substeps);
         w.f64(s.forces.weight);
@@ -89,6 +91,8 @@ impl YarnModel {
             0 => None,
             1 => Some(Integrator::Explicit),
             2 => Some(Integrator::Implicit),
+            3 => Some(Integrator::ImplicitVertices),
+            4 => Some(Integrator::MidpointVertices),
             b => return Err(format!("bad integrator byte {b}")),
         };
         if let Some((i, v)) = reals.iter().enumerate().find_map(|(i, v)| {

@@ -94,6 +94,8 @@ pub fn integrator_name(i: Integrator) -> &'static str {
     match i {
         Integrator::Explicit => "explicit",
         Integrator::Implicit => "implicit",
+        Integrator::ImplicitVertices => "implicit-vertices",
+        Integrator::MidpointVertices => "midpoint-vertices",
     }
 }
 
@@ -102,6 +104,8 @@ pub fn parse_integrator(s: &str) -> Option<Integrator> {
     match s {
         "explicit" => Some(Integrator::Explicit),
         "implicit" => Some(Integrator::Implicit),
+        "implicit-vertices" => Some(Integrator::ImplicitVertices),
+        "midpoint-vertices" => Some(Integrator::MidpointVertices),
         _ => None,
     }
 }

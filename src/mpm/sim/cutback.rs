@@ -89,7 +89,7 @@ impl YarnSim {
         if depth == MAX_CUTBACKS {
             return self.substep_once(dt).map_err(|e| self.exhausted(e, dt));
         }
-        if dt <= self.advection_limit() {
+        if self.is_gridless() || dt <= self.advection_limit() {
             let keep = Checkpoint::of(self);
             match self.substep_once(dt) {
                 Err(SimError::NonFinite { .. }) => {

@@ -11,6 +11,7 @@ use crate::math::Vec2;
 
 mod cutback;
 mod diagnostics;
+mod gridless;
 mod implicit_grid;
 mod stats;
 mod substep;
@@ -21,6 +22,7 @@ use crate::scene::{
 };
 pub use cutback::MAX_CUTBACKS;
 pub use diagnostics::Diagnostics;
+pub use gridless::THETA;
 pub use implicit_grid::ImplicitStats;
 pub use stats::{DtStats, PassTimes, Passes};
 
@@ -85,7 +87,9 @@ pub fn stepping_of(scene: &YarnScene) -> Stepping {
             safety: scene.time.safety.unwrap_or(DEFAULT_SAFETY),
             // implicit: no stability cap, so the frame time by default
             dt_max: scene.time.dt_max.unwrap_or(match scene.time.integrator {
-                Integrator::Implicit => scene.time.frame_dt,
+                Integrator::Implicit
+                | Integrator::ImplicitVertices
+                | Integrator::MidpointVertices => scene.time.frame_dt,
                 Integrator::Explicit => f64::INFINITY,
             }),
         },
@@ -197,11 +201,32 @@ impl YarnSim {
             Stepping::Fixed(_) => (DEFAULT_SAFETY, f64::INFINITY),
         };
         if self.is_implicit() {
-            let dx = self.grid_geom().dx;
+            let dx = self.advection_length();
             let g = self.gravity().norm();
             return super::timestep::implicit_auto_dt(dx, self.max_speed(), g, safety).min(dt_max);
         }
         (safety * self.stable_dt()).min(dt_max)
+    }
+    /// The length a particle may cross in one implicit substep under
+    /// `dt = "auto"` (times the safety and [`super::timestep::COURANT`]):
+    /// the grid spacing, or without the grid (`"implicit-vertices"`) the
+    /// shortest rest segment, so that a vertex moves less than a segment
+    /// (the contacts' tangent-line constraint and their friction stay
+    /// valid over the substep).
+    pub fn advection_length(&self) -> f64 {
+        if self.is_gridless() {
+            let l = self
+                .particles
+                .quad
+                .l0
+                .iter()
+                .copied()
+                .fold(f64::INFINITY, f64::min);
+            if l.is_finite() {
+                return l;
+            }
+        }
+        self.grid_geom().dx
     }
     /// Count and sizes of the substeps since the last
     /// [`YarnSim::reset_dt_stats`] (or since the start).
@@ -241,9 +266,16 @@ impl YarnSim {
     pub fn implicit_stats(&self) -> ImplicitStats {
         self.implicit_stats
     }
-    /// Whether the substeps are backward Euler (`[time] integrator`).
+    /// Whether the substeps are backward Euler (`[time] integrator`), on
+    /// the grid or on the vertices.
     pub fn is_implicit(&self) -> bool {
-        self.scene.time.integrator == Integrator::Implicit
+        self.scene.time.integrator.is_implicit()
+    }
+    /// Whether the substeps are backward Euler on the vertices without the
+    /// grid (`integrator = "implicit-vertices"` or `"midpoint-vertices"`,
+    /// [`crate::mpm::gridless`]).
+    pub fn is_gridless(&self) -> bool {
+        self.scene.time.integrator.is_gridless()
     }
     /// The error that stopped the simulation, if any.
     pub fn failure(&self) -> Option<&SimError> {

@@ -18,6 +18,9 @@ impl YarnSim {
     /// once. On a `SimError` the state is part-way through the substep
     /// and the error is recorded in `failed`.
     pub(super) fn substep_once(&mut self, dt: f64) -> Result<(), SimError> {
+        if self.is_gridless() {
+            return self.substep_gridless(dt);
+        }
         let passes = self.passes();
         let bending = if passes.bending {
             self.scene.material.bending

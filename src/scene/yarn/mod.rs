@@ -188,8 +188,11 @@ pub struct TimeSpec {
     /// Output frame interval in s (CLI frames and recordings; default 1/60).
     #[serde(default = "default_frame_dt", deserialize_with = "positive")]
     pub frame_dt: f64,
-    /// How a substep advances the grid velocities: `"explicit"` (default)
-    /// or `"implicit"` (backward Euler, in its scope only, see [`Integrator`]).
+    /// How a substep advances the velocities: `"explicit"` (default),
+    /// `"implicit"` (backward Euler on the grid), `"implicit-vertices"`
+    /// (backward Euler on a single yarn's vertices, without the grid) or
+    /// `"midpoint-vertices"` (the implicit midpoint rule there), each in
+    /// its scope only, see [`Integrator`].
     #[serde(default, skip_serializing_if = "Integrator::is_explicit")]
     pub integrator: Integrator,
 }
@@ -210,12 +213,34 @@ pub enum Integrator {
     /// scene outside that scope is refused at load naming the field, never
     /// run with the explicit step instead.
     Implicit,
+    /// Backward Euler on the vertex velocities of a single yarn without the
+    /// grid ([`crate::mpm::gridless`]): for one yarn whose material has no
+    /// cross-section energy (`gamma = youngs_modulus = 0`), no walls; a
+    /// scene outside that scope is refused at load naming the field.
+    #[serde(rename = "implicit-vertices")]
+    ImplicitVertices,
+    /// The implicit midpoint rule on the same vertices, in the same scope
+    /// ([`crate::mpm::gridless`]): second order, no numerical damping (a
+    /// vertex in contact keeps the first-order velocity of its constraint).
+    #[serde(rename = "midpoint-vertices")]
+    MidpointVertices,
 }
 
 impl Integrator {
     /// Whether this is the default explicit step.
     pub fn is_explicit(&self) -> bool {
         *self == Integrator::Explicit
+    }
+    /// Whether this is an implicit step (on the grid or the vertices).
+    pub fn is_implicit(&self) -> bool {
+        !self.is_explicit()
+    }
+    /// Whether this steps a single yarn's vertices without the grid.
+    pub fn is_gridless(&self) -> bool {
+        matches!(
+            self,
+            Integrator::ImplicitVertices | Integrator::MidpointVertices
+        )
     }
 }
 

@@ -68,6 +68,7 @@ impl YarnScene {
         }
         self.validate_pins(text)?;
         self.validate_time(text)?;
+        self.validate_gridless(text)?;
         overlap::check_yarns_clear_of_obstacles(self, text)?;
         Ok(())
     }
@@ -113,6 +114,61 @@ impl YarnScene {
                     return Err(invalid("dt_max", format!("must be > 0, got {m}")));
                 }
             }
+        }
+        Ok(())
+    }
+
+    /// The scope of `integrator = "implicit-vertices"` (backward Euler on a
+    /// single yarn's vertices, without the grid): one yarn, no shear or
+    /// cross-section stiffness (the energies that need the grid), no walls.
+    fn validate_gridless(&self, text: Option<&str>) -> Result<(), SceneError> {
+        if !self.time.integrator.is_gridless() {
+            return Ok(());
+        }
+        let why = "integrator = \"implicit-vertices\" or \"midpoint-vertices\" steps a single yarn on its vertices, without the grid";
+        let at = |field: &str, header: &str, key: &str, message: String| SceneError::Invalid {
+            field: field.into(),
+            line: text.and_then(|t| key_line(t, header, key)),
+            message: format!("{message} ({why}; integrator = \"implicit\" runs this scene)"),
+        };
+        let yarns: u64 = self.yarns.iter().map(|y| y.count as u64).sum();
+        if yarns != 1 {
+            return Err(SceneError::Invalid {
+                field: "yarns".into(),
+                line: table_line(text, "[[yarns]]", 1),
+                message: format!("{yarns} yarns; it needs exactly one ({why}, with no yarn-yarn contact; integrator = \"implicit\" runs this scene)"),
+            });
+        }
+        let m = &self.material;
+        if m.gamma != 0.0 {
+            return Err(at(
+                "material.gamma",
+                "[material]",
+                "gamma",
+                format!(
+                    "gamma is {}; it needs 0 (the shear energy lives on the grid)",
+                    m.gamma
+                ),
+            ));
+        }
+        if m.youngs_modulus != 0.0 {
+            return Err(at(
+                "material.youngs_modulus",
+                "[material]",
+                "youngs_modulus",
+                format!(
+                    "youngs_modulus is {}; it needs 0 (the cross-section energy lives on the grid)",
+                    m.youngs_modulus
+                ),
+            ));
+        }
+        if self.walls.mode != super::WallMode::None {
+            return Err(at(
+                "walls.mode",
+                "[walls]",
+                "mode",
+                "the walls act on grid nodes; it needs mode = \"none\"".into(),
+            ));
         }
         Ok(())
     }
