@@ -135,7 +135,9 @@ fn integrator_parameter_takes_the_two_names_and_is_fixed_after_initialization() 
     let f = Fmu::new(&chain());
     assert_eq!(f.set_string(VR_INTEGRATOR, "backward-euler"), fmi2Error);
     f.assert_error_contains("integrator = \"backward-euler\" is not an integrator");
-    f.assert_error_contains("\"explicit\" or \"implicit\"");
+    f.assert_error_contains(
+        "\"explicit\", \"implicit\", \"implicit-vertices\" or \"midpoint-vertices\"",
+    );
 
     let g = Fmu::new(&mixed_scene());
     assert_eq!(g.set_string(VR_INTEGRATOR, "implicit"), fmi2OK);
@@ -155,6 +157,51 @@ fn integrator_parameter_takes_the_two_names_and_is_fixed_after_initialization() 
     assert_eq!(ok.get_string(VR_INTEGRATOR), "implicit");
     assert_eq!(ok.set_string(VR_INTEGRATOR, "explicit"), fmi2Error);
     ok.assert_error_contains("value reference 302 is a fixed parameter");
+}
+
+/// `"implicit-vertices"` and `"midpoint-vertices"` (one yarn's vertices,
+/// no grid): the chain gives the library's bits at every communication
+/// point; a scene outside their scope (two yarns, a shear stiffness) is
+/// refused at the end of initialization naming the scene field.
+#[test]
+fn gridless_integrators_give_the_library_bits_and_refuse_out_of_scope_scenes() {
+    let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+    for (name, integ) in [
+        ("implicit-vertices", Integrator::ImplicitVertices),
+        ("midpoint-vertices", Integrator::MidpointVertices),
+    ] {
+        let scene = chain();
+        let f = Fmu::new(&scene);
+        assert_eq!(f.set_string(VR_INTEGRATOR, name), fmi2OK);
+        f.init();
+        assert_eq!(f.get_string(VR_INTEGRATOR), name);
+        let mut lib = scene.clone();
+        lib.time.integrator = integ;
+        let mut sim = YarnSim::new(&lib).unwrap();
+        for k in 0..30 {
+            assert_eq!(f.do_step(k as f64 * 0.01, 0.01), fmi2OK, "{:?}", f.lines());
+            sim.steps_n(10).unwrap();
+            let (l, r) = sim.yarn_endpoints(0);
+            assert_eq!(
+                bits(&f.outputs()[..4]),
+                bits(&[l.x, l.y, r.x, r.y]),
+                "{name} step {k}"
+            );
+        }
+        let two = Fmu::new(&mixed_scene());
+        assert_eq!(two.set_string(VR_INTEGRATOR, name), fmi2OK);
+        assert_eq!(init_status(&two), fmi2Error, "{:?}", two.lines());
+        let log = format!("{:?}", two.lines());
+        assert!(log.contains("yarns") && log.contains(name), "{log}");
+        let small = Fmu::new(&small_scene());
+        assert_eq!(small.set_string(VR_INTEGRATOR, name), fmi2OK);
+        assert_eq!(init_status(&small), fmi2Error, "{:?}", small.lines());
+        let log = format!("{:?}", small.lines());
+        assert!(
+            log.contains("material.gamma") || log.contains("yarns"),
+            "{log}"
+        );
+    }
 }
 
 /// A step whose implicit substep fails at every cutback (dt 1.6e-2 and

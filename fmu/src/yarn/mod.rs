@@ -186,7 +186,7 @@ impl YarnModel {
                 };
                 let Some(i) = parse_integrator(v) else {
                     return refuse(format!(
-                        "integrator = {v:?} is not an integrator: use \"explicit\" or \"implicit\""
+                        "integrator = {v:?} is not an integrator: use \"explicit\", \"implicit\", \"implicit-vertices\" or \"midpoint-vertices\""
                     ));
                 };
                 changed |= self.config.integrator != Some(i);
