@@ -19,6 +19,9 @@
 //! * [`pins`]: pinned and driven vertices and their reaction forces.
 //! * [`spin`]: the per-yarn angular momentum balance of the FLIP transfer.
 //! * [`simd`]: AVX2 + FMA / portable kernel dispatch and the fixed chunking.
+//! * [`implicit`]: backward Euler on the grid velocities (Newton, PCG).
+//! * [`gridless`]: backward Euler and the generalized midpoint rule on a
+//!   single yarn's vertices without the grid (banded Newton, contacts).
 //! * [`sim`]: [`YarnSim`], which runs the passes a scene needs.
 //! * [`state`]: byte serialization of the dynamic state.
 //! * [`timestep`]: the stable substep bound (CFL / elastic waves).

@@ -85,7 +85,7 @@ def cases(quick):
     # (`integrator = "implicit-vertices"`) and the generalized midpoint rule
     # (`"midpoint-vertices"`, theta 0.55), k = 2e5 as above
     ch_gl = [(50, "1e-2")] if quick else [(25, "1e-2"), (40, "1e-2"), (50, "1e-2"), (50, "5e-3"),
-                                         (100, "5e-3")]
+                                         (100, "5e-3"), (100, "2e-3"), (150, "2e-3")]
     for integ, name in [("midpoint-vertices", "vertices-midpoint"),
                         ("implicit-vertices", "vertices-implicit")]:
         for v, dt in ch_gl:
@@ -109,8 +109,8 @@ def cases(quick):
         for dt in (1e-3, 2e-3):
             c.append(("yarnsim", "mpm-implicit", "cantilever", f"{v} vertices, 64^2, dt {dt:g}",
                       lambda v=v, dt=dt: yarnsim_rope.cantilever(v, "implicit", dt)))
-    for v in [] if quick else [25, 50]:
-        for dt in (1e-3, 2e-3):
+    for v, dts in [] if quick else [(25, (5e-4, 1e-3, 2e-3)), (50, (2.5e-4, 1e-3, 2e-3))]:
+        for dt in dts:
             c.append(("yarnsim", "vertices-midpoint", "cantilever",
                       f"{v} vertices, no grid, dt {dt:g}",
                       lambda v=v, dt=dt: yarnsim_rope.cantilever(v, "midpoint-vertices", dt)))

@@ -75,7 +75,7 @@ impl Banded {
                 let l = self.band[j * s + (j - p)];
                 d -= l * l;
             }
-            if !(d > 0.0) {
+            if d.is_nan() || d <= 0.0 {
                 return Err(j);
             }
             let d = d.sqrt();
@@ -94,6 +94,8 @@ impl Banded {
     }
 
     /// Solves `L L^T x = b` in place with the factor of [`Banded::factor`].
+    // the band's index arithmetic reads best as index loops
+    #[allow(clippy::needless_range_loop)]
     pub fn solve(&self, b: &mut [f64]) {
         let (n, w) = (self.n, self.w);
         let s = w + 1;

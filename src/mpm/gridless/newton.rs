@@ -178,6 +178,8 @@ fn m_norm(rod: &Rod, g: &[Vec2]) -> f64 {
 
 /// Minimises `E` over the velocities that satisfy `cons`, from `v`
 /// (made feasible first). `Err`: why it did not converge.
+// the 2x2 blocks' entries read best as index loops
+#[allow(clippy::needless_range_loop)]
 pub fn solve(
     rod: &Rod,
     cons: &[Constraint],
@@ -279,7 +281,7 @@ pub fn solve(
             });
         }
         let slope: f64 = dir.iter().zip(&g).map(|(d, g)| d.dot(g)).sum();
-        if !(slope < 0.0) {
+        if slope.is_nan() || slope >= 0.0 {
             return Err(format!("no descent direction at Newton iteration {it}"));
         }
         if -slope <= s.decrease_tol * energy.abs() {
