@@ -253,3 +253,33 @@ fn scenes_outside_the_scope_are_refused_naming_the_field() {
     mp.material.gamma = 1.0;
     assert_eq!(refusal(&mp), "material.gamma");
 }
+
+/// The capstan yarn on a frictionless circle slides: the free end's drop
+/// after 0.3 s under the midpoint rule against backward Euler at dt 1e-3
+/// (both first order in the contact, the same motion to the step's
+/// order); a contact that lost its tangential momentum each step would
+/// lag by tens of percent. Tolerance 2 %.
+#[test]
+fn midpoint_contacts_slide_as_backward_euler_without_friction() {
+    let (r, l1, l2) = (0.1, 0.1, 0.3);
+    let drop = |integ| {
+        let s =
+            YarnScene::from_toml_str(&capstan_toml(r, l1, l2, 0.0, &CAPSTAN_PURE_STRING)).unwrap();
+        let mut sim = YarnSim::new(&with(s, integ, 1e-3)).unwrap();
+        let y0 = sim.yarn_endpoints(0).1.y;
+        sim.advance(0.3).unwrap();
+        y0 - sim.yarn_endpoints(0).1.y
+    };
+    let (be, mp) = (
+        drop(Integrator::ImplicitVertices),
+        drop(Integrator::MidpointVertices),
+    );
+    eprintln!(
+        "frictionless capstan, drop of the heavy end in 0.3 s: backward Euler {be}, midpoint {mp}"
+    );
+    assert!(be > 0.01, "no slide: {be}");
+    assert!(
+        (mp - be).abs() < 0.02 * be,
+        "midpoint {mp} vs backward Euler {be}"
+    );
+}

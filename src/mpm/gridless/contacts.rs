@@ -14,7 +14,8 @@
 //! (smoothed below `eps_v`, [`super::newton::Settings`]), with `lambda`
 //! from the previous round of the same step (round 0 frictionless): the
 //! rounds stop when the set is unchanged and no `lambda` moved by more than
-//! [`LAMBDA_RTOL`] of the largest, at most [`MAX_ROUNDS`]. Nothing carries
+//! [`LAMBDA_RTOL`] of the largest, at most [`MAX_ROUNDS`] (else an error,
+//! which the cutback answers by halving the substep). Nothing carries
 //! over from one step to the next, so a saved state needs nothing more.
 
 use super::energy::Rod;
@@ -70,8 +71,11 @@ fn contact(o: &Obstacle, x: Vec2, dt: f64) -> Constraint {
 }
 
 /// The step of `rod` with the velocities `fixed` (pins) and the obstacles;
-/// the solved velocity moves a vertex over `reach` (s): the step's `dt`
-/// under backward Euler, twice it for the midpoint rule's half step.
+/// the solved velocity moves a vertex over `reach` (s): the substep `dt`
+/// (the solve's own step is `dt` under backward Euler, `theta dt` under
+/// the generalized midpoint rule). `Err` when a solve fails or the
+/// contacts do not settle in [`MAX_ROUNDS`] (the cutback then halves the
+/// substep).
 pub fn step(
     rod: &Rod,
     fixed: &[Option<Vec2>],
@@ -120,13 +124,18 @@ pub fn step(
         let mut new_lambda = vec![0.0; n];
         for i in 0..n {
             match (touch[i], cons[i]) {
-                (Some(_), Constraint::Normal { n, .. }) => {
+                (Some(k), Constraint::Normal { n, .. }) => {
                     let l = n.dot(&sol.gradient[i]);
                     if l < 0.0 {
                         touch[i] = None;
                         changed = true;
                     } else {
                         new_lambda[i] = l;
+                        // ending inside another circle: that one instead
+                        if let Some(j) = inside(obstacles, y[i]).filter(|&j| j != k) {
+                            touch[i] = Some(j);
+                            changed = true;
+                        }
                     }
                 }
                 _ if base[i] == Constraint::Free => {
@@ -146,7 +155,14 @@ pub fn step(
         let rubbing = (0..n).any(|i| touch[i].is_some_and(|k| obstacles[k].friction > 0.0));
         lambda = new_lambda;
         let settled = !changed && (!moved || !rubbing);
-        if settled || round == MAX_ROUNDS {
+        if !settled && round == MAX_ROUNDS {
+            return Err(format!(
+                "the contacts did not settle in {MAX_ROUNDS} rounds (the contact set {}, the normal impulses {})",
+                if changed { "still changing" } else { "settled" },
+                if moved && rubbing { "still moving" } else { "settled" }
+            ));
+        }
+        if settled {
             let contacts = (0..n)
                 .filter_map(|i| touch[i].map(|k| (i, k, lambda[i])))
                 .collect();

@@ -16,7 +16,7 @@
 //! minimises ([`energy`])
 //!
 //! ```text
-//! E(v) = sum_i m_i |v_i - v_i - dt g|^2 / 2 + Psi(x + dt v)
+//! E(v) = sum_i m_i |v_i - v_i^n - dt g|^2 / 2 + Psi(x + dt v)
 //! ```
 //!
 //! (Gast, Schroeder, Stomakhin, Jiang, Teran 2015, the optimization form of

@@ -321,6 +321,13 @@ pub fn solve(
         }
         g = total_gradient(rod, fric, eps, &v);
     }
+    if m_norm(rod, &pg(&g)) <= s.rel_tol * g0 {
+        return Ok(Solved {
+            v,
+            gradient: g,
+            newton: s.max_newton,
+        });
+    }
     Err(format!(
         "Newton did not converge in {} iterations",
         s.max_newton

@@ -11,9 +11,11 @@
 //! grow, measured); [`THETA`] keeps its period error on the first mode
 //! (+0.015 % at `omega dt = 0.042`, against backward Euler's +0.059 %) and
 //! damps it 1.3 % per period (backward Euler 12 %) while every mode far
-//! above `1 / dt` loses 18 % per step. A vertex in contact at the end
-//! keeps `w` (its constraint and friction are inelastic: the extrapolation
-//! would turn a stopped normal velocity into a rebound).
+//! above `1 / dt` loses 18 % per step. A vertex in contact keeps the
+//! normal part of `w` (the contact is inelastic: extrapolated, a stopped
+//! normal velocity would rebound) and, where friction holds it (`|w_t| <=
+//! eps_v`), the tangential part too; a sliding contact is extrapolated
+//! along the surface like a free vertex.
 
 use std::time::Instant;
 
@@ -62,18 +64,16 @@ impl YarnSim {
     pub(super) fn substep_gridless(&mut self, dt: f64) -> Result<(), SimError> {
         let t0 = Instant::now();
         let midpoint = self.scene.time.integrator == Integrator::MidpointVertices;
-        // the solve's own step: half of it for the midpoint rule's mean velocity
+        // the solve's own step: theta dt for the midpoint rule's mean velocity
         let theta = if midpoint { THETA } else { 1.0 };
         let h = theta * dt;
         let rod = self.rod(h);
         let end = self.time + dt;
         let mut fixed: Vec<Option<Vec2>> = vec![None; rod.len()];
-        let mut targets = Vec::new();
         for pin in &self.pins {
             for (k, &i) in pin.vertices.iter().enumerate() {
                 let (x, _) = pin.target(k, end);
                 fixed[i] = Some((x - rod.x[i]) / dt);
-                targets.push((i, x));
             }
         }
         let empty: [Obstacle; 0] = [];
@@ -111,6 +111,17 @@ impl YarnSim {
                 .iter()
                 .fold(Vec2::zeros(), |a, &i| a + out.gradient[i] / h);
         }
+        // a contact's outward normal at the start of the substep
+        let normal = |i: usize, k: usize| {
+            let r = rod.x[i] - Vec2::from(obstacles[k].center);
+            let d = r.norm();
+            if d > 0.0 {
+                r / d
+            } else {
+                Vec2::new(0.0, 1.0)
+            }
+        };
+        let eps_v = Settings::default().eps_v;
         let vert = &mut self.particles.vert;
         for (i, v) in out.v.iter().enumerate() {
             vert.x[i] += v * dt;
@@ -122,16 +133,27 @@ impl YarnSim {
             vert.c[i] = Mat2::zeros();
         }
         if midpoint {
-            for &(i, _, _) in &out.contacts {
-                vert.v[i] = out.v[i];
+            // a contact keeps the mean velocity's normal part (inelastic:
+            // extrapolated, a stopped normal velocity would rebound), and
+            // its tangential part where friction holds it
+            for &(i, k, _) in &out.contacts {
+                let (n, w) = (normal(i, k), out.v[i]);
+                let t = Vec2::new(-n.y, n.x);
+                let held = obstacles[k].friction > 0.0 && t.dot(&w).abs() <= eps_v;
+                let v = &mut vert.v[i];
+                *v += n * (n.dot(&w) - n.dot(v));
+                if held {
+                    *v += t * (t.dot(&w) - t.dot(v));
+                }
             }
-        }
-        for (i, x) in targets {
-            vert.x[i] = x;
         }
         for &(i, k, _) in &out.contacts {
             project_out(&obstacles[k], &mut vert.x[i], &mut vert.v[i]);
         }
+        // no clamp to the grid's interior: without the grid a vertex may
+        // leave the square (walls "none" keeps only the grid's stencils on
+        // it); the pins at their targets with their velocities
+        crate::mpm::pins::place(&self.pins, vert, end);
         self.follow_vertices();
         self.frames_stale = true;
         let st = &mut self.implicit_stats;

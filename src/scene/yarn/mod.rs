@@ -191,7 +191,7 @@ pub struct TimeSpec {
     /// How a substep advances the velocities: `"explicit"` (default),
     /// `"implicit"` (backward Euler on the grid), `"implicit-vertices"`
     /// (backward Euler on a single yarn's vertices, without the grid) or
-    /// `"midpoint-vertices"` (the implicit midpoint rule there), each in
+    /// `"midpoint-vertices"` (the generalized midpoint rule there), each in
     /// its scope only, see [`Integrator`].
     #[serde(default, skip_serializing_if = "Integrator::is_explicit")]
     pub integrator: Integrator,
@@ -219,9 +219,11 @@ pub enum Integrator {
     /// scene outside that scope is refused at load naming the field.
     #[serde(rename = "implicit-vertices")]
     ImplicitVertices,
-    /// The implicit midpoint rule on the same vertices, in the same scope
-    /// ([`crate::mpm::gridless`]): second order, no numerical damping (a
-    /// vertex in contact keeps the first-order velocity of its constraint).
+    /// The generalized midpoint rule (theta 0.55) on the same vertices, in
+    /// the same scope ([`crate::mpm::gridless`]): the implicit midpoint
+    /// rule's period error on slow modes with light damping (1.3 % per
+    /// period at `omega dt = 0.042`) and strong damping of modes far above
+    /// `1 / dt`; a contact's normal velocity stays inelastic.
     #[serde(rename = "midpoint-vertices")]
     MidpointVertices,
 }

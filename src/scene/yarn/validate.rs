@@ -135,7 +135,7 @@ impl YarnScene {
         if yarns != 1 {
             return Err(SceneError::Invalid {
                 field: "yarns".into(),
-                line: table_line(text, "[[yarns]]", 1),
+                line: table_line(text, "[[yarns]]", usize::from(self.yarns.len() > 1)),
                 message: format!("{yarns} yarns; it needs exactly one ({why}, with no yarn-yarn contact; integrator = \"implicit\" runs this scene)"),
             });
         }
