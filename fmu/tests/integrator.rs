@@ -53,6 +53,23 @@ fn init_status(f: &Fmu) -> fmi2Status {
     }
 }
 
+fn bits(v: &[f64]) -> Vec<u64> {
+    v.iter().map(|x| x.to_bits()).collect()
+}
+
+/// Steps the library's `sim` over one communication step of 0.01 s (10
+/// substeps of the chain's dt 1e-3) and asserts that the FMU's yarn-end
+/// outputs are its bits.
+fn assert_ends_are_the_library_bits(f: &Fmu, sim: &mut YarnSim, what: &str) {
+    sim.steps_n(10).unwrap();
+    let (l, r) = sim.yarn_endpoints(0);
+    assert_eq!(
+        bits(&f.outputs()[..4]),
+        bits(&[l.x, l.y, r.x, r.y]),
+        "{what}"
+    );
+}
+
 /// `integrator = "implicit"` on the chain: the library's bits for the
 /// same scene with `time.integrator = "implicit"` at every communication
 /// point, other outputs than the explicit step's, and over four periods
@@ -71,7 +88,6 @@ fn integrator_parameter_runs_the_implicit_chain_with_the_library_bits() {
     lib.time.integrator = Integrator::Implicit;
     let mut sim = YarnSim::new(&lib).unwrap();
     let h = 0.01;
-    let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
     let end = VR_YARN_BASE + 2; // yarn[0].right.x
     let mut crossings = ZeroCrossings::new(f.get_real(&[end]).unwrap()[0] - 0.5);
     let mut k = 0;
@@ -80,13 +96,7 @@ fn integrator_parameter_runs_the_implicit_chain_with_the_library_bits() {
         assert_eq!(f.do_step(t, h), fmi2OK, "{:?}", f.lines());
         if k < 20 {
             assert_eq!(explicit.do_step(t, h), fmi2OK);
-            sim.steps_n(10).unwrap();
-            let (l, r) = sim.yarn_endpoints(0);
-            assert_eq!(
-                bits(&f.outputs()[..4]),
-                bits(&[l.x, l.y, r.x, r.y]),
-                "step {k}"
-            );
+            assert_ends_are_the_library_bits(&f, &mut sim, &format!("step {k}"));
             if k == 19 {
                 assert_ne!(bits(&f.outputs()[..4]), bits(&explicit.outputs()[..4]));
             }
@@ -165,7 +175,6 @@ fn integrator_parameter_takes_the_two_names_and_is_fixed_after_initialization() 
 /// refused at the end of initialization naming the scene field.
 #[test]
 fn gridless_integrators_give_the_library_bits_and_refuse_out_of_scope_scenes() {
-    let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
     for (name, integ) in [
         ("implicit-vertices", Integrator::ImplicitVertices),
         ("midpoint-vertices", Integrator::MidpointVertices),
@@ -180,13 +189,7 @@ fn gridless_integrators_give_the_library_bits_and_refuse_out_of_scope_scenes() {
         let mut sim = YarnSim::new(&lib).unwrap();
         for k in 0..30 {
             assert_eq!(f.do_step(k as f64 * 0.01, 0.01), fmi2OK, "{:?}", f.lines());
-            sim.steps_n(10).unwrap();
-            let (l, r) = sim.yarn_endpoints(0);
-            assert_eq!(
-                bits(&f.outputs()[..4]),
-                bits(&[l.x, l.y, r.x, r.y]),
-                "{name} step {k}"
-            );
+            assert_ends_are_the_library_bits(&f, &mut sim, &format!("{name} step {k}"));
         }
         let two = Fmu::new(&mixed_scene());
         assert_eq!(two.set_string(VR_INTEGRATOR, name), fmi2OK);

@@ -29,14 +29,25 @@ pub const MAX_ROUNDS: usize = 16;
 /// than this fraction of the largest one.
 pub const LAMBDA_RTOL: f64 = 1e-4;
 
+/// A vertex in contact at the end of a step.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Contact {
+    pub vertex: usize,
+    pub obstacle: usize,
+    /// Outward unit normal of the constraint (at the start of the step).
+    pub normal: Vec2,
+    /// Normal impulse the obstacle delivered (`lambda`).
+    pub impulse: f64,
+}
+
 /// A step's result.
 #[derive(Clone, Debug)]
 pub struct Stepped {
     pub v: Vec<Vec2>,
     /// `dE/dv` at the solution (a pinned vertex: its pin's impulse).
     pub gradient: Vec<Vec2>,
-    /// Vertices in contact: `(vertex, obstacle, normal impulse)`.
-    pub contacts: Vec<(usize, usize, f64)>,
+    /// The vertices in contact.
+    pub contacts: Vec<Contact>,
     pub newton: usize,
     pub rounds: usize,
 }
@@ -163,8 +174,17 @@ pub fn step(
             ));
         }
         if settled {
+            // settled: each contact's constraint is this round's
             let contacts = (0..n)
-                .filter_map(|i| touch[i].map(|k| (i, k, lambda[i])))
+                .filter_map(|i| match (touch[i], cons[i]) {
+                    (Some(k), Constraint::Normal { n, .. }) => Some(Contact {
+                        vertex: i,
+                        obstacle: k,
+                        normal: n,
+                        impulse: lambda[i],
+                    }),
+                    _ => None,
+                })
                 .collect();
             return Ok(Stepped {
                 v,

@@ -199,7 +199,8 @@ pub fn solve(
     // to the next only
     let bends = rod.bending > 0.0;
     let mut a = Banded::zeros(2 * n, if bends { 5 } else { 3 });
-    for it in 0..s.max_newton {
+    // iteration `max_newton` only tests the last iterate
+    for it in 0..=s.max_newton {
         let pgv = pg(&g);
         let gn = m_norm(rod, &pgv);
         if !gn.is_finite() || !energy.is_finite() {
@@ -213,6 +214,9 @@ pub fn solve(
                 gradient: g,
                 newton: it,
             });
+        }
+        if it == s.max_newton {
+            break;
         }
         // the filtered Hessian, with the mass on the constrained directions
         let mut h = rod.hessian(&v);
@@ -320,13 +324,6 @@ pub fn solve(
             ));
         }
         g = total_gradient(rod, fric, eps, &v);
-    }
-    if m_norm(rod, &pg(&g)) <= s.rel_tol * g0 {
-        return Ok(Solved {
-            v,
-            gradient: g,
-            newton: s.max_newton,
-        });
     }
     Err(format!(
         "Newton did not converge in {} iterations",

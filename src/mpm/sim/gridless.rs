@@ -82,7 +82,8 @@ impl YarnSim {
         } else {
             &empty
         };
-        let out = match gridless::step(&rod, &fixed, obstacles, dt, &Settings::default()) {
+        let settings = Settings::default();
+        let out = match gridless::step(&rod, &fixed, obstacles, dt, &settings) {
             Ok(out) => out,
             Err(what) => {
                 let e = SimError::NonFinite {
@@ -111,17 +112,6 @@ impl YarnSim {
                 .iter()
                 .fold(Vec2::zeros(), |a, &i| a + out.gradient[i] / h);
         }
-        // a contact's outward normal at the start of the substep
-        let normal = |i: usize, k: usize| {
-            let r = rod.x[i] - Vec2::from(obstacles[k].center);
-            let d = r.norm();
-            if d > 0.0 {
-                r / d
-            } else {
-                Vec2::new(0.0, 1.0)
-            }
-        };
-        let eps_v = Settings::default().eps_v;
         let vert = &mut self.particles.vert;
         for (i, v) in out.v.iter().enumerate() {
             vert.x[i] += v * dt;
@@ -136,19 +126,21 @@ impl YarnSim {
             // a contact keeps the mean velocity's normal part (inelastic:
             // extrapolated, a stopped normal velocity would rebound), and
             // its tangential part where friction holds it
-            for &(i, k, _) in &out.contacts {
-                let (n, w) = (normal(i, k), out.v[i]);
+            for c in &out.contacts {
+                let (n, w) = (c.normal, out.v[c.vertex]);
                 let t = Vec2::new(-n.y, n.x);
-                let held = obstacles[k].friction > 0.0 && t.dot(&w).abs() <= eps_v;
-                let v = &mut vert.v[i];
+                let held =
+                    obstacles[c.obstacle].friction > 0.0 && t.dot(&w).abs() <= settings.eps_v;
+                let v = &mut vert.v[c.vertex];
                 *v += n * (n.dot(&w) - n.dot(v));
                 if held {
                     *v += t * (t.dot(&w) - t.dot(v));
                 }
             }
         }
-        for &(i, k, _) in &out.contacts {
-            project_out(&obstacles[k], &mut vert.x[i], &mut vert.v[i]);
+        for c in &out.contacts {
+            let i = c.vertex;
+            project_out(&obstacles[c.obstacle], &mut vert.x[i], &mut vert.v[i]);
         }
         // no clamp to the grid's interior: without the grid a vertex may
         // leave the square (walls "none" keeps only the grid's stencils on

@@ -17,8 +17,7 @@ mod stats;
 mod substep;
 
 use crate::scene::{
-    Integrator, SceneError, StepSize, TransferScheme, TransferSpec, WallMode, YarnScene,
-    DEFAULT_SAFETY,
+    SceneError, StepSize, TransferScheme, TransferSpec, WallMode, YarnScene, DEFAULT_SAFETY,
 };
 pub use cutback::MAX_CUTBACKS;
 pub use diagnostics::Diagnostics;
@@ -86,12 +85,14 @@ pub fn stepping_of(scene: &YarnScene) -> Stepping {
         StepSize::Auto => Stepping::Auto {
             safety: scene.time.safety.unwrap_or(DEFAULT_SAFETY),
             // implicit: no stability cap, so the frame time by default
-            dt_max: scene.time.dt_max.unwrap_or(match scene.time.integrator {
-                Integrator::Implicit
-                | Integrator::ImplicitVertices
-                | Integrator::MidpointVertices => scene.time.frame_dt,
-                Integrator::Explicit => f64::INFINITY,
-            }),
+            dt_max: scene
+                .time
+                .dt_max
+                .unwrap_or(if scene.time.integrator.is_implicit() {
+                    scene.time.frame_dt
+                } else {
+                    f64::INFINITY
+                }),
         },
     }
 }
