@@ -31,8 +31,11 @@
 //!   vertically by more than 0.5 % of its hanging length; `DT` replaces
 //!   the substep.
 //! * `bundle`: the built-in `yarn-reference` scene for `DURATION` s; prints
-//!   every yarn's vertex positions for the driver's common metrics; `DT`
-//!   replaces the substep (4e-5).
+//!   every yarn's vertex positions for the driver's common metrics and the
+//!   wall time of two windows (`windows`: `[start, end, wall]` for the fall
+//!   and landing up to 0.2 s, then the rest) and the seconds spent in each
+//!   pass of the substep (`passes`, from `YarnSim::timings`); `DT` replaces the substep
+//!   (4e-5): a number or `auto`.
 //!
 //! Threads: set `RAYON_NUM_THREADS=1` for one thread. The whole run steps
 //! on one rayon worker (`yarnsim::pool::on_pool`), as a program's own
@@ -229,14 +232,44 @@ fn capstan(r: f64, l1: f64, l2: f64, mu: f64, integ: Integrator, dt: Option<f64>
     )
 }
 
-fn bundle(duration: f64, integ: Integrator, dt: Option<f64>) -> String {
+/// The end of the bundle's first timed window (s): it falls, lands on the
+/// top circle at about 0.1 s and settles into the drape by then.
+const BUNDLE_LANDED: f64 = 0.2;
+
+fn bundle(duration: f64, integ: Integrator, dt: Option<&str>) -> String {
     let mut s = yarn_reference();
-    if let Some(dt) = dt {
-        s.time.dt = StepSize::Fixed(dt);
+    match dt {
+        None => {}
+        Some("auto") => s.time.dt = StepSize::Auto,
+        Some(x) => match x.parse::<f64>() {
+            Ok(dt) => s.time.dt = StepSize::Fixed(dt),
+            Err(_) => {
+                eprintln!("DT must be a number or auto, got {x:?}");
+                std::process::exit(2)
+            }
+        },
     }
     let mut sim = sim_with(s, integ);
+    // wall time per window: the fall and landing (to 0.2 s), then the rest
+    let mut windows = Vec::new();
     let t0 = Instant::now();
-    let ok = sim.advance(duration).is_ok();
+    let mut ok = true;
+    for end in [BUNDLE_LANDED.min(duration), duration] {
+        if end <= sim.time() {
+            continue;
+        }
+        let w0 = Instant::now();
+        let start = sim.time();
+        ok = sim.advance(end - start).is_ok();
+        windows.push(format!(
+            "[{start}, {}, {}]",
+            sim.time(),
+            w0.elapsed().as_secs_f64()
+        ));
+        if !ok {
+            break;
+        }
+    }
     let wall = t0.elapsed().as_secs_f64();
     let p = sim.particles();
     let r = &p.yarn_vertices;
@@ -252,13 +285,22 @@ fn bundle(duration: f64, integ: Integrator, dt: Option<f64>) -> String {
         .collect::<Vec<_>>()
         .join(", ");
     let d = sim.diagnostics();
+    // where a substep's time goes (the passes of `YarnSim::timings`)
+    let passes = sim
+        .timings()
+        .entries()
+        .iter()
+        .map(|(name, t)| format!("[{}, {t}]", json_str(name)))
+        .collect::<Vec<_>>()
+        .join(", ");
     format!(
         "{{\"ok\": {ok}, \"wall_s\": {wall}, \"sim_s\": {}, \"steps\": {}, \"min_stretch\": {}, \
-         \"max_stretch\": {}, \"yarns\": [{yarns}]}}",
+         \"max_stretch\": {}, \"windows\": [{}], \"passes\": [{passes}], \"yarns\": [{yarns}]}}",
         sim.time(),
         sim.steps(),
         d.min_stretch,
-        d.max_stretch
+        d.max_stretch,
+        windows.join(", ")
     )
 }
 
@@ -289,7 +331,7 @@ fn main() {
         Some("bundle") => bundle(
             arg(&args, 1, "DURATION"),
             integrator(&args, 2),
-            opt(&args, 3, "DT"),
+            args.get(3).map(String::as_str),
         ),
         _ => {
             eprintln!("usage: peers_chain chain|cantilever|capstan|bundle ARGS (see the source)");

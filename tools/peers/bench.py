@@ -7,13 +7,16 @@ heavy-rope capstan) and the reference bundle.
         [--quick] [--rounds 3] [--out docs/performance] [--skip-bundle]
 
 Every run is one thread (NUMBA_NUM_THREADS, OMP_NUM_THREADS and
-RAYON_NUM_THREADS are set to 1 before the peers are imported) and times
-its stepping loop only. The timed cases run in `--rounds` rounds; within a
+RAYON_NUM_THREADS are set to 1 before the peers are imported; one bundle
+row of yarnsim on 2 threads says so) and times its stepping loop only. The timed cases run in `--rounds` rounds; within a
 round the tools take turns (the order rotates from round to round) and the
 wall time is the median over the rounds; errors are deterministic. The
 capstan threshold is a bisection (slides at 0.7 mu*, holds at 1.4 mu*, then
-five halvings: a bracket of 2.2 % of mu*; yarnsim's test does three) and the bundle a single window; both run
-once. yarnsim runs on the grid under both integrators (`mpm-explicit`,
+five halvings: a bracket of 2.2 % of mu*; yarnsim's test does three) and
+runs once. The bundle runs the scene's whole second (`--bundle-duration`),
+timed in two windows (the fall and landing to 0.2 s, then the drape); its
+cheap runs alternate over the rounds, the slow ones (grid implicit, MuJoCo
+with deleted joints) run once. yarnsim runs on the grid under both integrators (`mpm-explicit`,
 `mpm-implicit`) and, for the single-yarn oracles, on the vertices without
 the grid (`vertices-implicit`, `vertices-midpoint`);
 a scene the implicit integrator refuses is a row with ok=False and the
@@ -194,30 +197,84 @@ def refused_row(tool, integrator, case, setting, note):
                 wall_s_per_sim_s=nan, wall_s=nan, sim_s=nan, rounds=1, ok=False, note=note)
 
 
-def bundle(rows, duration):
+def _windows(res):
+    """Wall seconds per simulated second in each timed window of a bundle
+    run, as text: the fall and landing, then the draped rest."""
+    return "; ".join(f"{a:g}-{b:.2g} s: {w / (b - a):.3g} s/s" for a, b, w in res["windows"]
+                     if b > a)
+
+
+def bundle(rows, duration, implicit_duration, rounds):
+    """The reference bundle over `duration` s (the built-in scene's whole
+    second by default), timed in two windows (to 0.2 s: the fall and
+    landing; then the drape). The cheap runs go in `rounds` alternating
+    rounds (order rotated by round; median wall time, the window times of
+    the median run); the grid implicit step (about 500 s/s, over
+    `implicit_duration` s only), MuJoCo with a tight CG tolerance (about
+    60 s/s) and MuJoCo with deleted joints (a minute to compile, about
+    130 s/s) run once."""
     b = O.BUNDLE
-    for tool, integ, setting, fn in [
-        ("yarnsim", "mpm-explicit", "256^2, dt 4e-5 (yarn-reference)",
+    runs = [
+        ("yarnsim", "mpm-explicit", "256^2, dt auto (yarn-reference)", True,
+         lambda: yarnsim_rope.bundle(duration, "explicit", "auto")),
+        ("mujoco", "discrete", "CG, dt 1e-3, r 1.9 mm, planar (y armature 1e6)", True,
+         lambda: mujoco_rope.bundle(duration, planar="armature")),
+        ("yarnsim", "mpm-explicit", "256^2, dt 4e-5 (yarn-reference)", True,
          lambda: yarnsim_rope.bundle(duration)),
-        ("yarnsim", "mpm-implicit", "256^2, dt 1e-3 (yarn-reference)",
-         lambda: yarnsim_rope.bundle(duration, "implicit", 1e-3)),
-        ("mujoco", "discrete", "CG, dt 1e-3, r 1.9 mm, planar (y armature 1e6)",
-         lambda: mujoco_rope.bundle(duration)),
-    ]:
-        res = fn()
-        if "refused" in res:
-            print(f"  bundle {tool:10s} {integ} {setting}: refused: {res['refused']}", flush=True)
-            rows.append(refused_row(tool, integ, "bundle", setting, res["refused"]))
+        ("yarnsim", "mpm-explicit", "256^2, dt auto, 2 threads", True,
+         lambda: yarnsim_rope.bundle(duration, "explicit", "auto", threads=2)),
+        ("yarnsim", "mpm-implicit", f"256^2, dt 1e-3, first {implicit_duration:g} s", False,
+         lambda: yarnsim_rope.bundle(implicit_duration, "implicit", 1e-3)),
+        # the armature raises MuJoCo's mean inertia, which scales the CG
+        # tolerance: the run above stops after ~13 iterations per step; at
+        # tolerance 1e-16 it iterates as the deleted-joint run does (~70)
+        ("mujoco", "discrete", "CG tolerance 1e-16, dt 1e-3, r 1.9 mm, planar (y armature 1e6)",
+         False, lambda: mujoco_rope.bundle(duration, planar="armature", tolerance=1e-16)),
+        ("mujoco", "discrete", "CG, dt 1e-3, r 1.9 mm, planar (y joints deleted)", False,
+         lambda: mujoco_rope.bundle(duration, planar="delete")),
+    ]
+    results = {i: [] for i in range(len(runs))}
+    for r in range(rounds):
+        order = list(range(len(runs)))
+        order = order[r % len(order):] + order[:r % len(order)]
+        for i in order:
+            tool, integ, setting, repeat, fn = runs[i]
+            if r > 0 and not repeat:
+                continue
+            res = fn()
+            results[i].append(res)
+            if "refused" in res:
+                print(f"  bundle {tool:10s} {integ} {setting}: refused: {res['refused']}",
+                      flush=True)
+                continue
+            print(f"  round {r + 1} bundle {tool:10s} {setting}: {res['wall_s']:.2f} s wall for "
+                  f"{res['sim_s']:.3f} s; {_windows(res)}", flush=True)
+    for i, (tool, integ, setting, _, _) in enumerate(runs):
+        rs = results[i]
+        if "refused" in rs[0]:
+            rows.append(refused_row(tool, integ, "bundle", setting, rs[0]["refused"]))
             continue
-        m = bundle_metrics.describe(res["yarns"], b)
+        res = sorted(rs, key=lambda x: x["wall_s"])[len(rs) // 2]  # the median run
+        m = _windows(res) + "; " + bundle_metrics.describe(res["yarns"], b)
         if "out_of_plane" in res:
             m += f"; out-of-plane drift {res['out_of_plane']:.2e} m"
-        print(f"  bundle {tool:10s} {setting}: {res['wall_s']:.2f} s wall for "
-              f"{res['sim_s']:.3f} s; {m}", flush=True)
+        if res.get("passes") and res.get("steps"):
+            total = sum(t for _, t in res["passes"])
+            short = {"P2G": "P2G", "grid": "grid", "G2P vertices": "G2P vertices",
+                     "G2P quadrature": "G2P quadrature"}
+            parts = ", ".join(f"{k} {100 * t / total:.0f} %" for name, t in res["passes"]
+                              for k in short if name.startswith(k) and t > 0)
+            m += (f"; {res['steps']} substeps (mean dt {res['sim_s'] / res['steps']:.3g} s), "
+                  f"{1e3 * res['wall_s'] / res['steps']:.3g} ms each: {parts}")
+        if "solver_iterations" in res:
+            m += (f"; CG {res['solver_iterations']:.1f} iterations per step (cap "
+                  f"{res['iteration_cap']}), {res['contacts']:.0f} contacts per step")
+        print(f"  bundle {tool:10s} {setting}: median {res['wall_s']:.2f} s wall for "
+              f"{res['sim_s']:.3f} s over {len(rs)} round(s); {m}", flush=True)
         rows.append(dict(tool=tool, integrator=integ, case="bundle", setting=setting,
                          error=float("nan"), wall_s_per_sim_s=res["wall_s"] / res["sim_s"],
-                         wall_s=res["wall_s"], sim_s=res["sim_s"], rounds=1, ok=res["ok"],
-                         note=m))
+                         wall_s=res["wall_s"], sim_s=res["sim_s"], rounds=len(rs),
+                         ok=all(x["ok"] for x in rs), note=m))
     rows.append(dict(tool="pyelastica", integrator="position-verlet", case="bundle",
                      setting="not run", error=float("nan"), wall_s_per_sim_s=float("nan"),
                      wall_s=float("nan"), sim_s=float("nan"), rounds=0, ok=False,
@@ -246,7 +303,10 @@ def main():
     ap.add_argument("--rounds", type=int, default=3)
     ap.add_argument("--out", default=None)
     ap.add_argument("--skip-bundle", action="store_true")
-    ap.add_argument("--bundle-duration", type=float, default=0.2)
+    ap.add_argument("--bundle-duration", type=float, default=1.0,
+                    help="simulated seconds of the bundle runs (the scene's whole second)")
+    ap.add_argument("--bundle-implicit-duration", type=float, default=0.2,
+                    help="simulated seconds of the grid implicit bundle run (~500 s/s)")
     ap.add_argument("--replot", metavar="CSV", help="only redraw the SVG next to CSV")
     a = ap.parse_args()
     if a.replot:
@@ -292,7 +352,7 @@ def main():
             capstan("mujoco", lambda mu, n=n: mujoco_rope.capstan_slides(n, 1e-3, mu),
                     f"{n} elements, dt 1e-3", "discrete", rows)
         if not a.skip_bundle:
-            bundle(rows, a.bundle_duration)
+            bundle(rows, a.bundle_duration, a.bundle_implicit_duration, rounds)
     # ratios against yarnsim's first explicit setting of the same case (same run)
     for r in rows:
         ref = next((x for x in rows if x["tool"] == "yarnsim" and x["integrator"] == "mpm-explicit"

@@ -151,14 +151,18 @@ def capstan_slides(elements, dt, mu, radius=1e-3):
     return slid, time.perf_counter() - t0, d.time
 
 
-def bundle(duration, dt=1e-3, radius=0.0019, planar=True):
+def bundle(duration, dt=1e-3, radius=0.0019, planar="armature", landed=0.2, tolerance=1e-8):
     """The reference bundle: 12 ropes x 200 points falling onto three
     cylinders, rope-rope and rope-cylinder friction, floor and side walls,
-    CG solver. `planar`: every out-of-plane (y) slide joint gets an armature
-    of 1e6 kg, so the bundle stays in the x-z plane without rebuilding the
-    model (deleting the 2,400 joints in the spec is slow); the driver
-    reports the remaining drift. Returns wall time and every rope's points
-    in yarnsim's plane."""
+    CG solver. Two ways to keep it in the x-z plane (free 3D drifts out):
+    `planar="armature"` gives every out-of-plane (y) slide joint an
+    armature of 1e6 kg (the driver reports the remaining drift);
+    `planar="delete"` deletes those 2,400 joints in the spec, a truly 2D
+    model (the compile takes about a minute, not timed). Returns the wall
+    time, the mean CG iterations and contacts per step (and the cap), the
+    wall time per window (`windows`: [start, end, wall] for the
+    fall and landing up to `landed` s, then the rest) and every rope's
+    points in yarnsim's plane."""
     b = O.BUNDLE
     n = b["vertices"] - 1
     seg = b["length"] / n
@@ -181,24 +185,44 @@ def bundle(duration, dt=1e-3, radius=0.0019, planar=True):
               f'<geom type="plane" size="1 1 0.01" pos="{1 - wall} 0 0.5" zaxis="-1 0 0"/>')
     xml = (
         f'<mujoco><option gravity="0 0 {-b["g"]}" integrator="discrete" timestep="{dt}" '
-        f'solver="CG" cone="elliptic" impratio="10"/><worldbody>{planes}{cyls}'
+        f'solver="CG" tolerance="{tolerance}" cone="elliptic" impratio="10"/><worldbody>{planes}{cyls}'
         f'{"".join(ropes)}</worldbody></mujoco>'
     )
-    m = mujoco.MjModel.from_xml_string(xml)
+    if planar == "delete":
+        spec = mujoco.MjSpec.from_string(xml)
+        spec.compile()  # the flexcomp's bodies and joints exist after a compile
+        for j in [j for j in spec.joints if abs(j.axis[1]) > 0.5]:
+            spec.delete(j)
+        m = spec.compile()
+    elif planar == "armature":
+        m = mujoco.MjModel.from_xml_string(xml)
+    else:
+        raise ValueError(f"planar must be armature or delete, got {planar!r}")
     spans = [_set_masses(m, f"r{j}", seg, b["rho"]) for j in range(b["yarns"])]
-    if planar:
+    if planar == "armature":
         for j in range(m.njnt):
             if abs(m.jnt_axis[j][1]) > 0.5:
                 m.dof_armature[m.jnt_dofadr[j]] = 1e6
     _refresh(m)
     d = mujoco.MjData(m)
-    steps = int(round(duration / dt))
+    windows = []
+    iters = steps = contacts = 0
     t0 = time.perf_counter()
-    for _ in range(steps):
-        mujoco.mj_step(m, d)
+    start = 0.0
+    for end in sorted({min(landed, duration), duration}):
+        w0 = time.perf_counter()
+        for _ in range(int(round((end - start) / dt))):
+            mujoco.mj_step(m, d)
+            iters += int(d.solver_niter[0])
+            contacts += d.ncon
+            steps += 1
+        windows.append([start, d.time, time.perf_counter() - w0])
+        start = end
     wall_s = time.perf_counter() - t0
     x = d.flexvert_xpos
     yarns = [np.column_stack([x[a:a + k, 0], x[a:a + k, 2]]) for a, k in spans]
     drift = float(np.max(np.abs(x[:, 1])))
     return dict(ok=bool(np.all(np.isfinite(x))) and d.time > 0.99 * duration, wall_s=wall_s,
-                sim_s=d.time, yarns=yarns, out_of_plane=drift)
+                sim_s=d.time, yarns=yarns, out_of_plane=drift, windows=windows,
+                solver_iterations=iters / max(steps, 1), contacts=contacts / max(steps, 1),
+                iteration_cap=int(m.opt.iterations))

@@ -18,8 +18,8 @@ def build():
                    check=True)
 
 
-def _run(*args):
-    env = dict(os.environ, RAYON_NUM_THREADS="1")
+def _run(*args, threads=1):
+    env = dict(os.environ, RAYON_NUM_THREADS=str(threads))
     out = subprocess.run([BIN, *map(str, args)], env=env, check=True, capture_output=True,
                          text=True).stdout
     return json.loads(out.strip().splitlines()[-1])
@@ -72,8 +72,11 @@ def capstan_slides(r, l1, l2, mu, integrator="explicit", dt=None):
     return res.get("slid", False) or not res["ok"], res["wall_s"], res["sim_s"]
 
 
-def bundle(duration, integrator="explicit", dt=None):
-    res = _refused(_run("bundle", duration, *_opt(integrator, dt)))
+def bundle(duration, integrator="explicit", dt=None, threads=1):
+    """The built-in `yarn-reference` for `duration` s; `dt` a number or
+    "auto" (default: the scene's 4e-5); `windows` in the result: [start,
+    end, wall] for the fall and landing (to 0.2 s), then the rest."""
+    res = _refused(_run("bundle", duration, *_opt(integrator, dt), threads=threads))
     if "yarns" in res:
         import numpy as np
         res["yarns"] = [np.array(y) for y in res["yarns"]]
