@@ -1,7 +1,16 @@
 #!/usr/bin/env python3
-"""The benchmark's CSV as the Markdown table of README.md "Measured".
+"""The benchmark's CSV as Markdown tables.
 
-    python3 tools/peers/table.py [docs/performance/peers.csv]
+    python3 tools/peers/table.py [docs/performance/peers.csv]          # README.md "Measured"
+    python3 tools/peers/table.py --at-peer-error [CSV]                 # the goals' comparison
+
+`--at-peer-error`: for every peer row of a single-yarn case (chain,
+cantilever, capstan), the cheapest row of yarnsim's implicit integrators
+(the goal is theirs: every integrator but `mpm-explicit`) of the same case
+whose |error| is at or below the peer's (the capstan: the threshold
+bracket's midpoint), and the ratio of their wall times per simulated
+second; for the bundle (no oracle), every yarnsim row over the whole
+second against every MuJoCo row.
 """
 
 import csv
@@ -19,7 +28,16 @@ def fmt(x, pct=False):
     return f"{100 * v:+.3f} %" if pct else f"{v:.3g}"
 
 
-def main(path):
+def rows_of(path):
+    out = []
+    for r in csv.DictReader(open(path)):
+        r["error"] = float(r["error"])
+        r["wall_s_per_sim_s"] = float(r["wall_s_per_sim_s"])
+        out.append(r)
+    return out
+
+
+def measured(path):
     print("| tool (integrator) | case | setting | error | wall s per simulated s | vs yarnsim | note |")
     print("|---|---|---|---|---|---|---|")
     for r in csv.DictReader(open(path)):
@@ -28,5 +46,42 @@ def main(path):
               f"{r['note']} |")
 
 
+def name(r):
+    return f"{r['tool']} {r['integrator']}, {r['setting']}"
+
+
+def at_peer_error(path):
+    rows = [r for r in rows_of(path) if r["ok"] == "True" and math.isfinite(r["wall_s_per_sim_s"])]
+    print("| case | peer at its error (wall s per simulated s) | yarnsim cheapest at or below "
+          "that error | yarnsim / peer |")
+    print("|---|---|---|---|")
+    for case in ("chain", "cantilever", "capstan"):
+        ours = [r for r in rows if r["tool"] == "yarnsim" and r["case"] == case
+                and r["integrator"] != "mpm-explicit" and math.isfinite(r["error"])]
+        for p in (r for r in rows if r["tool"] != "yarnsim" and r["case"] == case):
+            # 1e-12: the capstan's brackets are the same bisection points
+            fit = [r for r in ours if abs(r["error"]) <= abs(p["error"]) + 1e-12]
+            if not fit:
+                print(f"| {case} | {name(p)}: {fmt(p['error'], True)}, "
+                      f"{fmt(p['wall_s_per_sim_s'])} | none | - |")
+                continue
+            best = min(fit, key=lambda r: r["wall_s_per_sim_s"])
+            print(f"| {case} | {name(p)}: {fmt(p['error'], True)}, {fmt(p['wall_s_per_sim_s'])} | "
+                  f"{name(best)}: {fmt(best['error'], True)}, {fmt(best['wall_s_per_sim_s'])} | "
+                  f"{best['wall_s_per_sim_s'] / p['wall_s_per_sim_s']:.3g} |")
+    ours = [r for r in rows if r["tool"] == "yarnsim" and r["case"] == "bundle"
+            and float(r["sim_s"]) >= 0.99]
+    for p in (r for r in rows if r["tool"] == "mujoco" and r["case"] == "bundle"):
+        for r in ours:
+            ratio = r["wall_s_per_sim_s"] / p["wall_s_per_sim_s"]
+            print(f"| bundle | {name(p)}: {fmt(p['wall_s_per_sim_s'])} | {name(r)}: "
+                  f"{fmt(r['wall_s_per_sim_s'])} | {ratio:.3g} ({1 / ratio:.3g}x faster) |")
+
+
 if __name__ == "__main__":
-    main(sys.argv[1] if len(sys.argv) > 1 else "docs/performance/peers.csv")
+    args = [a for a in sys.argv[1:] if not a.startswith("--")]
+    path = args[0] if args else "docs/performance/peers.csv"
+    if "--at-peer-error" in sys.argv:
+        at_peer_error(path)
+    else:
+        measured(path)
