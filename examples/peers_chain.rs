@@ -34,8 +34,8 @@
 //!   every yarn's vertex positions for the driver's common metrics and the
 //!   wall time of two windows (`windows`: `[start, end, wall]` for the fall
 //!   and landing up to 0.2 s, then the rest) and the seconds spent in each
-//!   pass of the substep (`passes`, from `YarnSim::timings`); `DT` replaces the substep
-//!   (4e-5): a number or `auto`.
+//!   pass of the substep (`passes`, from `YarnSim::timings`); `DT`
+//!   replaces the substep (4e-5): a number or `auto`.
 //!
 //! Threads: set `RAYON_NUM_THREADS=1` for one thread. The whole run steps
 //! on one rayon worker (`yarnsim::pool::on_pool`), as a program's own
@@ -233,7 +233,8 @@ fn capstan(r: f64, l1: f64, l2: f64, mu: f64, integ: Integrator, dt: Option<f64>
 }
 
 /// The end of the bundle's first timed window (s): it falls, lands on the
-/// top circle at about 0.1 s and settles into the drape by then.
+/// top circle at about 0.1 s and settles into the drape by then
+/// (`BUNDLE["landed"]` in `tools/peers/oracles.py`).
 const BUNDLE_LANDED: f64 = 0.2;
 
 fn bundle(duration: f64, integ: Integrator, dt: Option<&str>) -> String {

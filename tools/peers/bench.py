@@ -8,15 +8,16 @@ heavy-rope capstan) and the reference bundle.
 
 Every run is one thread (NUMBA_NUM_THREADS, OMP_NUM_THREADS and
 RAYON_NUM_THREADS are set to 1 before the peers are imported; one bundle
-row of yarnsim on 2 threads says so) and times its stepping loop only. The timed cases run in `--rounds` rounds; within a
-round the tools take turns (the order rotates from round to round) and the
+row of yarnsim on 2 threads says so) and times its stepping loop only.
+The timed cases run in `--rounds` rounds; within a round the tools take turns (the order rotates from round to round) and the
 wall time is the median over the rounds; errors are deterministic. The
 capstan threshold is a bisection (slides at 0.7 mu*, holds at 1.4 mu*, then
 five halvings: a bracket of 2.2 % of mu*; yarnsim's test does three) and
 runs once. The bundle runs the scene's whole second (`--bundle-duration`),
 timed in two windows (the fall and landing to 0.2 s, then the drape); its
 cheap runs alternate over the rounds, the slow ones (grid implicit, MuJoCo
-at CG tolerance 1e-16 and with deleted joints) run once. yarnsim runs on the grid under both integrators (`mpm-explicit`,
+at CG tolerance 1e-16 and with deleted joints) run once. yarnsim runs on
+the grid under both integrators (`mpm-explicit`,
 `mpm-implicit`) and, for the single-yarn oracles, on the vertices without
 the grid (`vertices-implicit`, `vertices-midpoint`);
 a scene the implicit integrator refuses is a row with ok=False and the

@@ -151,7 +151,7 @@ def capstan_slides(elements, dt, mu, radius=1e-3):
     return slid, time.perf_counter() - t0, d.time
 
 
-def bundle(duration, dt=1e-3, radius=0.0019, planar="armature", landed=0.2, tolerance=1e-8):
+def bundle(duration, dt=1e-3, radius=0.0019, planar="armature", tolerance=1e-8):
     """The reference bundle: 12 ropes x 200 points falling onto three
     cylinders, rope-rope and rope-cylinder friction, floor and side walls,
     CG solver. Two ways to keep it in the x-z plane (free 3D drifts out):
@@ -161,9 +161,9 @@ def bundle(duration, dt=1e-3, radius=0.0019, planar="armature", landed=0.2, tole
     model (the compile takes about a minute, not timed). Returns the wall
     time, per window the mean CG iterations per step (of the island that
     took the most), the share of steps at the iteration cap and the mean
-    contacts per step, the wall time per window (`windows`: [start, end, wall] for the
-    fall and landing up to `landed` s, then the rest) and every rope's
-    points in yarnsim's plane."""
+    contacts per step, the wall time per window (`windows`: [start, end,
+    wall] for the fall and landing up to `BUNDLE["landed"]` s, then the
+    rest) and every rope's points in yarnsim's plane."""
     b = O.BUNDLE
     n = b["vertices"] - 1
     seg = b["length"] / n
@@ -214,20 +214,20 @@ def bundle(duration, dt=1e-3, radius=0.0019, planar="armature", landed=0.2, tole
     t0 = time.perf_counter()
     start = 0.0
     cap = int(m.opt.iterations)
-    for end in sorted({min(landed, duration), duration}):
+    for end in sorted({min(b["landed"], duration), duration}):
         w0 = time.perf_counter()
-        it = con = n = at_cap = 0
+        it = con = nsteps = at_cap = 0
         for _ in range(int(round((end - start) / dt))):
             mujoco.mj_step(m, d)
             k = int(d.solver_niter[:max(1, min(d.nisland, len(d.solver_niter)))].max())
             it += k
             at_cap += k >= cap
             con += d.ncon
-            n += 1
+            nsteps += 1
         windows.append([start, d.time, time.perf_counter() - w0])
         iters.append(it)
         contacts.append(con)
-        steps.append(n)
+        steps.append(nsteps)
         capped.append(at_cap)
         start = end
     wall_s = time.perf_counter() - t0

@@ -15,6 +15,9 @@ BUNDLE = dict(
     k=1000.0, bending=1e-3, yarn_friction=0.05, g=9.8,
     cylinders=[(0.25, 0.6), (0.5, 0.3), (0.75, 0.5)], cyl_radius=0.08, cyl_friction=0.3,
     box=(0.0, 1.0),
+    # end of the first timed window (s): the fall and the landing on the top
+    # circle (about 0.1 s); `BUNDLE_LANDED` in examples/peers_chain.rs
+    landed=0.2,
 )
 
 
