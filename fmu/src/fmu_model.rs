@@ -46,9 +46,38 @@ pub struct StepFailure {
     pub msg: String,
 }
 
-/// Checks that the parameter with this value reference may be set now
-/// (fixed parameters: only before the end of initialization).
-pub type ParamCheck<'a> = &'a dyn Fn(u32) -> ModelResult;
+/// Checks that the parameter with this name may be set now (fixed
+/// parameters: only before the end of initialization); the refusal names
+/// the parameter.
+pub type ParamCheck<'a> = &'a dyn Fn(&str) -> ModelResult;
+
+/// A variable's name and causality (`"input"`, `"parameter"`, `"output"`,
+/// `"independent"`), for the log messages: they name the variable as
+/// `modelDescription.xml` does, not only its value reference.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct VarName {
+    pub name: String,
+    pub causality: &'static str,
+}
+
+impl VarName {
+    pub fn new(name: impl Into<String>, causality: &'static str) -> Self {
+        VarName {
+            name: name.into(),
+            causality,
+        }
+    }
+}
+
+/// The name of `vr` for a message: the variable's name with its value
+/// reference in parentheses (`material.plasticity (value reference 17)`),
+/// or `value reference 99` for one no variable has.
+pub fn shown(name: Option<VarName>, vr: u32) -> String {
+    match name {
+        Some(v) => format!("{} (value reference {vr})", v.name),
+        None => format!("value reference {vr}"),
+    }
+}
 
 /// What the setter of String variables may need besides the values.
 pub struct SetContext<'a> {
@@ -118,6 +147,15 @@ pub trait FmuModel: fmt::Debug + Send {
     fn checkpoint(&self) -> Checkpoint;
     /// Puts back a [`Self::checkpoint`] of this model.
     fn restore(&mut self, c: Checkpoint);
+    /// The name and causality of the model's own variable `vr` (scalars of
+    /// every type and the FMI 3.0 arrays; not the [`crate::model::COMMON_VARIABLES`],
+    /// which the instance serves), `None` if it has none.
+    fn variable(&self, vr: u32) -> Option<VarName>;
+    /// The name of the model's own variable `vr` as a message shows it
+    /// ([`shown`]).
+    fn shown(&self, vr: u32) -> String {
+        shown(self.variable(vr), vr)
+    }
     /// Whether the Real variable `vr` depends on the simulated state.
     fn is_state_output(&self, vr: u32) -> bool;
     /// The value of the Real variable `vr`, `None` if there is none.

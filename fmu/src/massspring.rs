@@ -12,8 +12,11 @@ use yarnsim::massspring::{Integrator, IntegratorOptions, MassSpringScene, Simula
 
 use crate::fmu_model::{
     refuse, Checkpoint, FmuModel, ModelResult, ModelState, ParamCheck, SetContext, StepFailure,
+    VarName,
 };
-use crate::model::{output, var, Causality::*, Description, Start, VarSpec, VarType, Variable};
+use crate::model::{
+    output, table_name, var, Causality::*, Description, Start, VarSpec, VarType, Variable,
+};
 use crate::state_bytes::{Reader, Writer};
 
 /// The FMI model identifier of a mass-spring FMU.
@@ -342,6 +345,18 @@ impl FmuModel for MsModel {
                 .iter()
                 .all(|p| p.iter().all(|c| c.is_finite()))
     }
+    fn variable(&self, vr: u32) -> Option<VarName> {
+        if let Some((name, causality)) = table_name(&MASS_SPRING_VARIABLES, vr) {
+            return Some(VarName::new(name, causality));
+        }
+        if vr == VR_POSITIONS {
+            return Some(VarName::new("positions", "output"));
+        }
+        let k = vr.checked_sub(VR_PARTICLE_BASE)? as usize;
+        let axis = ["x", "y", "z"][k % 3];
+        (k / 3 < self.count())
+            .then(|| VarName::new(format!("particle[{}].{axis}", k / 3), "output"))
+    }
     /// Whether the Real variable `vr` depends on the simulated state.
     fn is_state_output(&self, vr: u32) -> bool {
         (VR_KINETIC_ENERGY..=VR_MAX_STRAIN).contains(&vr)
@@ -396,7 +411,7 @@ impl FmuModel for MsModel {
             match vr {
                 VR_GRAVITY_X..=VR_GRAVITY_Z => gravity[(vr - VR_GRAVITY_X) as usize] = v,
                 VR_DT => {
-                    param_ok(vr)?;
+                    param_ok("dt")?;
                     if !(0.0..=1e3).contains(&v) {
                         return refuse(format!(
                             "dt = {v} s is out of range (0 = automatic, else up to 1e3 s)"
@@ -406,15 +421,29 @@ impl FmuModel for MsModel {
                 }
                 _ => {
                     return refuse(format!(
-                        "value reference {vr} is not a Real input or parameter"
+                        "{} is not a Real input or parameter",
+                        self.shown(vr)
                     ))
                 }
             }
         }
         if gravity != self.gravity {
+            let assigned = || {
+                vrs.iter()
+                    .zip(vals)
+                    .filter(|(vr, _)| (VR_GRAVITY_X..=VR_GRAVITY_Z).contains(vr))
+                    .map(|(&vr, v)| {
+                        format!(
+                            "{} = {v}",
+                            MASS_SPRING_VARIABLES[(vr - VR_GRAVITY_X) as usize].name
+                        )
+                    })
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            };
             self.sim
                 .set_gravity(V3::from(gravity))
-                .or_else(|e| refuse(format!("{e}")))?;
+                .or_else(|e| refuse(format!("{} refused: {e}", assigned())))?;
             self.gravity = gravity;
         }
         let changed = dt != self.dt;
@@ -424,8 +453,9 @@ impl FmuModel for MsModel {
     fn set_boolean(&mut self, vrs: &[u32], _vals: &[bool], _: ParamCheck) -> ModelResult<bool> {
         match vrs.first() {
             None => Ok(false),
-            Some(vr) => refuse(format!(
-                "value reference {vr} is not a Boolean input or parameter"
+            Some(&vr) => refuse(format!(
+                "{} is not a Boolean input or parameter (this FMU has none)",
+                self.shown(vr)
             )),
         }
     }
@@ -440,9 +470,9 @@ impl FmuModel for MsModel {
         let mut integrator = self.integrator;
         for (&vr, v) in vrs.iter().zip(vals) {
             if vr != VR_INTEGRATOR {
-                return refuse(format!("value reference {vr} is not a String parameter"));
+                return refuse(format!("{} is not a String parameter", self.shown(vr)));
             }
-            param_ok(vr)?;
+            param_ok("integrator")?;
             let Some(v) = v else {
                 return refuse("the integrator name is a null pointer");
             };

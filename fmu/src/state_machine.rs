@@ -195,14 +195,15 @@ pub fn message_in(api: Api, msg: &str) -> String {
     s
 }
 
-/// Fixed parameters can be set only before `fmi2ExitInitializationMode`.
-pub fn parameter_settable(phase: Phase, func: &str, vr: u32) -> Res {
+/// Fixed parameters can be set only before `fmi2ExitInitializationMode`;
+/// the refusal names the parameter (`name`).
+pub fn parameter_settable(phase: Phase, func: &str, name: &str) -> Res {
     use Phase::*;
     if matches!(phase, Instantiated | InitializationMode) {
         Ok(())
     } else {
         error(format!(
-            "{func}: value reference {vr} is a fixed parameter, settable only before fmi2ExitInitializationMode (state is {:?})",
+            "{func}: {name} is a fixed parameter: it can be set only before fmi2ExitInitializationMode (state is {:?})",
             phase_name(phase)
         ))
     }

@@ -285,7 +285,7 @@ fn illegal_call_order_is_an_error_with_a_log_line() {
     // Fixed parameters cannot change after initialization.
     let f = Fmu::initialized(&scene);
     assert_eq!(f.set_real(&[VR_DT], &[1e-4]), fmi2Error);
-    f.assert_error_contains("fixed parameter");
+    f.assert_error_contains("dt is a fixed parameter");
 
     // Terminate, then no more steps.
     let f = Fmu::initialized(&scene);

@@ -133,8 +133,11 @@ fn instantiation_refuses_what_the_fmu_cannot_do() {
 #[test]
 fn nan_and_inf_inputs_are_refused_and_change_nothing() {
     for v in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
-        refused("is not finite", |f| f.set(&[VR_ATTRACTOR_X], &[v]));
-        refused("is not finite", |f| {
+        refused(
+            &format!("attractor.x = {v} refused: inputs must be finite"),
+            |f| f.set(&[VR_ATTRACTOR_X], &[v]),
+        );
+        refused(&format!("gravity.y = {v} refused"), |f| {
             f.set(&[VR_GRAVITY_X, VR_GRAVITY_Y], &[1.0, v])
         });
     }
@@ -175,11 +178,14 @@ fn wrong_value_counts_are_refused_without_reading_past_the_arrays() {
         // SAFETY: as above.
         unsafe { fmi3GetBoolean(f.c, &VR_ATTRACTOR_ACTIVE, 1, v.as_mut_ptr(), 0) }
     });
-    refused("no Float32 variable", |f| {
-        let mut v = [0f32; 1];
-        // SAFETY: as above.
-        unsafe { fmi3GetFloat32(f.c, &VR_GRAVITY_X, 1, v.as_mut_ptr(), 1) }
-    });
+    refused(
+        "gravity.x (value reference 5) is not a Float32 variable",
+        |f| {
+            let mut v = [0f32; 1];
+            // SAFETY: as above.
+            unsafe { fmi3GetFloat32(f.c, &VR_GRAVITY_X, 1, v.as_mut_ptr(), 1) }
+        },
+    );
     // the right count of all arrays at once works
     let f = Fmu3::small();
     f.init();

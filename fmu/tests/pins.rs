@@ -222,8 +222,8 @@ fn pin_variables_follow_the_scene() {
     );
     assert_eq!(f.get_real(&force_vrs(0)), Ok(vec![0.0, 0.0]));
     for (vals, what) in [
-        ([f64::NAN, 0.5, 0.0, 0.0], "not finite"),
-        ([0.5, 0.5, f64::INFINITY, 0.0], "not finite"),
+        ([f64::NAN, 0.5, 0.0, 0.0], "pin[0].x = NaN refused"),
+        ([0.5, 0.5, f64::INFINITY, 0.0], "pin[0].vx = inf refused"),
         ([2e6, 0.5, 0.0, 0.0], "absurd"),
         ([0.5, 0.5, 0.0, -3e6], "absurd"),
     ] {
@@ -243,7 +243,7 @@ fn pin_variables_follow_the_scene() {
         .all(|v| !(VR_PIN_BASE..VR_PIN_BASE + 4).contains(&v.vr)));
     let g = Fmu::new(&fixed);
     assert_eq!(g.set_real(&[VR_PIN_BASE], &[0.3]), fmi2Error);
-    g.assert_error_contains("not a motion");
+    g.assert_error_contains("pin[0].x (value reference 2000) is not an input");
     // SAFETY: `g.c` came from `fmi2Instantiate` and lives until its `Fmu` drops; every pointer
     // argument is a local that outlives the call.
     unsafe { assert_eq!(fmi2Reset(g.c), fmi2OK) };

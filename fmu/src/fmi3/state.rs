@@ -46,7 +46,8 @@ pub unsafe extern "C" fn fmi3GetVariableDependencies(
         let deps = inst.variable_dependencies(dependent)?;
         if deps.len() != nDependencies {
             return crate::instance::error(format!(
-                "{func}: nDependencies = {nDependencies}, but value reference {dependent} has {} (fmi3GetNumberOfVariableDependencies)",
+                "{func}: nDependencies = {nDependencies}, but {} has {} (fmi3GetNumberOfVariableDependencies)",
+                inst.shown(dependent),
                 deps.len()
             ));
         }

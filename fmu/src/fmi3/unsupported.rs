@@ -24,8 +24,10 @@ macro_rules! refused {
 }
 
 /// A getter or setter of a type this FMU has no variable of: nothing to do
-/// for no value reference, else the first one is unknown.
+/// for no value reference, else the first one is refused, by name where it
+/// is a variable of another type.
 fn no_variable(
+    inst: &crate::instance::Instance,
     ty: &str,
     vr: *const fmi3ValueReference,
     nvr: size_t,
@@ -35,10 +37,15 @@ fn no_variable(
     }
     // SAFETY: FMI passes `nvr` value references.
     match unsafe { slice(vr, nvr) } {
-        Some(vrs) => error(format!(
-            "no {ty} variable has value reference {} (this FMU has Float64, Int32, Boolean and String variables)",
-            vrs[0]
-        )),
+        Some(vrs) => {
+            let which = match inst.variable(vrs[0]) {
+                Some(_) => format!("{} is not a {ty} variable", inst.shown(vrs[0])),
+                None => format!("no {ty} variable has value reference {}", vrs[0]),
+            };
+            error(format!(
+                "{which} (this FMU has Float64, Int32, Boolean and String variables)"
+            ))
+        }
         None => error("valueReferences is a null pointer"),
     }
 }
@@ -50,7 +57,7 @@ macro_rules! no_variable {
         exports! { call3(fmi3Instance) -> fmi3Status;
             $name(valueReferences: *const fmi3ValueReference, nValueReferences: size_t, $($arg: $ty),*) |inst| {
                 inst.require($row)?;
-                no_variable($tyname, valueReferences, nValueReferences)
+                no_variable(inst, $tyname, valueReferences, nValueReferences)
             };
         }
     )*};

@@ -49,12 +49,14 @@ impl Instance {
                     let dst = &mut out[k..k + n];
                     if !self.model.physics.get_real_array(vr, dst) {
                         return error(format!(
-                            "fmi3GetFloat64: array value reference {vr} cannot be read"
+                            "fmi3GetFloat64: the array {} cannot be read",
+                            self.shown(vr)
                         ));
                     }
                     if let Some(v) = dst.iter().find(|v| !v.is_finite()) {
                         return error(format!(
-                            "fmi3GetFloat64: array value reference {vr} has a non-finite element ({v}) at t = {}",
+                            "fmi3GetFloat64: the array {} has a non-finite element ({v}) at t = {}",
+                            self.shown(vr),
                             self.model.clock.time
                         ));
                     }
@@ -81,7 +83,8 @@ impl Instance {
             .find(|&&vr| vr == VR_TIME || self.model.physics.array_len(vr).is_some())
         {
             return error(format!(
-                "fmi3SetFloat64: value reference {vr} is an output or the independent variable, not an input or parameter"
+                "fmi3SetFloat64: {} is an output or the independent variable, not an input or parameter",
+                self.shown(*vr)
             ));
         }
         self.check_scalars("fmi3SetFloat64", vrs, vals.len())?;
@@ -101,7 +104,8 @@ impl Instance {
                 Ok(step)
             }
             None => error(format!(
-                "value reference {vr} is not an output (ModelStructure lists the dependencies of outputs only)"
+                "{} is not an output (ModelStructure lists the dependencies of outputs only)",
+                self.shown(vr)
             )),
         }
     }

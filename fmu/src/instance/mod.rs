@@ -17,7 +17,8 @@ use yarnsim::scene::Scene;
 
 pub use crate::clock::Clock;
 pub use crate::fmu_model::{
-    FmuModel, ModelError, ModelResult, ModelState, ParamCheck, SetContext, StepFailure,
+    shown, FmuModel, ModelError, ModelResult, ModelState, ParamCheck, SetContext, StepFailure,
+    VarName,
 };
 pub use crate::logging::*;
 pub use crate::models::{new_model, SceneFmu};
@@ -288,6 +289,31 @@ impl Instance {
     /// Whether `logAll` messages would be shown (to skip formatting them).
     pub fn log_all(&self) -> bool {
         self.has_logger() && self.logging_on && self.categories[LOG_ALL]
+    }
+
+    /// The name and causality of any variable of the instance: the model's,
+    /// the common ones ([`crate::model::COMMON_VARIABLES`]) and, for FMI
+    /// 3.0, `time`.
+    pub fn variable(&self, vr: u32) -> Option<VarName> {
+        if let Some((name, causality)) = crate::model::common_name(vr) {
+            return Some(VarName::new(name, causality));
+        }
+        if self.api == Api::Fmi3 && vr == crate::model::VR_TIME {
+            return Some(VarName::new("time", "independent"));
+        }
+        self.model.physics.variable(vr)
+    }
+
+    /// `vr` as a message shows it: `attractor.active (value reference 4)`,
+    /// or `value reference 99` where no variable has it.
+    pub fn shown(&self, vr: u32) -> String {
+        shown(self.variable(vr), vr)
+    }
+
+    /// The name of `vr` alone (`value reference 99` where no variable has it).
+    pub fn name_of(&self, vr: u32) -> String {
+        self.variable(vr)
+            .map_or_else(|| format!("value reference {vr}"), |v| v.name)
     }
 
     /// Fails unless the state table allows `func` in the current state

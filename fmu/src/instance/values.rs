@@ -11,6 +11,23 @@ impl Instance {
         self.model.ensure_built(self.count)
     }
 
+    /// The refusal of `vr` where a `what` ("Real variable") was asked for:
+    /// `attractor.active (value reference 4) is not a Real variable`, or
+    /// `no Real variable has value reference 99`.
+    fn not_a(&self, vr: u32, what: &str) -> String {
+        match self.variable(vr) {
+            Some(_) => {
+                let a = if what.starts_with(['A', 'E', 'I', 'O', 'U']) {
+                    "an"
+                } else {
+                    "a"
+                };
+                format!("{} is not {a} {what}", self.shown(vr))
+            }
+            None => format!("no {what} has value reference {vr}"),
+        }
+    }
+
     pub fn get_real(&mut self, vrs: &[u32], out: &mut [f64]) -> Res {
         self.require("fmi2GetReal")?;
         for (k, &vr) in vrs.iter().enumerate() {
@@ -18,13 +35,12 @@ impl Instance {
                 self.require_state()?;
             }
             let Some(v) = self.model.physics.get_real(vr) else {
-                return error(format!(
-                    "fmi2GetReal: no Real variable has value reference {vr}"
-                ));
+                return error(format!("fmi2GetReal: {}", self.not_a(vr, "Real variable")));
             };
             if !v.is_finite() {
                 return error(format!(
-                    "fmi2GetReal: value reference {vr} is not finite ({v}) at t = {}",
+                    "fmi2GetReal: {} is not finite ({v}) at t = {}",
+                    self.shown(vr),
                     self.model.clock.time
                 ));
             }
@@ -43,7 +59,8 @@ impl Instance {
                 VR_THREADS => self.execution.threads as c_int,
                 _ => {
                     return error(format!(
-                        "fmi2GetInteger: no Integer variable has value reference {vr}"
+                        "fmi2GetInteger: {}",
+                        self.not_a(vr, "Integer variable")
                     ))
                 }
             };
@@ -56,7 +73,8 @@ impl Instance {
         for (k, &vr) in vrs.iter().enumerate() {
             let Some(v) = self.model.physics.get_boolean(vr) else {
                 return error(format!(
-                    "fmi2GetBoolean: no Boolean variable has value reference {vr}"
+                    "fmi2GetBoolean: {}",
+                    self.not_a(vr, "Boolean variable")
                 ));
             };
             out[k] = v as c_int;
@@ -71,7 +89,8 @@ impl Instance {
         for &vr in vrs {
             let Some(v) = self.model.physics.get_string(vr) else {
                 return error(format!(
-                    "fmi2GetString: no String variable has value reference {vr}"
+                    "fmi2GetString: {}",
+                    self.not_a(vr, "String variable")
                 ));
             };
             self.strings.push(escape_nul(v));
@@ -89,7 +108,8 @@ impl Instance {
     ) -> Res {
         self.require(func)?;
         let phase = self.phase;
-        let check = |vr: u32| parameter_settable(phase, func, vr).map_err(|f| ModelError(f.msg));
+        let check =
+            |name: &str| parameter_settable(phase, func, name).map_err(|f| ModelError(f.msg));
         let ctx = SetContext {
             resources: &self.resources,
             bundled: &self.bundled,
@@ -101,14 +121,22 @@ impl Instance {
     }
 
     pub fn set_real(&mut self, vrs: &[u32], vals: &[f64]) -> Res {
-        self.set_values("fmi2SetReal", |m, check, _| {
-            if let Some((vr, v)) = vrs.iter().zip(vals).find(|(_, v)| !v.is_finite()) {
-                return Err(ModelError(format!(
-                    "value {v} for value reference {vr} is not finite"
-                )));
-            }
-            m.set_real(vrs, vals, check)
-        })
+        if let Some((&vr, v)) = vrs.iter().zip(vals).find(|(_, v)| !v.is_finite()) {
+            self.require("fmi2SetReal")?;
+            let what = match self.variable(vr) {
+                Some(VarName { name, causality }) => {
+                    let kind = if causality == "parameter" {
+                        "parameters"
+                    } else {
+                        "inputs"
+                    };
+                    format!("{name} = {v} refused: {kind} must be finite")
+                }
+                None => format!("{v} for value reference {vr} refused: values must be finite"),
+            };
+            return error(format!("fmi2SetReal: {what}"));
+        }
+        self.set_values("fmi2SetReal", |m, check, _| m.set_real(vrs, vals, check))
     }
 
     /// Sets the execution parameters `max_substeps_per_step` and `threads`
@@ -120,11 +148,12 @@ impl Instance {
         for (&vr, &v) in vrs.iter().zip(vals) {
             match vr {
                 VR_MAX_SUBSTEPS | VR_THREADS => {
-                    parameter_settable(self.phase, "fmi2SetInteger", vr)?
+                    parameter_settable(self.phase, "fmi2SetInteger", &self.name_of(vr))?
                 }
                 _ => {
                     return error(format!(
-                        "fmi2SetInteger: value reference {vr} is not an Integer input or parameter"
+                        "fmi2SetInteger: {}",
+                        self.not_a(vr, "Integer input or parameter")
                     ))
                 }
             }

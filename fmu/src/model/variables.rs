@@ -210,3 +210,20 @@ pub const fn output<S>(
         description,
     }
 }
+
+/// The name and causality of the row of `table` with value reference `vr`.
+pub fn table_name<S>(table: &[VarSpec<S>], vr: u32) -> Option<(&'static str, &'static str)> {
+    table
+        .iter()
+        .find(|v| v.vr == vr)
+        .map(|v| (v.name, v.causality))
+}
+
+/// The name and causality of the common variable ([`super::COMMON_VARIABLES`])
+/// with value reference `vr`.
+pub fn common_name(vr: u32) -> Option<(&'static str, &'static str)> {
+    super::COMMON_VARIABLES
+        .iter()
+        .find(|c| c.1 == vr)
+        .map(|c| (c.0, c.2))
+}

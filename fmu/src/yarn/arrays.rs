@@ -21,6 +21,18 @@ fn array_of(vr: u32, yarns: usize) -> Option<(usize, bool)> {
     (k / 2 < yarns).then_some((k / 2, k % 2 == 1))
 }
 
+/// The name of the array `vr` of a bundle of `yarns` yarns
+/// (`yarn[i].positions` or `yarn[i].velocities`).
+pub fn array_name(vr: u32, yarns: usize) -> Option<String> {
+    let (i, velocities) = array_of(vr, yarns)?;
+    let what = if velocities {
+        "velocities"
+    } else {
+        "positions"
+    };
+    Some(format!("yarn[{i}].{what}"))
+}
+
 /// The array outputs of the FMU for this scene, in `ModelVariables` order;
 /// their values after initialization depend on `initial` (the `scene`
 /// parameter: the initial positions and velocities are the scene's).

@@ -11,7 +11,7 @@ use yarnsim::scene::{Integrator, TransferScheme, YarnScene};
 
 use crate::fmu_model::{
     refuse, Checkpoint, FmuModel, ModelError, ModelResult, ModelState, ParamCheck, SetContext,
-    StepFailure,
+    StepFailure, VarName,
 };
 use crate::model::*;
 use crate::state_bytes::{Reader, Writer};
@@ -58,6 +58,19 @@ fn real_param(vr: u32) -> Option<(usize, SceneField<YarnScene>)> {
         .enumerate()
         .find(|(_, (p, _))| *p == vr)
         .map(|(i, (_, f))| (i, f))
+}
+
+/// The name of the variable `vr` of [`YARN_VARIABLES`] (a caller that
+/// matched `vr` against the table's constants).
+fn name_of(vr: u32) -> &'static str {
+    table_name(&YARN_VARIABLES, vr).map_or("?", |(name, _)| name)
+}
+
+/// The name of an input of `model` (its value reference if it has none).
+fn name_of_input(model: &YarnModel, vr: u32) -> String {
+    model
+        .variable(vr)
+        .map_or_else(|| format!("value reference {vr}"), |v| v.name)
 }
 
 /// The base scene with the parameter overrides applied.
@@ -177,9 +190,9 @@ impl YarnModel {
         let mut changed = false;
         for (&vr, v) in vrs.iter().zip(vals) {
             if vr != VR_SCENE && vr != VR_TRANSFER_SCHEME && vr != VR_INTEGRATOR {
-                return refuse(format!("value reference {vr} is not a String parameter"));
+                return refuse(format!("{} is not a String parameter", self.shown(vr)));
             }
-            param_ok(vr)?;
+            param_ok(name_of(vr))?;
             if vr == VR_INTEGRATOR {
                 let Some(v) = v else {
                     return refuse("integrator is a null pointer");
@@ -348,6 +361,28 @@ impl FmuModel for YarnModel {
                 f.x.is_finite() && f.y.is_finite()
             })
     }
+    fn variable(&self, vr: u32) -> Option<VarName> {
+        if let Some((name, causality)) = table_name(&YARN_VARIABLES, vr) {
+            return Some(VarName::new(name, causality));
+        }
+        if (VR_YARN_BASE..VR_PIN_BASE).contains(&vr) {
+            let k = vr - VR_YARN_BASE;
+            let (yarn, end) = ((k / 4) as usize, k % 4);
+            let end = ["left.x", "left.y", "right.x", "right.y"][end as usize];
+            return (yarn < self.count())
+                .then(|| VarName::new(format!("yarn[{yarn}].{end}"), "output"));
+        }
+        if let Some((i, k)) = self.pin_vr(vr) {
+            let (what, causality) = match k {
+                0..=3 => (["x", "y", "vx", "vy"][k as usize], "input"),
+                PIN_FORCE => ("force.x", "output"),
+                5 => ("force.y", "output"),
+                _ => return None,
+            };
+            return Some(VarName::new(format!("pin[{i}].{what}"), causality));
+        }
+        arrays::array_name(vr, self.count()).map(|n| VarName::new(n, "output"))
+    }
     /// Whether the Real variable `vr` depends on the simulated state.
     fn is_state_output(&self, vr: u32) -> bool {
         matches!(vr, VR_KINETIC_ENERGY | VR_ELASTIC_ENERGY | VR_MAX_STRETCH)
@@ -435,7 +470,8 @@ impl FmuModel for YarnModel {
                     let (i, k) = self.pin_vr(vr).unwrap();
                     let Some(p) = inputs.pin_mut(i) else {
                         return refuse(format!(
-                            "value reference {vr} (pin {i}) is not an input: pin {i} is not a motion = \"input\" pin"
+                            "pin[{i}].{} (value reference {vr}) is not an input: pin {i} is not a motion = \"input\" pin",
+                            ["x", "y", "vx", "vy"][k as usize]
                         ));
                     };
                     match k {
@@ -451,13 +487,14 @@ impl FmuModel for YarnModel {
                 VR_GRAVITY_X => gravity.x = v,
                 VR_GRAVITY_Y => gravity.y = v,
                 _ if real_param(vr).is_some() => {
-                    param_ok(vr)?;
+                    let name = name_of(vr);
+                    param_ok(name)?;
                     let (i, field) = real_param(vr).unwrap();
                     let ok = if field.positive { v > 0.0 } else { v >= 0.0 } && v <= field.max;
                     if !ok {
                         let range = if field.positive { "> 0" } else { ">= 0" };
                         return refuse(format!(
-                            "parameter value reference {vr} = {v} is out of range (must be {range} and at most {})",
+                            "{name} = {v} is out of range (must be {range} and at most {})",
                             field.max
                         ));
                     }
@@ -465,17 +502,42 @@ impl FmuModel for YarnModel {
                 }
                 _ => {
                     return refuse(format!(
-                        "value reference {vr} is not a Real input or parameter"
+                        "{} is not a Real input or parameter",
+                        self.shown(vr)
                     ))
                 }
             }
         }
         // Every value is checked (by the library's limits) before any is
         // set, so a rejected call changes nothing.
-        YarnSim::check_gravity(gravity)
-            .and_then(|_| attractor.check())
-            .or_else(|e| refuse(e.to_string()))?;
-        inputs.check()?;
+        // A refusal names the variables of the call that make up the
+        // refused value ("gravity.y = 2000000 refused: ...").
+        let assigned = |group: &dyn Fn(u32) -> bool| {
+            vrs.iter()
+                .zip(vals)
+                .filter(|(&vr, _)| group(vr))
+                .map(|(&vr, v)| format!("{} = {v}", name_of_input(self, vr)))
+                .collect::<Vec<_>>()
+                .join(", ")
+        };
+        YarnSim::check_gravity(gravity).or_else(|e| {
+            refuse(format!(
+                "{} refused: {e}",
+                assigned(&|vr| vr == VR_GRAVITY_X || vr == VR_GRAVITY_Y)
+            ))
+        })?;
+        attractor.check().or_else(|e| {
+            refuse(format!(
+                "{} refused: {e}",
+                assigned(&|vr| (VR_ATTRACTOR_X..=VR_ATTRACTOR_STRENGTH).contains(&vr))
+            ))
+        })?;
+        inputs.check().or_else(|e| {
+            refuse(format!(
+                "{} refused: {e}",
+                assigned(&|vr| self.pin_vr(vr).is_some())
+            ))
+        })?;
         self.sim
             .set_gravity(gravity)
             .and_then(|_| self.sim.set_attractor(attractor))
@@ -498,12 +560,13 @@ impl FmuModel for YarnModel {
             match vr {
                 VR_ATTRACTOR_ACTIVE => attractor.active = v,
                 VR_PLASTICITY => {
-                    param_ok(vr)?;
+                    param_ok(name_of(vr))?;
                     plasticity = Some(v);
                 }
                 _ => {
                     return refuse(format!(
-                        "value reference {vr} is not a Boolean input or parameter"
+                        "{} is not a Boolean input or parameter",
+                        self.shown(vr)
                     ))
                 }
             }
