@@ -38,13 +38,18 @@ pub fn xml_escape(s: &str) -> String {
     out
 }
 
-/// Units used by the variables with their SI base-unit exponents.
-pub const UNITS: [(&str, &str); 8] = [
+/// Units used by the variables with their SI base-unit exponents. The yarn
+/// bundle is a 2D model per metre of depth: its energies are in J/m, its
+/// stiffnesses and forces in N/m, its bending stiffness in N.m (N m^2 per
+/// m of depth) and its line density in kg/m2 (kg per m of yarn per m of
+/// depth); the mass-spring model is 3D (J).
+pub const UNITS: [(&str, &str); 9] = [
     ("J", r#"kg="1" m="2" s="-2""#),
+    ("J/m", r#"kg="1" m="1" s="-2""#),
+    ("N.m", r#"kg="1" m="2" s="-2""#),
     ("N/m", r#"kg="1" s="-2""#),
     ("m/s", r#"m="1" s="-1""#),
-    ("Pa", r#"kg="1" m="-1" s="-2""#),
-    ("kg/m", r#"kg="1" m="-1""#),
+    ("kg/m2", r#"kg="1" m="-2""#),
     ("m", r#"m="1""#),
     ("m/s2", r#"m="1" s="-2""#),
     ("s", r#"s="1""#),

@@ -15,7 +15,7 @@ use Causality::{Input, Parameter};
 pub const MODEL_IDENTIFIER: &str = "YarnBundle";
 
 /// Bumped whenever the variable layout changes; part of the GUID.
-pub const INTERFACE_VERSION: u32 = 4;
+pub const INTERFACE_VERSION: u32 = 5;
 
 // Value references. They are unique across all types.
 pub const VR_ATTRACTOR_X: u32 = 1;
@@ -134,20 +134,20 @@ pub static YARN_VARIABLES: [VarSpec<YarnScene>; 21] = [
     var(Input, "attractor.active", VR_ATTRACTOR_ACTIVE, None, Start::Bool(|s| s.attractor.active), "Whether the attractor acts"),
     var(Input, "gravity.x", VR_GRAVITY_X, Some("m/s2"), Start::Real(|s| s.gravity[0]), "Gravity x, |g| at most 1e6"),
     var(Input, "gravity.y", VR_GRAVITY_Y, Some("m/s2"), Start::Real(|s| s.gravity[1]), "Gravity y, |g| at most 1e6"),
-    var(Parameter, "material.k", VR_K, Some("Pa"), material(|s| s.material.k, |s, v| s.material.k = v, false), "Fiber stretch stiffness"),
-    var(Parameter, "material.gamma", VR_GAMMA, Some("Pa"), material(|s| s.material.gamma, |s, v| s.material.gamma = v, false), "Fiber shear stiffness"),
-    var(Parameter, "material.youngs_modulus", VR_YOUNGS_MODULUS, Some("Pa"), material(|s| s.material.youngs_modulus, |s, v| s.material.youngs_modulus = v, false), "Young's modulus of the cross-section"),
+    var(Parameter, "material.k", VR_K, Some("N/m"), material(|s| s.material.k, |s, v| s.material.k = v, false), "Fiber stretch stiffness (per m of depth)"),
+    var(Parameter, "material.gamma", VR_GAMMA, Some("N/m"), material(|s| s.material.gamma, |s, v| s.material.gamma = v, false), "Fiber shear stiffness (per m of depth)"),
+    var(Parameter, "material.youngs_modulus", VR_YOUNGS_MODULUS, Some("N/m"), material(|s| s.material.youngs_modulus, |s, v| s.material.youngs_modulus = v, false), "Young's modulus of the cross-section (per m of depth)"),
     var(Parameter, "material.friction", VR_FRICTION, None, material(|s| s.material.friction, |s, v| s.material.friction = v, false), "Mohr-Coulomb friction coefficient"),
-    var(Parameter, "material.bending", VR_BENDING, Some("Pa"), material(|s| s.material.bending, |s, v| s.material.bending = v, false), "Bending modulus (0 disables bending)"),
-    var(Parameter, "material.density", VR_DENSITY, Some("kg/m"), material(|s| s.material.density, |s, v| s.material.density = v, true), "Line density"),
+    var(Parameter, "material.bending", VR_BENDING, Some("N.m"), material(|s| s.material.bending, |s, v| s.material.bending = v, false), "Bending stiffness B of the energy int B/2 kappa^2 ds, N m^2 per m of depth (0 disables bending)"),
+    var(Parameter, "material.density", VR_DENSITY, Some("kg/m2"), material(|s| s.material.density, |s, v| s.material.density = v, true), "Line density (kg per m of yarn, per m of depth)"),
     var(Parameter, "dt", VR_DT, Some("s"), Start::Scene(SceneField { get: |s| s.time.dt.fixed().unwrap_or(0.0), set: set_dt, positive: false, max: 1e12 }), "Substep size; 0: adaptive (the scene's dt = \"auto\": each substep is the safety factor times the stability bound of the current state, the last one before a communication point shortened to land on it). A fixed dt runs an integer number of substeps per communication step"),
     var(Parameter, "material.plasticity", VR_PLASTICITY, None, Start::Bool(|s| s.material.plasticity), "Mohr-Coulomb return mapping on or off"),
     var(Parameter, "transfer.scheme", VR_TRANSFER_SCHEME, None, Start::Name(|s| scheme_name(s.transfer.scheme)), "Particle velocity update of grid-to-particle: flip (FLIP/APIC blend by transfer.flip_ratio) or apic"),
     var(Parameter, "transfer.flip_ratio", VR_FLIP_RATIO, None, Start::Scene(SceneField { get: |s| s.transfer.flip_ratio, set: |s, v| s.transfer.flip_ratio = v, positive: false, max: 1.0 }), "FLIP ratio in [0, 1] of the flip scheme (1: pure FLIP; ignored by apic)"),
     var(Parameter, "integrator", VR_INTEGRATOR, None, Start::Name(|s| integrator_name(s.time.integrator)), "Time integrator (the scene's time.integrator): explicit (symplectic Euler), implicit (backward Euler, Newton on the grid velocities), implicit-vertices (backward Euler on the vertices of a single yarn without the grid) or midpoint-vertices (generalized midpoint there); the last two only for one yarn with gamma = youngs_modulus = 0 and no walls: another scene is refused with fmi2Error at the end of initialization, the log naming the scene field; a Newton solve that fails in a step gives fmi2Discard"),
     var(Parameter, "scene", VR_SCENE, None, Start::Text(SCENE_FILE), "Scene file: a path relative to the FMU's resources folder, or absolute; it must create as many yarns as the bundled scene and have its pins (same number, same input pins)"),
-    output("kinetic_energy", VR_KINETIC_ENERGY, Some("J"), "Kinetic energy (per unit depth)"),
-    output("elastic_energy", VR_ELASTIC_ENERGY, Some("J"), "Elastic energy (per unit depth)"),
+    output("kinetic_energy", VR_KINETIC_ENERGY, Some("J/m"), "Kinetic energy (per m of depth)"),
+    output("elastic_energy", VR_ELASTIC_ENERGY, Some("J/m"), "Elastic energy (per m of depth)"),
     output("max_stretch", VR_MAX_STRETCH, None, "Largest segment stretch |x_r - x_l| / l0"),
 ];
 
