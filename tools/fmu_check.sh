@@ -11,7 +11,10 @@
 # input) and compares them bit for bit with fmpy; then builds the FMI 3.0
 # FMUs of the small, default, wire and driven scenes (build-fmu --fmi-version 3) and
 # checks them in fmpy against the FMI 2.0 FMUs and the library
-# (tools/fmu3_check.py). Exits non-zero on failure.
+# (tools/fmu3_check.py); then runs the documented recipes for a refused
+# input (save the FMU state, restore it after the refusal) and for a
+# diverged step in simulate_fmu, as they stand in docs/fmu.md and
+# docs/fmu3.md (tools/fmu_errors.py). Exits non-zero on failure.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 venv=tools/.venv
@@ -43,3 +46,4 @@ trap 'rm -rf "$work"' EXIT
     "$target/fmu/YarnBundle-fmi3.fmu" "$target/fmu/YarnBundle.fmu" \
     "$target/fmu/MassSpring-wire-fmi3.fmu" "$target/fmu/MassSpring-wire.fmu" \
     "$target/fmu/YarnBundle-driven-fmi3.fmu" "$target/fmu/YarnBundle-driven.fmu"
+"$venv/bin/python" tools/fmu_errors.py "$target/fmu/YarnBundle-small.fmu" "$target/fmu/YarnBundle-small-fmi3.fmu"
