@@ -333,17 +333,21 @@ impl<'de> Deserialize<'de> for StepSize {
     }
 }
 
-/// Material of the yarns (per unit thickness: the 2D model has unit depth).
+/// Material of the yarns, per metre of depth: the 2D model is a sheet of
+/// parallel yarns one metre deep, so stiffnesses are in N/m (J/m^2, the
+/// energy density over the plane), the bending stiffness in N m and the
+/// density in kg/m^2.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Material {
-    /// Fiber stretch stiffness `k` (Pa).
+    /// Fiber stretch stiffness `k` (N/m per metre of depth).
     #[serde(deserialize_with = "nonnegative")]
     pub k: f64,
-    /// Fiber shear stiffness `gamma` (Pa).
+    /// Fiber shear stiffness `gamma` (N/m per metre of depth).
     #[serde(deserialize_with = "nonnegative")]
     pub gamma: f64,
-    /// Young's modulus `E` of the cross-section (Pa); `mu = 0.4 E`, `lambda = 0.6 E`.
+    /// Young's modulus `E` of the cross-section (N/m per metre of depth);
+    /// `mu = 0.4 E`, `lambda = 0.6 E`.
     #[serde(deserialize_with = "nonnegative")]
     pub youngs_modulus: f64,
     /// Mohr-Coulomb friction coefficient `c_f` (dimensionless).
@@ -354,7 +358,7 @@ pub struct Material {
     /// [`crate::mpm::vertex_forces`]). 0 disables bending.
     #[serde(default, deserialize_with = "nonnegative")]
     pub bending: f64,
-    /// Line density in kg/m (per unit depth).
+    /// Density in kg/m^2: mass per metre of yarn per metre of depth.
     #[serde(default = "one", deserialize_with = "positive")]
     pub density: f64,
     /// Mohr-Coulomb return mapping on (default) or off.
