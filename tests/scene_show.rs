@@ -305,3 +305,83 @@ fn unit_table_covers_every_field_once() {
         }
     }
 }
+
+/// The field keys and the unit of each row of the two reference tables of
+/// `docs/scene-files.md`: `(kind, key of the row's first field, unit)`,
+/// kind `yarn` or `mass-spring`. A row's first cell names its fields in
+/// backticks, after a `[table]` or `[[array]]` prefix
+/// (`` `[[obstacles]] center` ``, `` `[time] frame_time` ``); the unit is
+/// the second cell's first comma-separated part without a leading shape
+/// (`[x, y, z] m/s^2` is `m/s^2`), and none for `bool`, `string`, `index`,
+/// `integer ...` or a shape alone.
+fn documented_units() -> Vec<(&'static str, String, String)> {
+    let text = include_str!("../docs/scene-files.md");
+    let mut kind = "";
+    let mut rows = Vec::new();
+    for line in text.lines() {
+        if line.starts_with("## Yarn scenes") {
+            kind = "yarn";
+        } else if line.starts_with("## Mass-spring scene files") {
+            kind = "mass-spring";
+        } else if line.starts_with("## ") || line.starts_with("### ") {
+            kind = "";
+        }
+        if kind.is_empty() || !line.starts_with("| `") {
+            continue;
+        }
+        let cells: Vec<&str> = line.split('|').map(str::trim).collect();
+        let first = cells[1];
+        let name = first.split('`').nth(1).unwrap();
+        let key = match name.split_once(' ') {
+            Some((prefix, field)) => {
+                let table = prefix.trim_matches(|c| c == '[' || c == ']');
+                format!("{table}.{field}")
+            }
+            None => name.to_string(),
+        };
+        let mut unit = cells[2];
+        if unit.starts_with('[') {
+            unit = unit.split_once(']').map_or("", |(_, rest)| rest).trim();
+        }
+        let unit = unit.split(',').next().unwrap().trim();
+        let unit = if ["bool", "string", "index"].contains(&unit) || unit.starts_with("integer") {
+            ""
+        } else {
+            unit
+        };
+        rows.push((kind, key, unit.to_string()));
+    }
+    rows
+}
+
+#[test]
+fn unit_table_agrees_with_the_scene_file_reference() {
+    let rows = documented_units();
+    assert!(rows.len() > 60, "{rows:?}");
+    for (kind, key, unit) in &rows {
+        let fields = if *kind == "yarn" {
+            YARN_FIELDS
+        } else {
+            MASS_SPRING_FIELDS
+        };
+        let doc = field_doc(fields, key).unwrap_or_else(|| {
+            panic!("docs/scene-files.md names {kind} field {key}, the code does not")
+        });
+        assert_eq!(
+            doc.unit, unit,
+            "{kind} field {key}: unit {:?} in the code, {unit:?} in docs/scene-files.md",
+            doc.unit
+        );
+    }
+    // Every field the code knows is documented (in a row of its own or
+    // named in another row's cell, as `[[pins]] motion` names `velocity`).
+    let text = include_str!("../docs/scene-files.md");
+    for f in YARN_FIELDS.iter().chain(MASS_SPRING_FIELDS) {
+        let field = f.key.rsplit('.').next().unwrap();
+        assert!(
+            text.contains(&format!("`{field}`")) || text.contains(&format!("{field}`")),
+            "{} is not in docs/scene-files.md",
+            f.key
+        );
+    }
+}
