@@ -7,7 +7,9 @@
 //! Each plot's title names its series with their colours instead
 //! (`energy [J]: kinetic blue, elastic orange, ...`); hovering a curve shows
 //! its full name. The time axis spans the whole run, `[0, duration]`, and a
-//! little more.
+//! little more (the viewer's default, the recording's extent, puts the last
+//! point on the edge); it is a range of `sim_time`, the timeline the layout
+//! selects, in ns (on the `frame` timeline it would span that many frames).
 
 use rerun::blueprint::components::{Corner2D, PanelState, PlayState};
 use rerun::datatypes::{Range2D, TimeInt, TimeRange, TimeRangeBoundary};
