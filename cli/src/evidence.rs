@@ -1,11 +1,11 @@
-//! `yarnsim bench precision`, `yarnsim stress`, `yarnsim bench skip` and
-//! `yarnsim bench roofline`: the
-//! evidence studies of [`yarnsim_evidence`], writing CSV, SVG and a text
-//! report into a directory and printing the report.
+//! `yarnsim bench precision`, `yarnsim bench skip`, `yarnsim bench
+//! roofline` (the studies under `bench`, [`BenchStudy`]) and `yarnsim
+//! stress`: the evidence studies of [`yarnsim_evidence`], writing CSV, SVG
+//! and a text report into a directory and printing the report.
 //!
-//! `bench precision` and `bench skip` are spelled `bench-precision` and
-//! `bench-skip` internally; [`rewrite_args`] maps the two-word forms onto them
-//! before clap parses, so `yarnsim bench SCENE` keeps working.
+//! The old one-word spellings `bench-precision`, `precision`, `bench-skip`
+//! and `bench-roofline` still work, hidden: [`rewrite_args`] maps them onto
+//! the `bench` subcommands before clap parses.
 
 use std::ffi::OsString;
 use std::path::{Path, PathBuf};
@@ -15,19 +15,19 @@ use yarnsim_evidence::{precision, roofline, skip, stress, write_report};
 
 use crate::error::CliError;
 
-/// The evidence commands (flattened into the top-level command list).
+/// The studies under `yarnsim bench` (without one, `bench` measures a
+/// scene's throughput).
 #[derive(Subcommand, Debug, Clone, PartialEq)]
-pub enum EvidenceCommand {
-    /// Work-precision: run time against error per scene and integrator
-    /// (`yarnsim bench precision`): CSV, SVG plots, convergence orders and
-    /// the fastest method per error level
+pub enum BenchStudy {
+    /// Work-precision: run time against error per scene and integrator:
+    /// CSV, SVG plots, convergence orders and the fastest method per error
+    /// level
     ///
     /// Mass-spring scenes per integrator against a converged reference; the
     /// yarn against the hanging-chain oracle (first-mode frequency) per
     /// transfer scheme over a dt ladder and a grid ladder, with the cheapest
     /// setting per error level 1e-1, 1e-2, 1e-3.
-    #[command(name = "bench-precision", visible_alias = "precision")]
-    BenchPrecision {
+    Precision {
         /// Output directory for precision*.csv, precision_<scene>.svg,
         /// precision_chain.svg, precision.txt.
         #[arg(long, value_name = "DIR", default_value = "evidence")]
@@ -43,20 +43,9 @@ pub enum EvidenceCommand {
         #[arg(long)]
         no_chain: bool,
     },
-    /// Stability stress: largest stable dt per integrator and stiffness / yarn
-    /// parameter by bisection, next to the theoretical bound.
-    Stress {
-        /// Output directory for stress.csv, stress*.svg, stress.txt.
-        #[arg(long, value_name = "DIR", default_value = "evidence")]
-        out: PathBuf,
-        /// Fewer configurations and bisection steps.
-        #[arg(long)]
-        quick: bool,
-    },
-    /// Skip what a scene doesn't need (`yarnsim bench skip`): optional passes
-    /// on/off, 256^2 vs 1024^2 grid, per-pass breakdown of the reference scene.
-    #[command(name = "bench-skip")]
-    BenchSkip {
+    /// Skip what a scene doesn't need: optional passes on/off, 256^2 vs
+    /// 1024^2 grid, per-pass breakdown of the reference scene.
+    Skip {
         /// Output directory for skip*.csv, skip.svg, skip.txt.
         #[arg(long, value_name = "DIR", default_value = "evidence")]
         out: PathBuf,
@@ -67,12 +56,11 @@ pub enum EvidenceCommand {
         #[arg(long, default_value_t = 12)]
         repeats: usize,
     },
-    /// The limit (`yarnsim bench roofline`): this core's peak flop/s and
-    /// memory bandwidth (multiply-add and triad kernels), the flops and
-    /// bytes per particle of each pass counted from the kernels, and where
-    /// each pass of the reference scene (1 thread) sits on the roofline.
-    #[command(name = "bench-roofline")]
-    BenchRoofline {
+    /// The limit: this core's peak flop/s and memory bandwidth
+    /// (multiply-add and triad kernels), the flops and bytes per particle of
+    /// each pass counted from the kernels, and where each pass of the
+    /// reference scene (1 thread) sits on the roofline.
+    Roofline {
         /// Output directory for roofline*.csv, roofline.txt.
         #[arg(long, value_name = "DIR", default_value = "evidence")]
         out: PathBuf,
@@ -85,18 +73,67 @@ pub enum EvidenceCommand {
     },
 }
 
-/// Maps `yarnsim bench precision ...` to `yarnsim bench-precision ...` and
-/// `yarnsim bench skip ...` to `yarnsim bench-skip ...` (and `roofline`
-/// likewise); other arguments
-/// pass unchanged.
+/// `yarnsim stress`: the stability stress study.
+#[derive(clap::Args, Debug, Clone, PartialEq)]
+pub struct StressArgs {
+    /// Output directory for stress.csv, stress*.svg, stress.txt.
+    #[arg(long, value_name = "DIR", default_value = "evidence")]
+    pub out: PathBuf,
+    /// Fewer configurations and bisection steps.
+    #[arg(long)]
+    pub quick: bool,
+}
+
+/// One evidence study to run.
+#[derive(Debug, Clone, PartialEq)]
+pub enum EvidenceCommand {
+    /// `yarnsim bench precision | skip | roofline`.
+    Bench(BenchStudy),
+    /// `yarnsim stress`.
+    Stress(StressArgs),
+}
+
+impl EvidenceCommand {
+    /// The command as typed, and how long it takes on 2 cores (README,
+    /// "Performance and accuracy evidence"), for the spinner.
+    pub fn label(&self) -> (&'static str, &'static str) {
+        match self {
+            EvidenceCommand::Bench(BenchStudy::Precision { quick: false, .. }) => {
+                ("bench precision", "about 40 s")
+            }
+            EvidenceCommand::Bench(BenchStudy::Precision { quick: true, .. }) => {
+                ("bench precision --quick", "about 5 s")
+            }
+            EvidenceCommand::Stress(StressArgs { quick: false, .. }) => ("stress", "about 50 s"),
+            EvidenceCommand::Stress(StressArgs { quick: true, .. }) => {
+                ("stress --quick", "about 25 s")
+            }
+            EvidenceCommand::Bench(BenchStudy::Skip { .. }) => {
+                ("bench skip", "grows with --steps x --repeats")
+            }
+            EvidenceCommand::Bench(BenchStudy::Roofline { .. }) => ("bench roofline", "about 10 s"),
+        }
+    }
+}
+
+/// The old spellings of the `bench` studies, hidden, and what they are now.
+const OLD_SPELLINGS: [(&str, &str); 4] = [
+    ("bench-precision", "precision"),
+    ("precision", "precision"),
+    ("bench-skip", "skip"),
+    ("bench-roofline", "roofline"),
+];
+
+/// Maps the old spellings `yarnsim bench-precision ...` (and `precision`,
+/// `bench-skip`, `bench-roofline`) onto `yarnsim bench precision ...`;
+/// other arguments pass unchanged.
 pub fn rewrite_args(args: impl IntoIterator<Item = OsString>) -> Vec<OsString> {
     let mut v: Vec<OsString> = args.into_iter().collect();
-    if v.len() >= 3
-        && v[1] == "bench"
-        && (v[2] == "precision" || v[2] == "skip" || v[2] == "roofline")
+    if let Some(&(_, study)) = v
+        .get(1)
+        .and_then(|a| OLD_SPELLINGS.iter().find(|(old, _)| a == old))
     {
-        let joined = format!("bench-{}", v[2].to_string_lossy());
-        v.splice(1..3, [OsString::from(joined)]);
+        v.splice(1..2, [OsString::from("bench"), OsString::from(study)]);
     }
     v
 }
@@ -108,12 +145,12 @@ fn write(out: &Path, files: &[(String, String)]) -> Result<Vec<String>, CliError
 /// Runs one evidence command; returns the report text and the files written.
 pub fn execute(cmd: &EvidenceCommand) -> Result<(String, Vec<String>), CliError> {
     match cmd {
-        EvidenceCommand::BenchPrecision {
+        EvidenceCommand::Bench(BenchStudy::Precision {
             out,
             quick,
             yarn_reference,
             no_chain,
-        } => {
+        }) => {
             let r = precision::run(&precision::PrecisionOptions {
                 quick: *quick,
                 yarn_reference: *yarn_reference,
@@ -122,15 +159,15 @@ pub fn execute(cmd: &EvidenceCommand) -> Result<(String, Vec<String>), CliError>
             .map_err(CliError::Failed)?;
             Ok((r.to_text(), write(out, &r.files())?))
         }
-        EvidenceCommand::Stress { out, quick } => {
+        EvidenceCommand::Stress(StressArgs { out, quick }) => {
             let r = stress::run(&stress::StressOptions { quick: *quick });
             Ok((r.to_text(), write(out, &r.files())?))
         }
-        EvidenceCommand::BenchSkip {
+        EvidenceCommand::Bench(BenchStudy::Skip {
             out,
             steps,
             repeats,
-        } => {
+        }) => {
             steps_and_repeats(*steps, *repeats)?;
             let r = skip::run(&skip::SkipOptions {
                 steps: *steps,
@@ -140,11 +177,11 @@ pub fn execute(cmd: &EvidenceCommand) -> Result<(String, Vec<String>), CliError>
             .map_err(CliError::Failed)?;
             Ok((r.to_text(), write(out, &r.files())?))
         }
-        EvidenceCommand::BenchRoofline {
+        EvidenceCommand::Bench(BenchStudy::Roofline {
             out,
             steps,
             repeats,
-        } => {
+        }) => {
             steps_and_repeats(*steps, *repeats)?;
             let r = roofline::run(&roofline::RooflineOptions {
                 steps: *steps,
@@ -176,39 +213,46 @@ mod tests {
     }
 
     #[test]
-    fn two_word_bench_commands_are_rewritten() {
+    fn old_spellings_are_rewritten_to_the_bench_subcommands() {
         assert_eq!(
-            rewrite_args(os(&["yarnsim", "bench", "precision", "--out", "d"])),
-            os(&["yarnsim", "bench-precision", "--out", "d"])
+            rewrite_args(os(&["yarnsim", "bench-precision", "--out", "d"])),
+            os(&["yarnsim", "bench", "precision", "--out", "d"])
         );
         assert_eq!(
-            rewrite_args(os(&["yarnsim", "bench", "skip"])),
-            os(&["yarnsim", "bench-skip"])
+            rewrite_args(os(&["yarnsim", "precision", "--quick"])),
+            os(&["yarnsim", "bench", "precision", "--quick"])
         );
         assert_eq!(
-            rewrite_args(os(&["yarnsim", "bench", "roofline", "--steps", "5"])),
-            os(&["yarnsim", "bench-roofline", "--steps", "5"])
+            rewrite_args(os(&["yarnsim", "bench-skip"])),
+            os(&["yarnsim", "bench", "skip"])
         );
         assert_eq!(
-            rewrite_args(os(&["yarnsim", "bench", "yarn-reference"])),
-            os(&["yarnsim", "bench", "yarn-reference"])
+            rewrite_args(os(&["yarnsim", "bench-roofline", "--steps", "5"])),
+            os(&["yarnsim", "bench", "roofline", "--steps", "5"])
         );
-        assert_eq!(
-            rewrite_args(os(&["yarnsim", "bench"])),
-            os(&["yarnsim", "bench"])
-        );
+        // The current spelling, a scene named `precision` after `run` and
+        // plain `bench` pass unchanged.
+        for args in [
+            vec!["yarnsim", "bench", "precision", "--quick"],
+            vec!["yarnsim", "bench", "yarn-reference"],
+            vec!["yarnsim", "run", "precision"],
+            vec!["yarnsim", "bench"],
+            vec!["yarnsim"],
+        ] {
+            assert_eq!(rewrite_args(os(&args)), os(&args));
+        }
     }
 
     #[test]
     #[cfg_attr(debug_assertions, ignore = "runs the quick studies; release only")]
     fn quick_precision_writes_csv_and_svg() {
         let dir = std::env::temp_dir().join(format!("yarnsim-evidence-{}", std::process::id()));
-        let (text, files) = execute(&EvidenceCommand::BenchPrecision {
+        let (text, files) = execute(&EvidenceCommand::Bench(BenchStudy::Precision {
             out: dir.clone(),
             quick: true,
             yarn_reference: false,
             no_chain: false,
-        })
+        }))
         .unwrap();
         assert!(text.contains("Fastest method per error level"));
         assert!(text.contains("Cheapest setting per error level"));

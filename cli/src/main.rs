@@ -9,6 +9,7 @@ use yarnsim_cli::bench::{bench, format_bench, BenchOptions};
 use yarnsim_cli::duration::parse_duration;
 use yarnsim_cli::error::{CliError, EXIT_INTERRUPTED};
 use yarnsim_cli::estimate::{announce, Estimate};
+use yarnsim_cli::evidence::{BenchStudy, EvidenceCommand, StressArgs};
 use yarnsim_cli::massspring::IntegratorArgs;
 use yarnsim_cli::record::{
     parse_memory_limit, record, MemoryLimit, RecordOptions, Sink, DEFAULT_CONNECT_URL,
@@ -111,10 +112,14 @@ enum Command {
         #[command(flatten)]
         integrator: IntegratorFlags,
     },
-    /// Measure substep throughput in this build, with a per-pass breakdown.
+    /// Measure substep throughput in this build, with a per-pass breakdown;
+    /// or run a benchmark study (precision, skip, roofline).
     ///
-    /// Prints a line `<number> particle-substeps/s`.
+    /// Without a study: prints a line `<number> particle-substeps/s`.
+    #[command(args_conflicts_with_subcommands = true)]
     Bench {
+        #[command(subcommand)]
+        study: Option<BenchStudy>,
         #[command(flatten)]
         scene: SceneArgs,
         /// Timed substeps.
@@ -129,8 +134,9 @@ enum Command {
         #[command(flatten)]
         integrator: IntegratorFlags,
     },
-    #[command(flatten)]
-    Evidence(yarnsim_cli::evidence::EvidenceCommand),
+    /// Stability stress: largest stable dt per integrator and stiffness / yarn
+    /// parameter by bisection, next to the theoretical bound.
+    Stress(StressArgs),
 }
 
 /// The scene of `run`, `record` and `bench`, with its overrides.
@@ -305,6 +311,11 @@ fn execute(command: Command) -> Result<u8, CliError> {
             }
         }
         Command::Bench {
+            study: Some(study), ..
+        } => return evidence(EvidenceCommand::Bench(study)),
+        Command::Stress(args) => return evidence(EvidenceCommand::Stress(args)),
+        Command::Bench {
+            study: None,
             scene,
             steps,
             warmup,
@@ -324,28 +335,23 @@ fn execute(command: Command) -> Result<u8, CliError> {
             )?;
             print!("{}", format_bench(&r));
         }
-        Command::Evidence(cmd) => {
-            use yarnsim_cli::evidence::EvidenceCommand as E;
-            // Durations measured on 2 cores (README, "Performance and accuracy evidence").
-            let (label, note) = match &cmd {
-                E::BenchPrecision { quick: false, .. } => ("bench precision", "about 40 s"),
-                E::BenchPrecision { quick: true, .. } => ("bench precision --quick", "about 5 s"),
-                E::Stress { quick: false, .. } => ("stress", "about 50 s"),
-                E::Stress { quick: true, .. } => ("stress --quick", "about 25 s"),
-                E::BenchSkip { .. } => ("bench skip", "grows with --steps x --repeats"),
-                E::BenchRoofline { .. } => ("bench roofline", "about 10 s"),
-            };
-            let spinner = yarnsim_cli::driver::spinner(label);
-            spinner.set_message(note);
-            let result = yarnsim_cli::evidence::execute(&cmd);
-            spinner.finish_and_clear();
-            let (text, files) = result?;
-            let text = yarnsim_cli::table::fit_tables(&text, yarnsim_cli::table::MAX_WIDTH);
-            print!("{text}");
-            for f in files {
-                println!("wrote {f}");
-            }
-        }
+    }
+    Ok(0)
+}
+
+/// Runs an evidence study under a spinner and prints its report and the
+/// files it wrote.
+fn evidence(cmd: EvidenceCommand) -> Result<u8, CliError> {
+    let (label, note) = cmd.label();
+    let spinner = yarnsim_cli::driver::spinner(label);
+    spinner.set_message(note);
+    let result = yarnsim_cli::evidence::execute(&cmd);
+    spinner.finish_and_clear();
+    let (text, files) = result?;
+    let text = yarnsim_cli::table::fit_tables(&text, yarnsim_cli::table::MAX_WIDTH);
+    print!("{text}");
+    for f in files {
+        println!("wrote {f}");
     }
     Ok(0)
 }

@@ -13,7 +13,7 @@ use crate::driver::run_frames_shown;
 use crate::error::CliError;
 use crate::massspring::{IntegratorArgs, MassSpringRun, MsDiagnostics};
 use crate::schedule::Schedule;
-use crate::table::{yarn_rows, DiagRow, Summary};
+use crate::table::{count, yarn_rows, DiagRow, Summary};
 
 /// Runs `scene` for `duration` seconds; writes the CSV to `csv` if given.
 /// `integrator` applies to mass-spring scenes only.
@@ -57,7 +57,11 @@ pub fn run_massspring(
         scene: run.name.clone(),
         model: format!("mass-spring, {}", run.sim.integrator()),
         particles,
-        particles_detail: format!("{fixed} pinned or driven, {springs} springs, {spheres} spheres"),
+        particles_detail: format!(
+            "{fixed} pinned or driven, {}, {}",
+            count(springs, "spring"),
+            count(spheres, "sphere")
+        ),
         dt: run.h,
         adaptive_dt: None,
         diagnostics: ms_rows(&initial, &last),
@@ -149,10 +153,10 @@ pub fn run_yarn(sim: &mut YarnSim, duration: f64, csv: Option<&Path>) -> Result<
         model: "yarn (MPM)".into(),
         particles: p.len(),
         particles_detail: format!(
-            "{} vertices + {} quadrature, {} yarns",
+            "{} vertices + {} quadrature, {}",
             p.vert.x.len(),
             p.quad.x.len(),
-            sim.num_yarns()
+            count(sim.num_yarns(), "yarn")
         ),
         dt: sim.dt(),
         adaptive_dt: sim

@@ -37,7 +37,9 @@ pub fn load_scene(name_or_path: &str, overrides: &[String]) -> Result<Scene, Cli
     Scene::resolve_with(name_or_path, overrides).map_err(CliError::from)
 }
 
-/// The scene as TOML, ready to save and edit.
+/// The scene as TOML, ready to save and edit: arrays on one line, each
+/// field's unit and range in a comment after it
+/// ([`Scene::to_commented_toml`]).
 pub fn show_scene(name_or_path: &str, overrides: &[String]) -> Result<String, CliError> {
-    Ok(load_scene(name_or_path, overrides)?.to_toml_string())
+    Ok(load_scene(name_or_path, overrides)?.to_commented_toml())
 }

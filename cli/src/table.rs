@@ -65,7 +65,7 @@ impl Summary {
 pub fn yarn_rows(a: &Diagnostics, b: &Diagnostics) -> Vec<DiagRow> {
     let total = |d: &Diagnostics| d.kinetic_energy + d.elastic_energy + d.potential_energy;
     vec![
-        ("time [s]", a.time, b.time),
+        ("time", a.time, b.time),
         ("kinetic energy", a.kinetic_energy, b.kinetic_energy),
         ("elastic energy", a.elastic_energy, b.elastic_energy),
         ("potential energy", a.potential_energy, b.potential_energy),
@@ -77,6 +77,51 @@ pub fn yarn_rows(a: &Diagnostics, b: &Diagnostics) -> Vec<DiagRow> {
         ("max stretch", a.max_stretch, b.max_stretch),
     ]
 }
+
+/// The unit of a diagnostic row by its quantity (the row's name up to its
+/// axis: `momentum x` is a `momentum`), shown after the name.
+const UNITS: [(&str, &str); 8] = [
+    ("time", "s"),
+    ("energy", "J"),
+    ("momentum", "kg m/s"),
+    ("angular momentum", "kg m^2/s"),
+    ("ang. momentum", "kg m^2/s"),
+    ("stretch", "l/l0"),
+    ("strain", "|l/l0 - 1|"),
+    ("centre of mass", "m"),
+];
+
+/// A diagnostic row's name with its unit: `kinetic energy [J]`,
+/// `momentum x [kg m/s]`, `min stretch [l/l0]`.
+pub fn with_unit(name: &str) -> String {
+    let quantity = name
+        .strip_suffix(" x")
+        .or_else(|| name.strip_suffix(" y"))
+        .or_else(|| name.strip_suffix(" z"))
+        .unwrap_or(name);
+    // The longest quantity the name ends with: `angular momentum` before `momentum`.
+    let unit = UNITS
+        .iter()
+        .filter(|(q, _)| quantity == *q || quantity.ends_with(&format!(" {q}")))
+        .max_by_key(|(q, _)| q.len())
+        .map(|(_, u)| *u);
+    match unit {
+        Some(u) if !name.contains('[') => format!("{name} [{u}]"),
+        _ => name.to_string(),
+    }
+}
+
+/// `1 yarn`, `12 yarns`: a count with its noun in the right number.
+pub fn count(n: usize, noun: &str) -> String {
+    if n == 1 {
+        format!("1 {noun}")
+    } else {
+        format!("{n} {noun}s")
+    }
+}
+
+/// Width of the name column of the diagnostic rows (`angular momentum [kg m^2/s]`).
+const NAME_WIDTH: usize = 28;
 
 /// Whether the wall-clock figures (wall time, throughput) are printed or
 /// replaced by `[timing]`: redaction gives output that depends only on the
@@ -150,9 +195,13 @@ pub fn format_summary(s: &Summary, timing: Timing) -> String {
     } else {
         "final"
     };
-    let _ = writeln!(out, "{:<18} {:>16} {:>16}", "", "initial", last);
+    let _ = writeln!(out, "{:<NAME_WIDTH$} {:>16} {:>16}", "", "initial", last);
     for (k, x, y) in &s.diagnostics {
-        let _ = writeln!(out, "{k:<18} {:>16} {:>16}", num(*x), num(*y));
+        let k = with_unit(k);
+        let _ = writeln!(out, "{k:<NAME_WIDTH$} {:>16} {:>16}", num(*x), num(*y));
+    }
+    if s.model.starts_with("yarn") {
+        let _ = writeln!(out, "(2D model: energies and momenta are per m of depth)");
     }
     out
 }

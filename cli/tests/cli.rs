@@ -66,11 +66,34 @@ fn help_texts() {
         ("help_run", vec!["run", "--help"]),
         ("help_record", vec!["record", "--help"]),
         ("help_bench", vec!["bench", "--help"]),
+        ("help_bench_precision", vec!["bench", "precision", "--help"]),
     ] {
         let out = yarnsim(&args);
         assert!(out.status.success(), "{args:?}");
         insta::assert_snapshot!(name, stdout(&out));
     }
+}
+
+#[test]
+fn bench_studies_have_one_name_and_the_old_ones_still_work() {
+    let top = stdout(&yarnsim(&["--help"]));
+    let bench = stdout(&yarnsim(&["bench", "--help"]));
+    for study in ["precision", "skip", "roofline"] {
+        assert!(!top.contains(&format!("bench-{study}")), "{top}");
+        assert!(
+            bench.lines().any(|l| l.trim_start().starts_with(study)),
+            "bench --help does not list {study}:\n{bench}"
+        );
+        let now = yarnsim(&["bench", study, "--help"]);
+        assert!(now.status.success(), "{}", stderr(&now));
+        let old = yarnsim(&[&format!("bench-{study}"), "--help"]);
+        assert_eq!(stdout(&old), stdout(&now), "bench-{study}");
+    }
+    let alias = yarnsim(&["precision", "--help"]);
+    assert_eq!(
+        stdout(&alias),
+        stdout(&yarnsim(&["bench", "precision", "--help"]))
+    );
 }
 
 #[test]
@@ -89,12 +112,28 @@ fn scenes_lists_every_builtin() {
 
 #[test]
 fn scene_show_round_trips() {
-    for name in ["yarn-reference", "wire", "cloth"] {
+    // Every built-in: the printed file reads back to the same scene, and
+    // showing that file prints the same text again.
+    for (name, _) in yarnsim::scene::builtin_names() {
         let out = yarnsim(&["scene", "show", name]);
-        assert!(out.status.success());
-        let shown = yarnsim::Scene::from_toml_str(&stdout(&out)).expect("valid TOML scene");
+        assert!(out.status.success(), "{}", stderr(&out));
+        let text = stdout(&out);
+        let shown = yarnsim::Scene::from_toml_str(&text).expect("valid TOML scene");
         assert_eq!(shown, yarnsim::Scene::resolve(name).unwrap(), "{name}");
+        let file = tmp(&format!("show-{name}.toml"));
+        std::fs::write(&file, &text).unwrap();
+        let again = yarnsim(&["scene", "show", file.to_str().unwrap()]);
+        assert_eq!(stdout(&again), text, "{name}: a re-show differs");
     }
+    // What a user reads: arrays inline, units and ranges in comments.
+    insta::assert_snapshot!(
+        "scene_show_yarn_drape",
+        stdout(&yarnsim(&["scene", "show", "yarn-drape"]))
+    );
+    insta::assert_snapshot!(
+        "scene_show_wire",
+        stdout(&yarnsim(&["scene", "show", "wire"]))
+    );
 }
 
 #[test]
@@ -395,11 +434,14 @@ fn row(table: &str, name: &str) -> (f64, f64) {
         .lines()
         .find(|l| l.starts_with(name))
         .unwrap_or_else(|| panic!("no row {name} in {table}"));
+    // The last two columns; the unit (`[J]`) may follow the name.
     let v: Vec<f64> = line[name.len()..]
         .split_whitespace()
+        .rev()
+        .take(2)
         .map(|x| x.parse().unwrap())
         .collect();
-    (v[0], v[1])
+    (v[1], v[0])
 }
 
 #[test]
@@ -437,7 +479,7 @@ fn set_overrides_scene_fields() {
     // Into an array of tables: one yarn instead of two.
     let one = run(&["--set", "yarns.0.count=1"]);
     assert!(
-        one.contains("particles          59 (30 vertices + 29 quadrature, 1 yarns)"),
+        one.contains("particles          59 (30 vertices + 29 quadrature, 1 yarn)"),
         "{one}"
     );
     // Built-in scenes, yarn and mass-spring, and `scene show`.

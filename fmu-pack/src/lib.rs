@@ -156,6 +156,23 @@ pub enum FmiVersion {
 }
 
 impl FmiVersion {
+    /// The standard's name and version, `FMI 2.0` or `FMI 3.0`.
+    pub fn label(self) -> &'static str {
+        match self {
+            FmiVersion::Fmi2 => "FMI 2.0",
+            FmiVersion::Fmi3 => "FMI 3.0",
+        }
+    }
+
+    /// The modelDescription attribute the scene's hash goes into: `guid`
+    /// (FMI 2.0) or `instantiationToken` (FMI 3.0).
+    pub fn token_name(self) -> &'static str {
+        match self {
+            FmiVersion::Fmi2 => "GUID",
+            FmiVersion::Fmi3 => "instantiationToken",
+        }
+    }
+
     /// `binaries/<platform>/<modelIdentifier>.so`.
     pub fn binary_path(self, identifier: &str) -> String {
         let platform = match self {

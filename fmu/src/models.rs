@@ -70,12 +70,15 @@ impl SceneFmu for Scene {
     }
 
     fn summary(&self) -> String {
-        match self {
-            Scene::Yarn(s) => format!("{} {}", num_yarns(s), self.objects()),
-            Scene::MassSpring(l) => match crate::massspring::num_particles(l) {
-                Ok(n) => format!("{n} {}", self.objects()),
-                Err(e) => e,
-            },
+        let n = match self {
+            Scene::Yarn(s) => Ok(num_yarns(s)),
+            Scene::MassSpring(l) => crate::massspring::num_particles(l),
+        };
+        match n {
+            // `1 yarn`, `12 yarns`.
+            Ok(1) => format!("1 {}", self.objects().trim_end_matches('s')),
+            Ok(n) => format!("{n} {}", self.objects()),
+            Err(e) => e,
         }
     }
 }

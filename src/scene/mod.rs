@@ -7,7 +7,9 @@
 //! Built-in scenes are listed by [`builtin_names`].
 
 pub mod builtin;
+pub mod commented;
 pub mod error;
+pub mod fields;
 pub mod massspring;
 pub mod overrides;
 pub(crate) mod readers;
@@ -15,6 +17,7 @@ pub mod yarn;
 
 pub use builtin::{builtin, builtin_names, DEFAULT_SCENE};
 pub use error::SceneError;
+pub use fields::{FieldDoc, MASS_SPRING_FIELDS, YARN_FIELDS};
 pub use massspring::MassSpringScene;
 pub use yarn::{
     AttractorSpec, GridSpec, Integrator, Material, Obstacle, PinMotionKind, PinSpec, StepSize,

@@ -25,7 +25,7 @@ pub fn record_massspring(
 ) -> Result<RecordOutcome, CliError> {
     let schedule = Schedule::new(duration, run.h, run.sim.system().frame_time)?;
     let name = run.name.clone();
-    let rec = open(&name, massspring_blueprint(), &opts.sink)?;
+    let rec = open(&name, &massspring_blueprint(duration), &opts.sink)?;
     log_massspring_static(&rec, run).map_err(|e| opts.sink.error(e))?;
     let t0 = run.time();
     record_frames(rec, run, &schedule, &name, opts, |rec, run, frame| {

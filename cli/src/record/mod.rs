@@ -24,17 +24,20 @@
 //! same scene hold the same data everywhere except under `timing/`.
 //!
 //! Modules: [`sink`] (where the stream goes, `--serve`), [`frames`] (the
-//! frame loop), [`blueprint`] (the viewer layout), [`style`] (colours,
+//! frame loop), [`blueprint`] (the viewer layout, written by [`layout`]), [`style`] (colours,
 //! radii, legend), [`yarn`] and [`massspring`] (what is logged per frame).
 
 pub mod blueprint;
 pub mod frames;
+pub mod layout;
 pub mod massspring;
 pub mod sink;
 pub mod style;
 pub mod yarn;
 
-pub use blueprint::{massspring_blueprint, yarn_blueprint};
+pub use blueprint::{
+    massspring_blueprint, plot_title, time_axis_end, yarn_blueprint, LEGEND_VISIBLE,
+};
 pub use frames::{RecordOptions, RecordOutcome};
 pub use massspring::record_massspring;
 pub use sink::{
@@ -42,8 +45,8 @@ pub use sink::{
     DEFAULT_SERVER_MEMORY_LIMIT, DEFAULT_SERVE_PORT,
 };
 pub use style::{
-    legend, series_color, stretch_color, view2, yarn_color, QUADRATURE_RADIUS, SERIES_COLORS,
-    STRIP_RADIUS, VERTEX_RADIUS,
+    legend, series_color, series_color_name, stretch_color, view2, yarn_color, QUADRATURE_RADIUS,
+    SERIES_COLORS, STRIP_RADIUS, VERTEX_RADIUS,
 };
 pub use yarn::{record_yarn, vertex_stretches};
 /// Plastic state of a quadrature particle, see [`values::PLASTIC`]; the
@@ -67,6 +70,12 @@ pub mod paths {
     pub const WALLS: &str = "world/walls";
     pub const OBSTACLES: &str = "world/obstacles";
     pub const ATTRACTOR: &str = "world/attractor";
+    /// The scale of the 2D view (static): tick marks outside the domain.
+    pub const SCALE_TICKS: &str = "world/scale/ticks";
+    /// The ticks' values in m and the axis names, as labelled points.
+    pub const SCALE_LABELS: &str = "world/scale/labels";
+    /// Faint grid lines across the domain at the labelled ticks.
+    pub const SCALE_GRID: &str = "world/scale/grid";
     pub const KINETIC: &str = "plots/energy/kinetic";
     pub const ELASTIC: &str = "plots/energy/elastic";
     pub const POTENTIAL: &str = "plots/energy/potential";

@@ -7,9 +7,9 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::Ordering;
 use std::time::Duration;
 
-use rerun::blueprint::Blueprint;
 use rerun::{RecordingStream, RecordingStreamBuilder};
 
+use super::layout::Layout;
 use super::APP_ID;
 use crate::driver::interrupt_flag;
 use crate::error::CliError;
@@ -218,14 +218,8 @@ impl Server {
 
 /// Opens the recording stream on its sink, without the wall-clock
 /// `log_time` timeline.
-pub(super) fn open(
-    name: &str,
-    blueprint: Blueprint,
-    sink: &Sink,
-) -> Result<RecordingStream, CliError> {
-    let builder = RecordingStreamBuilder::new(APP_ID)
-        .recording_name(name.to_string())
-        .with_blueprint(blueprint);
+pub(super) fn open(name: &str, layout: &Layout, sink: &Sink) -> Result<RecordingStream, CliError> {
+    let builder = RecordingStreamBuilder::new(APP_ID).recording_name(name.to_string());
     let rec = match sink {
         Sink::File(path) => {
             // Rerun's own error repeats the path and nests the OS error.
@@ -268,6 +262,7 @@ pub(super) fn open(
         }
     }
     .map_err(|e| sink.error(e))?;
+    layout.send(&rec, APP_ID).map_err(|e| sink.error(e))?;
     rec.set_log_time_enabled(false);
     if let Sink::Serve(s) = sink {
         // Before the first frame, so a viewer can follow the run live.

@@ -14,8 +14,8 @@ use super::blueprint::yarn_blueprint;
 use super::frames::{log_scalars, record_frames, RecordOptions, RecordOutcome};
 use super::sink::open;
 use super::style::{
-    legend, p2, series_color, stretch_color, view2, yarn_color, QUADRATURE_RADIUS, STRIP_RADIUS,
-    VERTEX_RADIUS,
+    legend, p2, scale, series_color, stretch_color, view2, yarn_color, QUADRATURE_RADIUS,
+    STRIP_RADIUS, VERTEX_RADIUS,
 };
 use super::{paths, values, TIMELINE_FRAME, TIMELINE_SIM_TIME};
 use crate::driver::FrameInfo;
@@ -30,7 +30,8 @@ pub fn record_yarn(
     let schedule = crate::run::yarn_schedule(sim, duration)?;
     sim.reset_dt_stats();
     let name = sim.scene().name.clone();
-    let rec = open(&name, yarn_blueprint(), &opts.sink)?;
+    let layout = yarn_blueprint(sim.scene().grid.size, duration);
+    let rec = open(&name, &layout, &opts.sink)?;
     log_yarn_static(&rec, sim).map_err(|e| opts.sink.error(e))?;
     let t0 = sim.time();
     let mut out = record_frames(rec, sim, &schedule, &name, opts, |rec, sim, frame| {
@@ -118,6 +119,7 @@ fn log_yarn_static(rec: &RecordingStream, sim: &YarnSim) -> rerun::RecordingStre
                 .with_colors([series_color(&paths::SERIES, path)]),
         )?;
     }
+    log_scale(rec, sc.grid.size)?;
     let walls = match sc.walls.mode {
         WallMode::Sticky => format!("brown: sticky walls, {} cells", sc.walls.cells),
         WallMode::Slip => format!("brown: slip walls, {} cells", sc.walls.cells),
@@ -130,6 +132,35 @@ fn log_yarn_static(rec: &RecordingStream, sim: &YarnSim) -> rerun::RecordingStre
     rec.log_static(
         paths::LEGEND,
         &TextDocument::from_markdown(legend(true) + &geometry),
+    )?;
+    Ok(())
+}
+
+/// The scale of the scene view: ticks and labels in m outside the domain,
+/// faint grid lines inside it, drawn behind everything else.
+fn log_scale(rec: &RecordingStream, size: f64) -> rerun::RecordingStreamResult<()> {
+    let s = scale(size);
+    let thin = 0.0015 * size as f32;
+    rec.log_static(
+        paths::SCALE_TICKS,
+        &LineStrips2D::new(s.ticks)
+            .with_radii([thin])
+            .with_colors([Color::from_rgb(170, 170, 170)]),
+    )?;
+    rec.log_static(
+        paths::SCALE_LABELS,
+        &Points2D::new(s.labels.iter().map(|(p, _)| *p))
+            .with_radii([0.0])
+            .with_colors([Color::from_rgb(200, 200, 200)])
+            .with_labels(s.labels.iter().map(|(_, t)| t.clone()))
+            .with_show_labels(true),
+    )?;
+    rec.log_static(
+        paths::SCALE_GRID,
+        &LineStrips2D::new(s.grid)
+            .with_radii([0.5 * thin])
+            .with_colors([Color::from_rgb(55, 55, 55)])
+            .with_draw_order(0.0),
     )?;
     Ok(())
 }

@@ -2,6 +2,8 @@
 //! output, the test scene and a scratch folder.
 #![allow(dead_code)]
 
+pub mod rrd;
+
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 

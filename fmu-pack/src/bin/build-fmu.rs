@@ -71,7 +71,12 @@ fn run() -> Result<(), String> {
     let xml = version.model_description(&scene)?;
     if let Some(path) = xml_only {
         std::fs::write(&path, xml).map_err(|e| format!("cannot write {}: {e}", path.display()))?;
-        println!("wrote {}", path.display());
+        println!(
+            "wrote {} ({} modelDescription.xml of {})",
+            path.display(),
+            version.label(),
+            scene.identifier()
+        );
         return Ok(());
     }
     // The cdylib sits next to this executable (target/<profile>/).
@@ -129,12 +134,14 @@ fn run() -> Result<(), String> {
     }
     std::fs::write(&out, &zip).map_err(|e| format!("cannot write {}: {e}", out.display()))?;
     println!(
-        "wrote {} ({} bytes): {} FMU, scene {:?}, {}, GUID {}, library needs {}",
+        "wrote {} ({} bytes): {} Co-Simulation FMU {}, scene {:?}, {}, {} {}, library needs {}",
         out.display(),
         zip.len(),
+        version.label(),
         scene.identifier(),
         scene.name(),
         scene.summary(),
+        version.token_name(),
         scene.guid(),
         info.needed.join(" ")
     );
