@@ -264,7 +264,7 @@ fn arrays_are_inline_and_every_field_states_its_unit_and_range() {
         "# m/s^2",
         "resolution = 256",
         "# cells, 8 to 8192 per side",
-        "# Pa, >= 0",
+        "# N/m, >= 0",
         "# \"sticky\", \"slip\" or \"none\"",
     ] {
         assert!(text.contains(want), "{want:?} missing:\n{text}");
