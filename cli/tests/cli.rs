@@ -179,7 +179,7 @@ fn errors_have_clear_messages_and_exit_codes() {
     assert_fails(
         &["run", small, "--integrator", "pbd"],
         2,
-        "mass-spring scenes only",
+        "--integrator applies to mass-spring scenes",
     );
     // Unwritable output: 4.
     let nowhere = "/nonexistent-dir/out";

@@ -98,6 +98,8 @@ impl YarnScene {
         let point = |p: Vec2| format!("[{}, {}]", short(p.x), short(p.y));
         let whose = if y.count == 1 {
             format!("yarn {yarn}")
+        } else if copy == 0 {
+            format!("yarn {yarn} (copy 0 of this entry's {})", y.count)
         } else {
             format!(
                 "yarn {yarn} (copy {copy} of this entry's {}, shifted by {copy} x spacing {})",
