@@ -158,7 +158,7 @@ fn is_index(seg: &str) -> bool {
 fn key_path(key: &str) -> Result<Vec<String>, String> {
     let bad = |what: &str| {
         format!(
-            "{what}; a key is names of letters, digits, `_` and `-` joined by `.`, with `[N]` \
+            "{what}; a key joins names (letters, digits, `_` and `-`) with `.`, with `[N]` \
              (or `.N`) for entry N of a list, e.g. yarns[0].count"
         )
     };
