@@ -13,7 +13,8 @@ use indicatif::ProgressBar;
 use crate::driver::{progress_bar, Stepper};
 use crate::error::CliError;
 use crate::massspring::{IntegratorArgs, MassSpringRun};
-use crate::run::no_integrator_for_yarn;
+use crate::run::start_yarn;
+use crate::yarn::explain;
 
 /// What to measure.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -73,8 +74,7 @@ pub fn bench(
     let progress = progress_bar(opts.warmup + opts.steps, &format!("bench {}", scene.name()));
     let result = match scene {
         Scene::Yarn(y) => {
-            no_integrator_for_yarn(integrator)?;
-            let mut sim = YarnSim::new(y)?;
+            let mut sim = start_yarn(y, integrator)?;
             pool.install(|| bench_yarn(&mut sim, opts, threads, &progress))
         }
         Scene::MassSpring(l) => {
@@ -133,10 +133,11 @@ fn bench_yarn(
     threads: usize,
     progress: &ProgressBar,
 ) -> Result<BenchResult, CliError> {
-    steps_with_progress(opts.warmup, progress, |k| Ok(sim.steps_n(k)?))?;
+    let steps = |sim: &mut YarnSim, k: u64| sim.steps_n(k).map_err(|e| explain(sim, e));
+    steps_with_progress(opts.warmup, progress, |k| steps(sim, k))?;
     sim.reset_timings();
     let t0 = Instant::now();
-    steps_with_progress(opts.steps, progress, |k| Ok(sim.steps_n(k)?))?;
+    steps_with_progress(opts.steps, progress, |k| steps(sim, k))?;
     let seconds = t0.elapsed().as_secs_f64();
     Ok(BenchResult {
         scene: sim.scene().name.clone(),

@@ -6,7 +6,6 @@ use std::sync::{Arc, OnceLock};
 use std::time::{Duration, Instant};
 
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
-use yarnsim::YarnSim;
 
 use crate::error::CliError;
 use crate::schedule::Schedule;
@@ -35,24 +34,6 @@ pub trait Stepper {
     /// finite (for simulations whose `step` does not check it itself).
     fn check_finite(&self) -> Result<(), CliError> {
         Ok(())
-    }
-}
-
-impl Stepper for YarnSim {
-    fn step(&mut self) -> Result<(), CliError> {
-        YarnSim::step(self).map_err(CliError::from)
-    }
-    fn steps(&self) -> u64 {
-        YarnSim::steps(self)
-    }
-    fn num_particles(&self) -> usize {
-        self.particles().len()
-    }
-    fn time(&self) -> f64 {
-        YarnSim::time(self)
-    }
-    fn step_toward(&mut self, until: f64) -> Result<bool, CliError> {
-        YarnSim::step_toward(self, until).map_err(CliError::from)
     }
 }
 

@@ -21,6 +21,8 @@ pub enum CliError {
     Viewer(String),
     /// The simulation diverged or refused its input (exit code 1).
     Sim(SimError),
+    /// A yarn simulation diverged, with a hint at the stable step (exit code 1).
+    Diverged { error: SimError, hint: String },
     /// Another simulation failure, e.g. a mass-spring solver (exit code 1).
     Failed(String),
 }
@@ -29,7 +31,7 @@ impl CliError {
     /// The process exit code for this error.
     pub fn exit_code(&self) -> u8 {
         match self {
-            CliError::Sim(_) | CliError::Failed(_) => 1,
+            CliError::Sim(_) | CliError::Diverged { .. } | CliError::Failed(_) => 1,
             CliError::Usage(_) => 2,
             CliError::Scene(_) => 3,
             CliError::Output { .. } | CliError::Viewer(_) => 4,
@@ -55,6 +57,7 @@ impl fmt::Display for CliError {
             }
             CliError::Viewer(m) => write!(f, "{m}"),
             CliError::Sim(e) => write!(f, "{e}"),
+            CliError::Diverged { error, hint } => write!(f, "{error}; {hint}"),
             CliError::Failed(m) => write!(f, "{m}"),
         }
     }

@@ -8,6 +8,8 @@
 //! * [`bench`]: `yarnsim bench`.
 //! * [`driver`], [`schedule`]: the frame loop, progress bar and Ctrl-C.
 //! * [`estimate`]: memory and recording-size estimates of large scenes.
+//! * [`yarn`]: how the commands start a yarn scene (the stable-step check)
+//!   and report its divergence.
 
 pub mod bench;
 pub mod driver;
@@ -21,5 +23,6 @@ pub mod run;
 pub mod scenes;
 pub mod schedule;
 pub mod table;
+pub mod yarn;
 
 pub use error::CliError;

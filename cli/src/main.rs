@@ -146,7 +146,8 @@ struct SceneArgs {
     #[arg(default_value = DEFAULT_SCENE)]
     scene: String,
     /// Override a scene field, KEY=VALUE with VALUE in TOML (repeatable):
-    /// --set material.friction=0.1 --set gravity=[0,-3] --set yarns.0.count=4.
+    /// --set material.friction=0.1 --set gravity=[0,-3] --set yarns[0].count=4
+    /// (an entry of a list as in error messages, `[0]`, or as `.0`).
     #[arg(long = "set", value_name = "KEY=VALUE")]
     set: Vec<String>,
 }
@@ -161,15 +162,17 @@ impl SceneArgs {
 #[derive(clap::Args, Debug, Clone, Default)]
 struct IntegratorFlags {
     /// Mass-spring scenes only: forward-euler, symplectic-euler, trapezoidal,
-    /// backward-euler (default), chebyshev-jacobi or pbd.
+    /// backward-euler (default), chebyshev-jacobi or pbd. A yarn scene's is
+    /// the scene field time.integrator: --set time.integrator=implicit.
     #[arg(long, value_name = "NAME")]
     integrator: Option<String>,
     /// Mass-spring scenes only: an integrator option KEY=VALUE (repeatable), e.g.
     /// dt=0.001, cfl=0.5, preconditioner=jacobi, rho=0.99, strain-limit=0.1.
     #[arg(long = "option", value_name = "KEY=VALUE")]
     options: Vec<String>,
-    /// Mass-spring scenes only: run forward or symplectic Euler with a dt
-    /// above its stability bound instead of refusing.
+    /// Run a step above the stability bound instead of refusing: forward or
+    /// symplectic Euler on a mass-spring scene, a yarn scene's fixed time.dt
+    /// more than 2x its bound (above the bound it warns).
     #[arg(long)]
     allow_unstable: bool,
 }

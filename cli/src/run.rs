@@ -6,7 +6,7 @@ use std::io::{BufWriter, Write};
 use std::path::Path;
 
 use yarnsim::mpm::Diagnostics;
-use yarnsim::scene::Scene;
+use yarnsim::scene::{Scene, YarnScene};
 use yarnsim::YarnSim;
 
 use crate::driver::run_frames_shown;
@@ -14,9 +14,11 @@ use crate::error::CliError;
 use crate::massspring::{IntegratorArgs, MassSpringRun, MsDiagnostics};
 use crate::schedule::Schedule;
 use crate::table::{count, yarn_rows, DiagRow, Summary};
+use crate::yarn::YarnFlags;
 
 /// Runs `scene` for `duration` seconds; writes the CSV to `csv` if given.
-/// `integrator` applies to mass-spring scenes only.
+/// `integrator`: the mass-spring integrator, and `allow_unstable` for both
+/// kinds of scene (see [`start_yarn`]).
 pub fn run(
     scene: &Scene,
     duration: f64,
@@ -24,10 +26,7 @@ pub fn run(
     integrator: &IntegratorArgs,
 ) -> Result<Summary, CliError> {
     match scene {
-        Scene::Yarn(y) => {
-            no_integrator_for_yarn(integrator)?;
-            run_yarn(&mut YarnSim::new(y)?, duration, csv)
-        }
+        Scene::Yarn(y) => run_yarn(&mut start_yarn(y, integrator)?, duration, csv),
         Scene::MassSpring(l) => {
             run_massspring(&mut MassSpringRun::new(l, integrator)?, duration, csv)
         }
@@ -100,15 +99,19 @@ pub fn ms_rows(a: &MsDiagnostics, b: &MsDiagnostics) -> Vec<DiagRow> {
     ]
 }
 
-/// Refuses integrator settings for a yarn scene (the MPM solver has one scheme).
-pub fn no_integrator_for_yarn(args: &IntegratorArgs) -> Result<(), CliError> {
-    if args.is_empty() {
-        Ok(())
-    } else {
-        Err(CliError::Usage(
-            "--integrator and --option apply to mass-spring scenes only; yarn scenes use the MPM solver".into(),
-        ))
-    }
+/// The simulation of a yarn scene for `run`, `record` and `bench`, with
+/// the command's integrator flags: `--integrator` and `--option` refused
+/// with a pointer to the scene field, a fixed `time.dt` checked against the
+/// stable bound ([`crate::yarn::start`]).
+pub fn start_yarn(scene: &YarnScene, args: &IntegratorArgs) -> Result<YarnSim, CliError> {
+    crate::yarn::start(
+        scene,
+        YarnFlags {
+            integrator: args.integrator.as_deref(),
+            options: &args.options,
+            allow_unstable: args.allow_unstable,
+        },
+    )
 }
 
 /// The frame schedule of a yarn run: fixed substeps, or adaptive ones

@@ -90,13 +90,20 @@ impl fmt::Display for SceneError {
 
 impl std::error::Error for SceneError {}
 
-/// 1-based line of byte offset `pos` in `text`.
 /// Line of the `i`-th `header` table (e.g. `[[yarns]]`) in `text`, when
-/// there is a text and it has that many.
+/// there is a text and it has that many: a line that starts with the
+/// header (a comment may follow it).
 pub(crate) fn table_line(text: Option<&str>, header: &str, i: usize) -> Option<usize> {
-    text.and_then(|t| t.match_indices(header).nth(i).map(|(p, _)| line_of(t, p)))
+    text.and_then(|t| {
+        t.lines()
+            .enumerate()
+            .filter(|(_, l)| l.trim_start().starts_with(header))
+            .nth(i)
+            .map(|(n, _)| n + 1)
+    })
 }
 
+/// 1-based line of byte offset `pos` in `text`.
 pub fn line_of(text: &str, pos: usize) -> usize {
     text.as_bytes()[..pos.min(text.len())]
         .iter()
@@ -105,8 +112,32 @@ pub fn line_of(text: &str, pos: usize) -> usize {
         + 1
 }
 
-/// The dotted path of the key at byte offset `pos`, best effort: the last
-/// `[table]` header above it plus the key on its line.
+/// The path of a table header line (`[grid]`, `[[yarns]]`, with a comment
+/// after it or not) as the user writes a field path: `grid`, and for an
+/// entry of an array of tables its index among the headers of that name
+/// up to this one, `yarns[2]`. `above` is the text before the header line.
+fn header_path(above: &str, line: &str) -> Option<String> {
+    let line = line.trim();
+    if let Some(rest) = line.strip_prefix("[[") {
+        let name = rest.split("]]").next()?.trim();
+        let before = above
+            .lines()
+            .filter(|l| {
+                l.trim()
+                    .strip_prefix("[[")
+                    .and_then(|r| r.split("]]").next())
+                    .is_some_and(|n| n.trim() == name)
+            })
+            .count();
+        return Some(format!("{name}[{before}]"));
+    }
+    let rest = line.strip_prefix('[')?;
+    Some(rest.split(']').next()?.trim().to_string())
+}
+
+/// The path of the key at byte offset `pos`, best effort: the last
+/// `[table]` header above it (with the entry's index under a `[[table]]`
+/// header, `yarns[1]`) plus the key on its line.
 pub fn key_at(text: &str, pos: usize) -> Option<String> {
     let pos = pos.min(text.len());
     let line_start = text[..pos].rfind('\n').map_or(0, |i| i + 1);
@@ -114,11 +145,7 @@ pub fn key_at(text: &str, pos: usize) -> Option<String> {
     let line = text[line_start..line_end].trim();
     if line.starts_with('[') {
         // A table header names its own table, not the one above it.
-        return Some(
-            line.trim_matches(|c| c == '[' || c == ']')
-                .trim()
-                .to_string(),
-        );
+        return header_path(&text[..line_start], line);
     }
     let key = line
         .split('=')
@@ -127,10 +154,17 @@ pub fn key_at(text: &str, pos: usize) -> Option<String> {
         .filter(|k| !k.is_empty() && !k.starts_with('['));
     let table = text[..line_start]
         .lines()
-        .rev()
-        .map(str::trim)
-        .find(|l| l.starts_with('['));
-    let table = table.map(|t| t.trim_matches(|c| c == '[' || c == ']').trim().to_string());
+        .enumerate()
+        .filter(|(_, l)| l.trim().starts_with('['))
+        .last()
+        .and_then(|(n, l)| {
+            let above: usize = text[..line_start]
+                .split_inclusive('\n')
+                .take(n)
+                .map(str::len)
+                .sum();
+            header_path(&text[..above], l)
+        });
     match (table, key) {
         (Some(t), Some(k)) => Some(format!("{t}.{k}")),
         (None, Some(k)) => Some(k.to_string()),
@@ -147,7 +181,7 @@ pub fn key_at(text: &str, pos: usize) -> Option<String> {
 /// another field's; the line is the table's header, none at top level.
 pub fn from_toml_error(text: &str, err: toml::de::Error) -> SceneError {
     let span = err.span();
-    let message = err.message().trim().to_string();
+    let message = plain_message(err.message().trim());
     if let Some(name) = missing_field(&message) {
         let table = span
             .as_ref()
@@ -168,6 +202,128 @@ pub fn from_toml_error(text: &str, err: toml::de::Error) -> SceneError {
         field: span.as_ref().and_then(|s| key_at(text, s.start)),
         message,
     }
+}
+
+/// serde's messages in the words of a scene file: a type error names
+/// the TOML type the field takes ("a number", "an integer", "a string",
+/// "a boolean", "a table", "an array") instead of the Rust type
+/// (`expected f64`), and an unknown field or value gets the known one it
+/// is probably a misspelling of. Other messages are kept.
+pub fn plain_message(message: &str) -> String {
+    for prefix in ["invalid type: ", "invalid value: "] {
+        if let Some((got, expected)) = message
+            .strip_prefix(prefix)
+            .and_then(|m| m.rsplit_once(", expected "))
+        {
+            return format!(
+                "must be {}, got {}",
+                expected_words(expected),
+                got_words(got)
+            );
+        }
+    }
+    if let Some((got, expected)) = message
+        .strip_prefix("invalid length ")
+        .and_then(|m| m.split_once(", expected "))
+    {
+        let n = expected
+            .strip_prefix("an array of length ")
+            .or_else(|| expected.strip_prefix("a tuple of size "));
+        return match n {
+            Some(n) => format!("must be an array of {n} values, got {got}"),
+            None => format!("must be {}, got {got} values", expected_words(expected)),
+        };
+    }
+    let unknown = message
+        .strip_prefix("unknown field `")
+        .or_else(|| message.strip_prefix("unknown variant `"));
+    if let Some(rest) = unknown {
+        if let Some((name, known)) = rest.split_once("`, expected ") {
+            let close = known
+                .split('`')
+                .skip(1)
+                .step_by(2)
+                .filter(|k| similar(name, k))
+                .min_by_key(|k| edit_distance(name, k));
+            if let Some(k) = close {
+                return format!("{message}; did you mean `{k}`?");
+            }
+        }
+    }
+    message.to_string()
+}
+
+/// serde's expected type in TOML words.
+fn expected_words(expected: &str) -> String {
+    let e = expected.trim();
+    let words = match e {
+        "f32" | "f64" => "a number",
+        "u8" | "u16" | "u32" | "u64" | "u128" | "usize" => "an integer >= 0",
+        "i8" | "i16" | "i32" | "i64" | "i128" | "isize" => "an integer",
+        "a string" | "a borrowed string" | "string" | "a char" => "a string",
+        "a boolean" | "bool" => "a boolean",
+        "a map" | "map" => "a table",
+        "a sequence" | "sequence" => "an array",
+        _ if e.starts_with("struct ") => "a table",
+        _ if e.starts_with("an array of length ") => {
+            return format!("an array of {} values", &e["an array of length ".len()..]);
+        }
+        _ => return e.to_string(),
+    };
+    words.to_string()
+}
+
+/// serde's description of the value found (`string "abc"`, ``integer `5` ``,
+/// ``floating point `2.5` ``, `sequence`, `map`) in TOML words.
+fn got_words(got: &str) -> String {
+    let g = got.trim();
+    let ticked = |prefix: &str| {
+        g.strip_prefix(prefix)
+            .map(|v| v.trim().trim_matches('`').to_string())
+    };
+    if let Some(v) = g.strip_prefix("string ") {
+        return format!("the string {v}");
+    }
+    if let Some(v) = ticked("integer") {
+        return format!("the integer {v}");
+    }
+    if let Some(v) = ticked("floating point") {
+        return format!("the number {v}");
+    }
+    if let Some(v) = ticked("boolean") {
+        return format!("the boolean {v}");
+    }
+    match g {
+        "sequence" => "an array".into(),
+        "map" => "a table".into(),
+        _ => g.to_string(),
+    }
+}
+
+/// Whether an unknown field name is probably a misspelling of `known`:
+/// within two edits and half its length (`centre` for `center`, `strat`
+/// for `start`).
+fn similar(name: &str, known: &str) -> bool {
+    let d = edit_distance(name, known);
+    d > 0 && d <= 2 && 2 * d <= known.len()
+}
+
+/// Levenshtein distance of two short ASCII names.
+fn edit_distance(a: &str, b: &str) -> usize {
+    let (a, b) = (a.as_bytes(), b.as_bytes());
+    let mut row: Vec<usize> = (0..=b.len()).collect();
+    for (i, &ca) in a.iter().enumerate() {
+        let mut prev = row[0];
+        row[0] = i + 1;
+        for (j, &cb) in b.iter().enumerate() {
+            let here = (prev + usize::from(ca != cb))
+                .min(row[j] + 1)
+                .min(row[j + 1] + 1);
+            prev = row[j + 1];
+            row[j + 1] = here;
+        }
+    }
+    row[b.len()]
 }
 
 /// `X` of serde's message "missing field `X`".
@@ -193,8 +349,7 @@ fn table_at(text: &str, pos: usize) -> Option<(usize, String)> {
         start -= l.len();
         let t = l.trim();
         if t.starts_with('[') {
-            let name = t.trim_matches(|c| c == '[' || c == ']').trim().to_string();
-            return Some((line_of(text, start), name));
+            return header_path(&text[..start], t).map(|name| (line_of(text, start), name));
         }
         start = start.saturating_sub(1);
     }
@@ -215,6 +370,58 @@ mod tests {
         let pos = text.find("[materal]").unwrap();
         assert_eq!(key_at(text, pos).as_deref(), Some("materal"));
         assert_eq!(key_at(text, pos + 3).as_deref(), Some("materal"));
+        // An entry of an array of tables carries its index, also after a
+        // header with a comment.
+        let text = "[[yarns]]\nvertices = 3\n[[obstacles]]\nradius = 1\n\
+                    [[yarns]]  # the second\nvertices = 4\n[[yarns]]\nvertices = 5\n";
+        let at = |s: &str| key_at(text, text.find(s).unwrap());
+        assert_eq!(at("3").as_deref(), Some("yarns[0].vertices"));
+        assert_eq!(at("1").as_deref(), Some("obstacles[0].radius"));
+        assert_eq!(at("4").as_deref(), Some("yarns[1].vertices"));
+        assert_eq!(at("5").as_deref(), Some("yarns[2].vertices"));
+        assert_eq!(at("[[yarns]]  #").as_deref(), Some("yarns[1]"));
+        assert_eq!(table_line(Some(text), "[[yarns]]", 2), Some(7));
+    }
+
+    #[test]
+    fn serde_words_become_toml_words() {
+        for (serde, plain) in [
+            (
+                "invalid type: string \"abc\", expected f64",
+                "must be a number, got the string \"abc\"",
+            ),
+            (
+                "invalid type: floating point `2.5`, expected i64",
+                "must be an integer, got the number 2.5",
+            ),
+            (
+                "invalid value: integer `-1`, expected u32",
+                "must be an integer >= 0, got the integer -1",
+            ),
+            (
+                "invalid type: integer `1`, expected a boolean",
+                "must be a boolean, got the integer 1",
+            ),
+            (
+                "invalid type: map, expected a sequence",
+                "must be an array, got a table",
+            ),
+            (
+                "invalid type: sequence, expected struct Material",
+                "must be a table, got an array",
+            ),
+            (
+                "invalid length 3, expected an array of length 2",
+                "must be an array of 2 values, got 3",
+            ),
+            (
+                "unknown field `centre`, expected one of `center`, `radius`",
+                "unknown field `centre`, expected one of `center`, `radius`; did you mean `center`?",
+            ),
+            ("must be >= 0, got -1", "must be >= 0, got -1"),
+        ] {
+            assert_eq!(plain_message(serde), plain, "{serde}");
+        }
     }
 
     #[test]
@@ -258,7 +465,7 @@ mod tests {
         let e = crate::scene::Scene::from_toml_str(text).unwrap_err();
         assert_eq!(
             e.to_string(),
-            "scene error at line 10 in field `yarns.vertices`: missing field `vertices`"
+            "scene error at line 10 in field `yarns[0].vertices`: missing field `vertices`"
         );
         let text = format!(
             "time = {{ frame_dt = 0.1 }}\n{}",

@@ -3,10 +3,11 @@
 //! is validated by the same code, with the same messages, as one in a file.
 //!
 //! * `KEY` is a dotted path of bare TOML keys (`A-Z a-z 0-9 _ -`):
-//!   `gravity`, `material.friction`. A segment that is a number indexes an
-//!   array, of tables (`yarns.0.count`, `obstacles.1.radius`) or of values
-//!   (`gravity.1`); the element must exist. Missing tables on the way are
-//!   created (`attractor.active=true` on a scene without `[attractor]`).
+//!   `gravity`, `material.friction`. An index `[N]` (the form errors
+//!   print) or a segment `.N` picks an entry of an array, of tables
+//!   (`yarns[0].count` = `yarns.0.count`, `obstacles[1].radius`) or of
+//!   values (`gravity[1]`); the entry must exist. Missing tables on the way
+//!   are created (`attractor.active=true` on a scene without `[attractor]`).
 //! * `VALUE` is a TOML value: `0.1`, `true`, `"apic"`, `[0, -3]`,
 //!   `{ mode = "slip" }`. A bare word that is not TOML (`apic`, `auto`) is
 //!   taken as a string, so `--set transfer.scheme=apic` needs no quotes.
@@ -43,14 +44,7 @@ impl Override {
             return Err(err("expected KEY=VALUE, e.g. material.friction=0.1".into()));
         };
         let key = key.trim();
-        let path: Vec<String> = key.split('.').map(|s| s.trim().to_string()).collect();
-        if let Some(bad) = path.iter().find(|s| !is_bare_key(s)) {
-            return Err(err(if bad.is_empty() {
-                format!("empty key segment in `{key}`")
-            } else {
-                format!("`{bad}` is not a bare key (letters, digits, `_` and `-`)")
-            }));
-        }
+        let path = key_path(key).map_err(err)?;
         let value = parse_value(value.trim()).map_err(err)?;
         Ok(Override {
             argument,
@@ -60,9 +54,11 @@ impl Override {
         })
     }
 
-    /// The dotted key.
+    /// The key as errors print it, with indices in brackets (`yarns[0].count`).
     pub fn key(&self) -> String {
-        self.path.join(".")
+        self.path
+            .iter()
+            .fold(String::new(), |walked, seg| join(&walked, seg))
     }
 
     /// Sets the value in `table`, creating missing tables on the way.
@@ -78,10 +74,7 @@ impl Override {
         let mut walked = String::new();
         for seg in inner {
             here = here.child(seg, &walked).map_err(err)?;
-            if !walked.is_empty() {
-                walked.push('.');
-            }
-            walked.push_str(seg);
+            walked = join(&walked, seg);
         }
         here.set(last, self.value.clone(), &walked).map_err(err)
     }
@@ -107,8 +100,8 @@ impl<'a> Slot<'a> {
             toml::Value::Table(t) => Ok(Slot::Table(t)),
             toml::Value::Array(a) => Ok(Slot::Array(a)),
             other => Err(format!(
-                "`{here}` is a {}, not a table or array",
-                other.type_str()
+                "`{here}` is {}, not a table or array",
+                value_words(other)
             )),
         }
     }
@@ -135,18 +128,81 @@ fn element<'a>(
         .parse()
         .map_err(|_| format!("`{walked}` is an array; `{seg}` is not an index"))?;
     a.get_mut(i).ok_or_else(|| {
-        format!(
-            "index {i} is out of range: `{walked}` has {n} entries (0 to {})",
-            n as isize - 1
-        )
+        let has = match n {
+            0 => "no entries".to_string(),
+            1 => format!("1 entry, `{walked}[0]`"),
+            _ => format!("{n} entries, `{walked}[0]` to `{walked}[{}]`", n - 1),
+        };
+        format!("index {i} is out of range: `{walked}` has {has}")
     })
 }
 
+/// `walked` extended by `seg`: `yarns` and `0` give `yarns[0]`, `yarns[0]`
+/// and `count` give `yarns[0].count`.
 fn join(walked: &str, seg: &str) -> String {
     if walked.is_empty() {
         seg.to_string()
+    } else if is_index(seg) {
+        format!("{walked}[{seg}]")
     } else {
         format!("{walked}.{seg}")
+    }
+}
+
+fn is_index(seg: &str) -> bool {
+    !seg.is_empty() && seg.chars().all(|c| c.is_ascii_digit())
+}
+
+/// The segments of a key: `yarns[0].count` and `yarns.0.count` both give
+/// `["yarns", "0", "count"]`.
+fn key_path(key: &str) -> Result<Vec<String>, String> {
+    let bad = |what: &str| {
+        format!(
+            "{what}; a key joins names (letters, digits, `_` and `-`) with `.`, with `[N]` \
+             (or `.N`) for entry N of a list, e.g. yarns[0].count"
+        )
+    };
+    let mut path = Vec::new();
+    for part in key.split('.') {
+        let part = part.trim();
+        let (name, mut rest) = part.split_at(part.find('[').unwrap_or(part.len()));
+        let name = name.trim();
+        if name.is_empty() && rest.is_empty() {
+            return Err(format!("empty key segment in `{key}`"));
+        }
+        if !name.is_empty() {
+            if !is_bare_key(name) {
+                return Err(bad(&format!("`{name}` is not a key")));
+            }
+            path.push(name.to_string());
+        } else if path.is_empty() {
+            return Err(bad(&format!("`{part}` has no name before its index")));
+        }
+        while !rest.is_empty() {
+            let index = rest
+                .strip_prefix('[')
+                .and_then(|r| r.split_once(']'))
+                .filter(|(i, _)| is_index(i.trim()));
+            let Some((i, after)) = index else {
+                return Err(bad(&format!("`{part}` is not a key")));
+            };
+            path.push(i.trim().to_string());
+            rest = after.trim_start();
+        }
+    }
+    Ok(path)
+}
+
+/// The TOML type of a value in the words of the scene errors.
+fn value_words(v: &toml::Value) -> &'static str {
+    match v {
+        toml::Value::String(_) => "a string",
+        toml::Value::Integer(_) => "an integer",
+        toml::Value::Float(_) => "a number",
+        toml::Value::Boolean(_) => "a boolean",
+        toml::Value::Datetime(_) => "a date-time",
+        toml::Value::Array(_) => "an array",
+        toml::Value::Table(_) => "a table",
     }
 }
 
@@ -266,19 +322,20 @@ fn error_message(e: &SceneError) -> String {
     }
 }
 
-/// Name segments of a field path (`yarns[0].count`, `yarns.count`), without
-/// array indices: an error on the re-written TOML names `[[yarns]]` fields
-/// without their index.
-fn names(path: &str) -> Vec<&str> {
+/// Segments of a field path, indices included: `yarns[0].count` and
+/// `yarns.0.count` give `yarns`, `0`, `count`.
+fn segments(path: &str) -> Vec<&str> {
     path.split(['.', '[', ']'])
-        .filter(|s| !s.is_empty() && !s.chars().all(|c| c.is_ascii_digit()))
+        .map(str::trim)
+        .filter(|s| !s.is_empty())
         .collect()
 }
 
 /// Whether an override of `key` is about the error's `field`: one path is a
-/// prefix of the other (`material` set as a whole and `material.k` missing).
+/// prefix of the other (`material` set as a whole and `material.k` missing;
+/// `yarns[0].count` set and `yarns[0]` refused, but not `yarns[1]`).
 fn same_field(key: &str, field: &str) -> bool {
-    let (k, f) = (names(key), names(field));
+    let (k, f) = (segments(key), segments(field));
     let n = k.len().min(f.len());
     n > 0 && k[..n] == f[..n]
 }
@@ -424,7 +481,7 @@ mod tests {
         assert_eq!(
             message(&r, &["gravity=[0,-3]", "material.friction=abc"]),
             "scene error in --set argument 2 (`material.friction=abc`): \
-             invalid type: string \"abc\", expected f64"
+             must be a number, got the string \"abc\""
         );
         assert_eq!(
             message(&r, &["material.friction=-1"]),
@@ -459,7 +516,7 @@ mod tests {
         assert_eq!(
             message(&r, &["yarns.3.count=2"]),
             "scene error in --set argument 1 (`yarns.3.count=2`): \
-             index 3 is out of range: `yarns` has 1 entries (0 to 0)"
+             index 3 is out of range: `yarns` has 1 entry, `yarns[0]`"
         );
         assert_eq!(
             message(&r, &["gravity.x=2"]),
@@ -469,8 +526,74 @@ mod tests {
         assert_eq!(
             message(&r, &["material.friction.x=2"]),
             "scene error in --set argument 1 (`material.friction.x=2`): \
-             `material.friction` is a float, not a table or array"
+             `material.friction` is a number, not a table or array"
         );
+    }
+
+    #[test]
+    fn an_index_is_written_in_brackets_or_as_a_segment() {
+        let r = reference();
+        for args in [
+            [
+                "yarns[0].count=3",
+                "gravity[1]=-3",
+                "obstacles[2].radius=0.05",
+            ],
+            ["yarns.0.count=3", "gravity.1=-3", "obstacles.2.radius=0.05"],
+            [
+                "yarns [0] . count=3",
+                "gravity[1] = -3",
+                "obstacles.2 .radius=0.05",
+            ],
+        ] {
+            let s = yarn(set(&r, &args).unwrap());
+            assert_eq!(s.yarns[0].count, 3, "{args:?}");
+            assert_eq!(s.gravity[1], -3.0, "{args:?}");
+            assert_eq!(s.obstacles[2].radius, 0.05, "{args:?}");
+        }
+        for text in ["yarns.0.count=3", "yarns[0].count=3"] {
+            let o = Override::parse(1, text).unwrap();
+            assert_eq!(o.path, ["yarns", "0", "count"]);
+            assert_eq!(o.key(), "yarns[0].count");
+        }
+        // Messages print the bracket form, whichever form was given.
+        for key in ["yarns.0.start.x", "yarns[0].start.x"] {
+            assert_eq!(
+                message(&r, &[&format!("{key}=1")]),
+                format!(
+                    "scene error in --set argument 1 (`{key}=1`): \
+                     `yarns[0].start` is an array; `x` is not an index"
+                )
+            );
+        }
+        assert_eq!(
+            message(&r, &["obstacles[5].radius=0.1"]),
+            "scene error in --set argument 1 (`obstacles[5].radius=0.1`): \
+             index 5 is out of range: `obstacles` has 3 entries, `obstacles[0]` to `obstacles[2]`"
+        );
+        // A check on an entry's field names it with its index.
+        assert_eq!(
+            message(&r, &["yarns[0].vertices=2.5"]),
+            "scene error in --set argument 1 (`yarns[0].vertices=2.5`): \
+             must be an integer, got the number 2.5"
+        );
+        assert_eq!(
+            message(&r, &["gravity=[0,-3]", "obstacles[1].friction=true"]),
+            "scene error in --set argument 2 (`obstacles[1].friction=true`): \
+             must be a number, got the boolean true"
+        );
+        for bad in [
+            "yarns[x].count=1",
+            "yarns[0.count=1",
+            "[0].count=1",
+            "yarns[0]x.count=1",
+        ] {
+            let m = message(&r, &[bad]);
+            assert!(
+                m.contains("with `[N]` (or `.N`) for entry N of a list"),
+                "{m}"
+            );
+        }
     }
 
     #[test]

@@ -169,11 +169,10 @@ pub mod values {
 }
 
 use yarnsim::scene::Scene;
-use yarnsim::YarnSim;
 
 use crate::error::CliError;
 use crate::massspring::{IntegratorArgs, MassSpringRun};
-use crate::run::no_integrator_for_yarn;
+use crate::run::start_yarn;
 
 /// Records `scene` for `duration` seconds; `integrator` applies to
 /// mass-spring scenes only.
@@ -184,10 +183,7 @@ pub fn record(
     integrator: &IntegratorArgs,
 ) -> Result<RecordOutcome, CliError> {
     match scene {
-        Scene::Yarn(y) => {
-            no_integrator_for_yarn(integrator)?;
-            record_yarn(&mut YarnSim::new(y)?, duration, opts)
-        }
+        Scene::Yarn(y) => record_yarn(&mut start_yarn(y, integrator)?, duration, opts),
         Scene::MassSpring(l) => {
             record_massspring(&mut MassSpringRun::new(l, integrator)?, duration, opts)
         }

@@ -139,17 +139,17 @@ impl MassSpringScene {
     fn pins(&self, positions: &[V3], src: Source) -> Result<Vec<Kinematic>, SceneError> {
         let n_total = positions.len();
         let mut kinematics = vec![Kinematic::Free; n_total];
-        for &i in &self.pinned {
+        for (k, &i) in self.pinned.iter().enumerate() {
             if i >= n_total {
                 return Err(invalid(
-                    "pinned".into(),
+                    format!("pinned[{k}]"),
                     src.key_line("pinned"),
                     out_of_range(i, n_total),
                 ));
             }
             if !kinematics[i].is_free() {
                 return Err(invalid(
-                    "pinned".into(),
+                    format!("pinned[{k}]"),
                     src.key_line("pinned"),
                     format!("particle {i} is listed twice"),
                 ));

@@ -130,6 +130,7 @@ pub struct ParticleSpec {
 #[serde(deny_unknown_fields)]
 pub struct SpringSpec {
     /// Global indices of the two particles.
+    #[serde(deserialize_with = "particle_pair")]
     pub particles: [usize; 2],
     /// Stiffness `k` in N/m: force `k (l - l0)` along the spring.
     #[serde(deserialize_with = "nonnegative")]
@@ -312,6 +313,17 @@ fn opt_strain<'de, D: Deserializer<'de>>(d: D) -> Result<Option<f64>, D::Error> 
     }
 }
 
+/// Two particle indices (serde's `[usize; 2]` would drop a third).
+fn particle_pair<'de, D: Deserializer<'de>>(d: D) -> Result<[usize; 2], D::Error> {
+    let v = Vec::<usize>::deserialize(d)?;
+    <[usize; 2]>::try_from(v.as_slice()).map_err(|_| {
+        D::Error::custom(format!(
+            "must be 2 particle indices, got {} ({v:?})",
+            v.len()
+        ))
+    })
+}
+
 fn frame_count<'de, D: Deserializer<'de>>(d: D) -> Result<u32, D::Error> {
     bounded_u32(d, 1, 100_000_000)
 }
@@ -359,7 +371,7 @@ damping = 100.0
             MassSpringScene::from_toml_str(&WIRE.replace("mass = 1.0", "mass = -1.0")).unwrap_err();
         let m = e.to_string();
         assert!(
-            m.contains("line 10") && m.contains("chains.mass") && m.contains("> 0"),
+            m.contains("line 10") && m.contains("`chains[0].mass`") && m.contains("> 0"),
             "{m}"
         );
     }
@@ -370,7 +382,7 @@ damping = 100.0
         let m = MassSpringScene::from_toml_str(&text)
             .unwrap_err()
             .to_string();
-        assert!(m.contains("line 3") && m.contains("pinned"), "{m}");
+        assert!(m.contains("line 3") && m.contains("`pinned[0]`"), "{m}");
     }
 
     #[test]

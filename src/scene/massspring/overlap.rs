@@ -35,8 +35,8 @@ pub fn check_particles_outside_spheres(
                 field: format!("spheres[{j}]"),
                 line: table_line(text, "[[spheres]]", j),
                 message: format!(
-                    "{count} particle{} start{} inside sphere {j} (centre ({}, {}, {}), radius {}); \
-                     the deepest, particle {i}, is {d:.4} m from the centre, {:.4} m inside; move \
+                    "{count} particle{} start{} inside sphere {j} (center [{}, {}, {}], radius {}); \
+                     the deepest, particle {i}, is {d:.4} m from the center, {:.4} m inside; move \
                      the sphere or the particles apart",
                     if count == 1 { "" } else { "s" },
                     if count == 1 { "s" } else { "" },
@@ -72,7 +72,7 @@ mod tests {
             .to_string();
         assert!(text.contains("2 particles start inside sphere 0"), "{text}");
         assert!(
-            text.contains("particle 1, is 0.5000 m from the centre"),
+            text.contains("particle 1, is 0.5000 m from the center"),
             "{text}"
         );
         assert!(check_particles_outside_spheres(&xs[..1], &[sphere], None).is_ok());

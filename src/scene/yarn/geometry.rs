@@ -69,6 +69,33 @@ impl YarnSpec {
         }
     }
 
+    /// The points of the control polyline as the entry gives them: the
+    /// field (`start`, `end`, `points[2]`, or `length` for the end of
+    /// `start`, `direction` and `length`), the words of a message before
+    /// the point (`ends at`), and the point in m. Empty when the geometry is invalid.
+    pub(super) fn control_points(&self) -> Vec<(String, &'static str, Vec2)> {
+        let Ok(poly) = self.polyline() else {
+            return Vec::new();
+        };
+        if self.points.is_some() {
+            return poly
+                .iter()
+                .enumerate()
+                .map(|(k, p)| (format!("points[{k}]"), "passes through", *p))
+                .collect();
+        }
+        let end = if self.end.is_some() {
+            ("end".to_string(), "ends at", poly[1])
+        } else {
+            (
+                "length".to_string(),
+                "ends (start + length * direction) at",
+                poly[1],
+            )
+        };
+        vec![("start".to_string(), "starts at", poly[0]), end]
+    }
+
     /// The vertex positions of every copy.
     pub fn curves(&self) -> Result<Vec<Vec<Vec2>>, String> {
         let poly = self.polyline()?;

@@ -229,6 +229,24 @@ pub enum Integrator {
 }
 
 impl Integrator {
+    /// Every value of `[time] integrator`, as a scene file writes it.
+    pub const NAMES: [&'static str; 4] = [
+        "explicit",
+        "implicit",
+        "implicit-vertices",
+        "midpoint-vertices",
+    ];
+
+    /// The value as a scene file writes it (one of [`Integrator::NAMES`]).
+    pub fn name(&self) -> &'static str {
+        match self {
+            Integrator::Explicit => Self::NAMES[0],
+            Integrator::Implicit => Self::NAMES[1],
+            Integrator::ImplicitVertices => Self::NAMES[2],
+            Integrator::MidpointVertices => Self::NAMES[3],
+        }
+    }
+
     /// Whether this is the default explicit step.
     pub fn is_explicit(&self) -> bool {
         *self == Integrator::Explicit
@@ -489,7 +507,11 @@ pub struct YarnSpec {
         deserialize_with = "opt_positive"
     )]
     pub length: Option<f64>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[serde(
+        default,
+        skip_serializing_if = "Option::is_none",
+        deserialize_with = "opt_points"
+    )]
     pub points: Option<Vec<[f64; 2]>>,
     /// Number of type-2 vertices (2 or more).
     #[serde(deserialize_with = "vertex_count")]
@@ -581,6 +603,25 @@ fn opt_safety<'de, D: Deserializer<'de>>(d: D) -> Result<Option<f64>, D::Error> 
 
 fn opt_finite2<'de, D: Deserializer<'de>>(d: D) -> Result<Option<[f64; 2]>, D::Error> {
     finite2(d).map(Some)
+}
+
+/// Points `[x, y]`, each exactly two numbers (serde's `[f64; 2]` would
+/// drop a third).
+fn opt_points<'de, D: Deserializer<'de>>(d: D) -> Result<Option<Vec<[f64; 2]>>, D::Error> {
+    let points = Vec::<Vec<f64>>::deserialize(d)?;
+    points
+        .iter()
+        .enumerate()
+        .map(|(k, p)| {
+            <[f64; 2]>::try_from(p.as_slice()).map_err(|_| {
+                D::Error::custom(format!(
+                    "points[{k}] must be 2 numbers [x, y], got {} ({p:?})",
+                    p.len()
+                ))
+            })
+        })
+        .collect::<Result<Vec<_>, _>>()
+        .map(Some)
 }
 
 fn resolution<'de, D: Deserializer<'de>>(d: D) -> Result<u32, D::Error> {

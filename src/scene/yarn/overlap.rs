@@ -1,14 +1,17 @@
 //! Start-up overlap check of a yarn scene: a yarn that starts through an
 //! obstacle is refused, because the contact handling would push it out
 //! violently in the first step (a yarn through an obstacle gained 40x its
-//! energy in 0.01 s). The error names both objects and the distance.
+//! energy in 0.01 s). The error names both objects (the yarn by its index,
+//! its `[[yarns]]` entry and that entry's line), the point of the yarn
+//! nearest the obstacle's center in m, and the distance.
 
 use super::YarnScene;
 use crate::math::Vec2;
 use crate::scene::error::{table_line, SceneError};
 
-/// Distance from `c` to the segment `a`-`b`.
-fn segment_distance(c: Vec2, a: Vec2, b: Vec2) -> f64 {
+/// The point of the segment `a`-`b` nearest to `c`, and the fraction
+/// along the segment where it lies.
+fn nearest_on_segment(c: Vec2, a: Vec2, b: Vec2) -> (Vec2, f64) {
     let ab = b - a;
     let len2 = ab.norm_squared();
     let t = if len2 > 0.0 {
@@ -16,15 +19,44 @@ fn segment_distance(c: Vec2, a: Vec2, b: Vec2) -> f64 {
     } else {
         0.0
     };
-    (a + ab * t - c).norm()
+    (a + ab * t, t)
+}
+
+/// The point of `curve` nearest to `c`, its distance, and the vertex
+/// nearest to that point.
+fn nearest_on_curve(curve: &[Vec2], c: Vec2) -> Option<(Vec2, f64, usize)> {
+    match curve.len() {
+        0 => None,
+        1 => Some((curve[0], (curve[0] - c).norm(), 0)),
+        _ => curve
+            .windows(2)
+            .enumerate()
+            .map(|(k, s)| {
+                let (p, t) = nearest_on_segment(c, s[0], s[1]);
+                (p, (p - c).norm(), k + usize::from(t > 0.5))
+            })
+            .min_by(|a, b| a.1.total_cmp(&b.1)),
+    }
+}
+
+/// A coordinate in m for a message: 4 decimals without trailing zeros.
+fn short(x: f64) -> String {
+    let s = format!("{x:.4}");
+    let s = s.trim_end_matches('0').trim_end_matches('.');
+    if s == "-0" {
+        "0".into()
+    } else {
+        s.into()
+    }
 }
 
 /// Refuses a yarn scene in which a yarn passes through an obstacle at the
-/// start: closer to its centre than its radius less half a grid cell (the
+/// start: closer to its center than its radius less half a grid cell (the
 /// contact's resolution; a yarn laid on the surface, whose chords cut the
 /// circle by their sagitta, is fine). Yarns are numbered as in the
 /// simulation, the CSV and the recording: copies of a `[[yarns]]` entry one
-/// after another. `text` (the scene file) gives the obstacle's line.
+/// after another. `text` (the scene file) gives the obstacle's line and
+/// that of the yarn's entry.
 pub fn check_yarns_clear_of_obstacles(
     scene: &YarnScene,
     text: Option<&str>,
@@ -38,27 +70,35 @@ pub fn check_yarns_clear_of_obstacles(
         for (copy, curve) in curves.iter().enumerate() {
             for (j, o) in scene.obstacles.iter().enumerate() {
                 let c = Vec2::from(o.center);
-                let d = match curve.len() {
-                    0 => f64::INFINITY,
-                    1 => (curve[0] - c).norm(),
-                    _ => curve
-                        .windows(2)
-                        .map(|s| segment_distance(c, s[0], s[1]))
-                        .fold(f64::INFINITY, f64::min),
+                let Some((p, d, vertex)) = nearest_on_curve(curve, c) else {
+                    continue;
                 };
                 if d < o.radius - tolerance {
+                    let line = match table_line(text, "[[yarns]]", entry) {
+                        Some(l) => format!(" at line {l}"),
+                        None => String::new(),
+                    };
+                    let copy = if spec.count > 1 {
+                        format!(", copy {copy} of {}", spec.count)
+                    } else {
+                        String::new()
+                    };
                     return Err(SceneError::Invalid {
                         field: format!("obstacles[{j}]"),
                         line: table_line(text, "[[obstacles]]", j),
                         message: format!(
-                            "obstacle {j} (centre ({}, {}), radius {}) overlaps yarn {yarn} \
-                             ([[yarns]] entry {entry}, copy {copy}) at the start: the yarn passes \
-                             {d:.4} m from the centre, {:.4} m inside the circle (more than half \
-                             a grid cell); move the obstacle or the yarn apart",
+                            "obstacle {j} (center [{}, {}], radius {}) overlaps yarn {yarn} \
+                             (`yarns[{entry}]`{line}{copy}) at the start: its point [{}, {}] \
+                             (near vertex {vertex}) lies {} m from the center, {} m inside the \
+                             circle (more than half a grid cell); move the obstacle \
+                             or the yarn apart",
                             o.center[0],
                             o.center[1],
                             o.radius,
-                            o.radius - d
+                            short(p.x),
+                            short(p.y),
+                            short(d),
+                            short(o.radius - d)
                         ),
                     });
                 }

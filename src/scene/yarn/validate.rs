@@ -20,33 +20,22 @@ impl YarnScene {
                 message: "a yarn scene needs at least one [[yarns]] entry".into(),
             });
         }
-        let size = self.grid.size;
-        let margin = self.dx() * 1.5;
+        let mut first_yarn = 0;
         for (i, y) in self.yarns.iter().enumerate() {
             let curves = y.curves().map_err(|message| SceneError::Invalid {
                 field: format!("yarns[{i}]"),
                 line: yarn_line(i),
                 message,
             })?;
-            for c in &curves {
-                for p in c {
-                    if p.x < margin || p.y < margin || p.x > size - margin || p.y > size - margin {
-                        return Err(SceneError::Invalid {
-                            field: format!("yarns[{i}]"),
-                            line: yarn_line(i),
-                            message: format!(
-                                "vertex ({:.4}, {:.4}) lies outside the grid interior [{margin:.4}, {:.4}]^2",
-                                p.x,
-                                p.y,
-                                size - margin
-                            ),
-                        });
-                    }
+            for (copy, c) in curves.iter().enumerate() {
+                if c.iter().any(|&p| !self.in_grid_interior(p)) {
+                    return Err(self.outside_grid(i, y, copy, first_yarn + copy, yarn_line(i)));
                 }
             }
+            first_yarn += curves.len();
         }
         for (i, o) in self.obstacles.iter().enumerate() {
-            if o.radius > 10.0 * size {
+            if o.radius > 10.0 * self.grid.size {
                 return Err(SceneError::Invalid {
                     field: format!("obstacles[{i}].radius"),
                     line: obstacle_line(i),
@@ -71,6 +60,70 @@ impl YarnScene {
         self.validate_gridless(text)?;
         overlap::check_yarns_clear_of_obstacles(self, text)?;
         Ok(())
+    }
+
+    /// The grid interior a yarn must start in, in m: 1.5 cells inside the
+    /// domain `[0, size]^2` on every side.
+    fn grid_interior(&self) -> (f64, f64) {
+        let margin = self.dx() * 1.5;
+        (margin, self.grid.size - margin)
+    }
+
+    fn in_grid_interior(&self, p: Vec2) -> bool {
+        let (lo, hi) = self.grid_interior();
+        p.x >= lo && p.y >= lo && p.x <= hi && p.y <= hi
+    }
+
+    /// The error of copy `copy` (yarn `yarn` of the run) of the `[[yarns]]`
+    /// entry `i`, which has a vertex outside the grid interior. It names a
+    /// point of the entry as the file gives it (`start`, `end`,
+    /// `points[k]`): the vertices lie on the polyline between those points
+    /// and the interior is convex, so one of them lies outside too.
+    fn outside_grid(
+        &self,
+        i: usize,
+        y: &YarnSpec,
+        copy: usize,
+        yarn: usize,
+        line: Option<usize>,
+    ) -> SceneError {
+        let (lo, hi) = self.grid_interior();
+        let shift = Vec2::from(y.spacing) * copy as f64;
+        let (field, what, at) = y
+            .control_points()
+            .into_iter()
+            .map(|(field, what, p)| (field, what, p + shift))
+            .find(|(_, _, p)| !self.in_grid_interior(*p))
+            .expect("a vertex outside the convex interior has a control point outside");
+        let point = |p: Vec2| format!("[{}, {}]", short(p.x), short(p.y));
+        let whose = if y.count == 1 {
+            format!("yarn {yarn}")
+        } else if copy == 0 {
+            format!("yarn {yarn} (copy 0 of this entry's {})", y.count)
+        } else {
+            format!(
+                "yarn {yarn} (copy {copy} of this entry's {}, shifted by {copy} x spacing {})",
+                y.count,
+                point(Vec2::from(y.spacing))
+            )
+        };
+        let which = if field.starts_with("points") {
+            format!(" {field} =")
+        } else {
+            String::new()
+        };
+        SceneError::Invalid {
+            field: format!("yarns[{i}].{field}"),
+            line,
+            message: format!(
+                "{whose} {what}{which} {}, outside the grid interior: x and y \
+                 must be within [{}, {}] m, 1.5 grid cells inside the domain [0, {}] m",
+                point(at),
+                short(lo),
+                short(hi),
+                short(self.grid.size)
+            ),
+        }
     }
 
     fn validate_time(&self, text: Option<&str>) -> Result<(), SceneError> {
@@ -249,6 +302,18 @@ impl YarnScene {
             seen.push((y, r));
         }
         Ok(())
+    }
+}
+
+/// A coordinate in m for a message: at most 6 decimals, without trailing
+/// zeros (`0.29`, not `0.29000000000000004`).
+fn short(x: f64) -> String {
+    let s = format!("{x:.6}");
+    let s = s.trim_end_matches('0').trim_end_matches('.');
+    if s == "-0" {
+        "0".into()
+    } else {
+        s.into()
     }
 }
 
