@@ -310,15 +310,25 @@ pub fn capstan_vertices(r: f64, l1: f64, l2: f64, res: u32) -> u32 {
 /// `l1` on the left and `l2` on the right, on a circle with friction `mu`,
 /// as scene TOML: k = 1000, no walls, the rest from `c`.
 pub fn capstan_toml(r: f64, l1: f64, l2: f64, mu: f64, c: &Capstan) -> String {
+    capstan_drop_toml(r, l1, l2, mu, 0.0, c)
+}
+
+/// [`capstan_toml`] with the yarn released `drop` (m) away from the
+/// circle: every point moved out by `drop`, radially on the arc (radius
+/// `r + drop`) and sideways on the two strands, which keep their hanging
+/// lengths; the vertex spacing stays about dx / 2. `drop = 0` is
+/// [`capstan_toml`] itself.
+pub fn capstan_drop_toml(r: f64, l1: f64, l2: f64, mu: f64, drop: f64, c: &Capstan) -> String {
     let (cx, cy) = (0.5, 0.75);
-    let mut pts = vec![[cx - r, cy - l1]];
+    let ra = r + drop;
+    let mut pts = vec![[cx - ra, cy - l1]];
     let arc = 64;
     for i in 0..=arc {
         let psi = std::f64::consts::PI * (1.0 - i as f64 / arc as f64);
-        pts.push([cx + r * psi.cos(), cy + r * psi.sin()]);
+        pts.push([cx + ra * psi.cos(), cy + ra * psi.sin()]);
     }
-    pts.push([cx + r, cy - l2]);
-    let vertices = capstan_vertices(r, l1, l2, c.res);
+    pts.push([cx + ra, cy - l2]);
+    let vertices = capstan_vertices(ra, l1, l2, c.res);
     let points = pts
         .iter()
         .map(|p| format!("[{:.12}, {:.12}]", p[0], p[1]))

@@ -25,8 +25,19 @@
 //! the obstacle and pushes its outer ones outward, and a node-by-node law
 //! would give those outer nodes no friction at all.
 //!
-//! A node carrying both touching and free particles gets the law in
-//! proportion to the touching mass.
+//! A node carrying both touching and free particles gets the normal part
+//! in proportion to the touching mass, but joins the friction pool with
+//! its whole mass, as does every node within [`POOL_CELLS`] of the
+//! surface. A yarn that lands on an obstacle stops where its particles
+//! enter the contact band, at its outer edge, so its particles are partly
+//! inside the band and partly outside: pooled by the touching share alone,
+//! a wedge's normal impulse fell on nodes whose tangential momentum
+//! friction had already stopped (inside the circle) while the moving yarn
+//! sat on nodes with a small share, and the wedge stuck with its Coulomb
+//! limit `mu J` unused while the yarn slid on (measured in
+//! `docs/obstacle-contact.md`, "Under impact"). Pooling whole nodes, the
+//! wedge's tangential momentum is that of the whole cross-section on the
+//! obstacle, as for a yarn laid on it.
 
 use crate::math::Vec2;
 use crate::scene::{Obstacle, WallMode};
@@ -63,9 +74,8 @@ pub struct ContactNode {
     pub ij: [u32; 2],
     /// Friction wedge, numbered over all obstacles ([`WedgeTable`]).
     pub wedge: u32,
-    /// Fraction of the node's mass the law acts on.
-    pub share: f64,
-    /// Mass the law acts on, `share m`.
+    /// The node's mass: all of it joins the wedge's friction pool (the
+    /// normal part acts on the touching share only).
     pub mass: f64,
     /// Normal impulse the obstacle delivered to it (`>= 0`).
     pub impulse: f64,
@@ -77,8 +87,10 @@ pub struct ContactNode {
 /// mass `m` with obstacle `o`: `touching` is the fraction of the node's mass
 /// that belongs to particles touching an obstacle (inside the circle the
 /// law acts in full). Removes the inward velocity of that share; returns
-/// the share, the outward normal and the normal impulse delivered, or
-/// `None` when the node is not in contact.
+/// the outward normal and the normal impulse delivered, or `None` when the
+/// node is not in contact: neither inside, nor carrying touching mass, nor
+/// within `pool_reach` (m) of the surface. A node in contact joins its
+/// wedge's friction pool with its whole mass ([`ContactNode`]).
 #[inline]
 pub fn obstacle_normal(
     o: &Obstacle,
@@ -86,7 +98,8 @@ pub fn obstacle_normal(
     v: &mut Vec2,
     m: f64,
     touching: f64,
-) -> Option<(f64, Vec2, f64)> {
+    pool_reach: f64,
+) -> Option<(Vec2, f64)> {
     let c = Vec2::from(o.center);
     let r = xi - c;
     let dist = r.norm();
@@ -95,7 +108,7 @@ pub fn obstacle_normal(
     } else {
         touching.min(1.0)
     };
-    if share <= 0.0 {
+    if share <= 0.0 && dist >= o.radius + pool_reach {
         return None;
     }
     let n = if dist > 0.0 {
@@ -110,7 +123,7 @@ pub fn obstacle_normal(
     } else {
         0.0
     };
-    Some((share, n, impulse))
+    Some((n, impulse))
 }
 
 /// Number of friction wedges around obstacle `o` on a grid of spacing `dx`.
@@ -120,11 +133,21 @@ pub fn friction_wedges(o: &Obstacle, dx: f64) -> usize {
     (arc.round() as usize).max(1)
 }
 
+/// Distance, in cells, from an obstacle's surface within which every grid
+/// node joins its wedge's friction pool with its whole mass, whatever
+/// particles it carries: the rows of the stencil of a yarn resting at the
+/// outer edge of the contact band ([`super::particle_to_grid::CONTACT_CELLS`]),
+/// whose particles sit partly inside the band and partly outside.
+pub const POOL_CELLS: f64 = 1.0;
+
 /// The friction wedges of all obstacles, numbered one obstacle after the
-/// other: obstacle `k` has wedges `start[k] .. start[k + 1]`.
+/// other: obstacle `k` has wedges `start[k] .. start[k + 1]`; and the
+/// pools' reach outside the surface.
 #[derive(Clone, Debug)]
 pub struct WedgeTable {
     pub start: Vec<usize>,
+    /// [`POOL_CELLS`] in m.
+    pub reach: f64,
 }
 
 impl WedgeTable {
@@ -136,7 +159,10 @@ impl WedgeTable {
             n += friction_wedges(o, dx);
             start.push(n);
         }
-        WedgeTable { start }
+        WedgeTable {
+            start,
+            reach: POOL_CELLS * dx,
+        }
     }
 
     /// Global wedge of a contact node of obstacle `k` with outward normal `n`.
@@ -215,7 +241,7 @@ pub fn obstacle_friction(
         if d == 0.0 {
             continue;
         }
-        let t = Vec2::new(-c.normal.y, c.normal.x) * (d * c.share);
+        let t = Vec2::new(-c.normal.y, c.normal.x) * d;
         let out = &mut node[c.index];
         out[0] += t.x;
         out[1] += t.y;

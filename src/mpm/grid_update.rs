@@ -184,13 +184,12 @@ fn obstacle_contacts(
     contacts: &mut Vec<ContactNode>,
 ) {
     for (oi, o) in ext.obstacles.iter().enumerate() {
-        if let Some((share, normal, impulse)) = obstacle_normal(o, xi, v, m, touching) {
+        if let Some((normal, impulse)) = obstacle_normal(o, xi, v, m, touching, wedges.reach) {
             contacts.push(ContactNode {
                 index,
                 ij: [ij[0] as u32, ij[1] as u32],
                 wedge: wedges.wedge(oi, normal),
-                share,
-                mass: share * m,
+                mass: m,
                 impulse,
                 normal,
             });
