@@ -322,3 +322,27 @@ fn mass_spring_list_entries_are_named_with_their_index() {
          particle index 7 out of range: the scene has 3 particles"
     );
 }
+
+/// A list written inline (`obstacles = [{ ... }, { ... }]`) names the entry
+/// by its index as a `[[obstacles]]` entry would be named.
+#[test]
+fn an_inline_list_entry_is_named_by_its_index() {
+    let inline = "obstacles = [{ center = [0.5, 0.2], radius = 0.05 },\n    \
+                  { center = [0.2, 0.2], radius = \"wide\" }]\n";
+    let text = SCENE.replacen(
+        "kind = \"yarn\"\n",
+        &format!("kind = \"yarn\"\n{inline}"),
+        1,
+    );
+    // drop the [[obstacles]] tables: the inline list replaces them
+    let text = text
+        .replace("[[obstacles]]\ncenter = [0.5, 0.2]\nradius = 0.05\n\n", "")
+        .replace(
+            "[[obstacles]]  # line 16\ncenter = [0.2, 0.2]\nradius = 0.05\n\n",
+            "",
+        );
+    assert!(!text.contains("[[obstacles]]"), "{text}");
+    let err = Scene::from_toml_str(&text).unwrap_err().to_string();
+    assert!(err.contains("`obstacles[1].radius`"), "{err}");
+    assert!(err.contains("a number"), "{err}");
+}

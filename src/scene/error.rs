@@ -199,8 +199,59 @@ pub fn from_toml_error(text: &str, err: toml::de::Error) -> SceneError {
     }
     SceneError::Parse {
         line: span.as_ref().map(|s| line_of(text, s.start)),
-        field: span.as_ref().and_then(|s| key_at(text, s.start)),
+        field: span.as_ref().and_then(|s| field_at(text, s.start)),
         message,
+    }
+}
+
+/// The path of the field at byte offset `pos`: [`key_at`]'s, or, where
+/// the field sits in an inline array of tables (`yarns = [{ ... }, { ... }]`),
+/// the parser's path with the entry's index (`yarns[1].vertices`), which
+/// the line alone cannot give. An entry of an array of numbers keeps the
+/// array's name (`gravity`), as `--set` takes it.
+fn field_at(text: &str, pos: usize) -> Option<String> {
+    let by_line = key_at(text, pos);
+    match spanned_path(text, pos) {
+        Some(p) if p.contains("].") && !by_line.as_deref().is_some_and(|l| l.contains('[')) => {
+            Some(p)
+        }
+        _ => by_line,
+    }
+}
+
+/// The path of the innermost key or value whose span holds byte offset
+/// `pos`, through tables and arrays, from the TOML parser's spans; `None`
+/// where the text does not parse.
+fn spanned_path(text: &str, pos: usize) -> Option<String> {
+    let doc = toml::de::DeTable::parse(text).ok()?;
+    let mut path = String::new();
+    spanned_table(doc.get_ref(), pos, &mut path);
+    (!path.is_empty()).then_some(path)
+}
+
+fn spanned_table(table: &toml::de::DeTable<'_>, pos: usize, path: &mut String) {
+    for (key, value) in table.iter() {
+        if key.span().contains(&pos) || value.span().contains(&pos) {
+            if !path.is_empty() {
+                path.push('.');
+            }
+            path.push_str(key.get_ref());
+            spanned_value(value.get_ref(), pos, path);
+            return;
+        }
+    }
+}
+
+fn spanned_value(value: &toml::de::DeValue<'_>, pos: usize, path: &mut String) {
+    match value {
+        toml::de::DeValue::Table(t) => spanned_table(t, pos, path),
+        toml::de::DeValue::Array(a) => {
+            if let Some((i, e)) = a.iter().enumerate().find(|(_, e)| e.span().contains(&pos)) {
+                path.push_str(&format!("[{i}]"));
+                spanned_value(e.get_ref(), pos, path);
+            }
+        }
+        _ => {}
     }
 }
 
@@ -381,6 +432,18 @@ mod tests {
         assert_eq!(at("5").as_deref(), Some("yarns[2].vertices"));
         assert_eq!(at("[[yarns]]  #").as_deref(), Some("yarns[1]"));
         assert_eq!(table_line(Some(text), "[[yarns]]", 2), Some(7));
+    }
+
+    #[test]
+    fn an_entry_of_an_inline_array_of_tables_is_named_with_its_index() {
+        let text = "obstacles = [{ center = [0.5, 0.5], radius = 0.1 },\n  \
+                    { center = [0.2, 0.2], radius = \"big\" }]\n";
+        let pos = text.find("\"big\"").unwrap();
+        assert_eq!(field_at(text, pos).as_deref(), Some("obstacles[1].radius"));
+        // a [[table]] entry keeps the header's index
+        let text = "[[obstacles]]\nradius = 1\n[[obstacles]]\nradius = \"big\"\n";
+        let pos = text.find("\"big\"").unwrap();
+        assert_eq!(field_at(text, pos).as_deref(), Some("obstacles[1].radius"));
     }
 
     #[test]
