@@ -24,8 +24,12 @@
 //! first-order splitting taken at too large a step (the contact's
 //! friction acting on the solved velocities, the cross-sections advected
 //! by the velocity gradient it leaves), whose error shrinks as `dt^2`.
-//! A substep that still raises it at the deepest cutback stops the run
-//! with that reason. Not checked where a force outside the ledger does
+//! A substep that still raises it at the deepest cutback is kept and
+//! counted (`ImplicitStats::energy_kept`, the largest such rise
+//! `max_energy_kept`): a rise that `dt / 32` does not remove is not the
+//! step size's (measured on the reference bundle: +4.97 J at dt 8.2e-5
+//! at k 1e5, the vertices pressed into a circle by the yarns above them,
+//! see docs/yarn-model.md). Not checked where a force outside the ledger does
 //! work (the attractor on, or a pin that moves), nor on the first substep
 //! of a new, loaded or edited state.
 //!
@@ -137,13 +141,14 @@ impl YarnSim {
         if depth == MAX_CUTBACKS {
             let ledger = self.energy_checked().then(|| Ledger::of(self));
             self.substep_once(dt).map_err(|e| self.exhausted(e, dt))?;
-            if let Some(what) = ledger.and_then(|l| self.energy_rise(&l)) {
-                let e = SimError::NonFinite {
-                    step: self.steps,
-                    time: self.time,
-                    what,
-                };
-                return Err(self.exhausted(e, dt));
+            if let Some(l) = ledger {
+                let (rise, tol) = l.rise(&Ledger::of(self));
+                if rise > tol {
+                    // not the step size's: kept, and counted
+                    let st = &mut self.implicit_stats;
+                    st.energy_kept += 1;
+                    st.max_energy_kept = st.max_energy_kept.max(rise);
+                }
             }
             return Ok(());
         }
@@ -155,7 +160,12 @@ impl YarnSim {
                     keep.restore(self);
                     self.implicit_stats.undone += 1;
                 }
-                Ok(()) if ledger.is_some_and(|l| self.energy_rise(&l).is_some()) => {
+                Ok(())
+                    if ledger.is_some_and(|l| {
+                        let (rise, tol) = l.rise(&Ledger::of(self));
+                        rise > tol
+                    }) =>
+                {
                     keep.restore(self);
                     self.implicit_stats.undone += 1;
                     self.implicit_stats.energy_cuts += 1;
@@ -196,20 +206,6 @@ impl YarnSim {
             && !self.frames_stale
             && !self.passes().attractor
             && self.pins.iter().all(|p| still(&p.motion))
-    }
-
-    /// Why the substep just run is refused for its energy (`before`: the
-    /// ledger it started from), or `None`.
-    fn energy_rise(&self, before: &Ledger) -> Option<String> {
-        let (rise, tol) = before.rise(&Ledger::of(self));
-        (rise > tol).then(|| {
-            format!(
-                "the implicit substep raised the total energy (kinetic, elastic, gravitational) \
-                 by {rise:.3e} J, more than its tolerance {tol:.3e} J ({} % of the kinetic and \
-                 elastic energy plus the work of gravity)",
-                100.0 * ENERGY_TOL
-            )
-        })
     }
 
     /// The error of a substep that failed at the deepest cutback, saying so.

@@ -47,6 +47,11 @@ pub struct ImplicitStats {
     /// Of the undone ones, those refused for raising the total energy
     /// ([`super::ENERGY_TOL`]).
     pub energy_cuts: u64,
+    /// Substeps at the deepest cutback kept although they raised the total
+    /// energy by more than [`super::ENERGY_TOL`], and the largest such
+    /// rise, J.
+    pub energy_kept: u64,
+    pub max_energy_kept: f64,
 }
 
 /// What [`implicit_grid`] writes.
