@@ -264,10 +264,14 @@ fn reference_bundle_drapes_under_backward_euler_at_a_fixed_25x_the_explicit_dt()
     // it did land and drape: well below the start (0.75 to 0.86 m), on
     // the circles (the lower yarns touch them, the others lie on those)
     assert!(im.mean_y < 0.65 && im.touching >= 1, "{}", im.mean_y);
-    // the whip was cut back, and only where it had to be
+    // the whip was cut back; since the energy cutback
+    // (src/mpm/sim/cutback.rs) the landing's substeps that raise the total
+    // energy are halved too: measured 1682 cutbacks (1539 undone) in the
+    // 350 outer substeps (before it, at most a fifth of them were cut),
+    // so at most 5 per outer substep
     let outer = (ON_T / dt).round() as u64;
     assert!(
-        st.cutbacks >= 1 && st.cutbacks * 5 <= outer,
+        st.cutbacks >= 1 && st.cutbacks <= 5 * outer,
         "{} cutbacks in {outer} substeps",
         st.cutbacks
     );
