@@ -264,10 +264,14 @@ fn reference_bundle_drapes_under_backward_euler_at_a_fixed_25x_the_explicit_dt()
     // it did land and drape: well below the start (0.75 to 0.86 m), on
     // the circles (the lower yarns touch them, the others lie on those)
     assert!(im.mean_y < 0.65 && im.touching >= 1, "{}", im.mean_y);
-    // the whip was cut back, and only where it had to be
+    // the whip was cut back; since the energy cutback
+    // (src/mpm/sim/cutback.rs) the landing's substeps that raise the total
+    // energy are halved too: measured 1682 cutbacks (1539 undone) in the
+    // 350 outer substeps (before it, at most a fifth of them were cut),
+    // so at most 5 per outer substep
     let outer = (ON_T / dt).round() as u64;
     assert!(
-        st.cutbacks >= 1 && st.cutbacks * 5 <= outer,
+        st.cutbacks >= 1 && st.cutbacks <= 5 * outer,
         "{} cutbacks in {outer} substeps",
         st.cutbacks
     );
@@ -306,9 +310,11 @@ const AUTO_SAFETY: f64 = 0.5;
 /// `dt = "auto"` with `dt_max = 1e-2` under backward Euler (the advection
 /// limit `safety dx / |v|max`, src/mpm/timestep.rs) runs the bundle through
 /// the landing to [`DRAPE_T`] at safety [`AUTO_SAFETY`] with no vertex deeper than a cell inside a
-/// circle and no yarn-yarn crossing; its mean substep is at least 10x
+/// circle and no yarn-yarn crossing; its mean substep is at least 7.5x
 /// the explicit 4e-5 (measured 1.00e-3 over 249 substeps, 6.84 Newton /
-/// 840 CG per substep: the landing takes the advection limit).
+/// 840 CG per substep, before the energy cutback, src/mpm/sim/cutback.rs;
+/// with it 3.93e-4 over 637 substeps, 6.70 Newton / 730 CG per substep:
+/// the landing's substeps that raise the total energy are halved).
 #[test]
 #[cfg_attr(debug_assertions, ignore = "release-mode test (cargo test --release)")]
 fn reference_bundle_runs_under_auto_dt_capped_at_1e_2() {
@@ -323,7 +329,7 @@ fn reference_bundle_runs_under_auto_dt_capped_at_1e_2() {
     );
     assert!(d.depth <= dx, "a vertex is {:.2} dx inside", d.depth / dx);
     assert_eq!(d.crossings, 0, "yarn-yarn segment crossings");
-    assert!(d.mean_dt > 4e-4, "mean substep {:.3e}", d.mean_dt);
+    assert!(d.mean_dt > 3e-4, "mean substep {:.3e}", d.mean_dt);
     assert!(d.mean_y < 0.65 && d.touching >= 1, "{}", d.mean_y);
 }
 

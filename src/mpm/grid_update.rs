@@ -147,7 +147,7 @@ fn pooled_friction(
 /// Whether an obstacle (within the contact's reach) and the walls reach
 /// window block `b`.
 #[inline(always)]
-fn block_near(geom: &GridGeom, ext: &GridForces, b: usize) -> (bool, bool) {
+pub(crate) fn block_near(geom: &GridGeom, ext: &GridForces, b: usize) -> (bool, bool) {
     let (i0, j0) = geom.block_origin(b);
     let cells = ext.wall_cells;
     let dx = geom.dx;

@@ -18,6 +18,9 @@ pub struct Blocks {
     pub quad: Vec<[[f64; 4]; 4]>,
     pub bend: Vec<[[f64; 4]; 4]>,
     pub attr: Vec<[[f64; 2]; 2]>,
+    /// Per contact term its weight `w` where it acts (`v . n < 0`), else 0:
+    /// the block `w n n^T`.
+    pub contact: Vec<f64>,
 }
 
 /// `phi(r) = s (r - 0.01 ln(r + 0.01))`: the attractor's potential per
@@ -123,7 +126,15 @@ impl Problem {
                 })
                 .sum()
         });
-        kinetic + elastic + bend + attr
+        let contact: f64 = self
+            .contacts
+            .iter()
+            .map(|c| {
+                let a = v[c.node as usize].dot(&c.n).min(0.0);
+                0.5 * c.w * a * a
+            })
+            .sum();
+        kinetic + elastic + bend + attr + contact
     }
 
     /// `dE/dv = M (v - v*) + dPsi/dv`: through each element's list, the
@@ -151,6 +162,10 @@ impl Problem {
                 let y = a.x[i] + v[i] * self.dt - a.position;
                 *g += y * (self.mass[i] * self.dt * a.strength / (y.norm() + 0.01));
             }
+        }
+        for c in &self.contacts {
+            let a = v[c.node as usize].dot(&c.n).min(0.0);
+            g[c.node as usize] += c.n * (c.w * a);
         }
         g
     }
@@ -211,7 +226,21 @@ impl Problem {
                 })
                 .collect()
         });
-        Blocks { quad, bend, attr }
+        let contact = (self.contacts.iter())
+            .map(|c| {
+                if v[c.node as usize].dot(&c.n) < 0.0 {
+                    c.w
+                } else {
+                    0.0
+                }
+            })
+            .collect();
+        Blocks {
+            quad,
+            bend,
+            attr,
+            contact,
+        }
     }
 
     /// `H d = M d + sum_e J_e^T K_e J_e d` from the blocks.
@@ -257,6 +286,10 @@ impl Problem {
         for ((y, a), d) in y.iter_mut().zip(&k.attr).zip(d) {
             *y += Vec2::new(a[0][0] * d.x + a[0][1] * d.y, a[1][0] * d.x + a[1][1] * d.y);
         }
+        for (c, &w) in self.contacts.iter().zip(&k.contact) {
+            let i = c.node as usize;
+            y[i] += c.n * (w * c.n.dot(&d[i]));
+        }
     }
 
     /// The exact `H d` at `v` (unprojected blocks).
@@ -293,6 +326,9 @@ impl Problem {
         for (o, a) in out.iter_mut().zip(&k.attr) {
             o.x += a[0][0];
             o.y += a[1][1];
+        }
+        for (c, &w) in self.contacts.iter().zip(&k.contact) {
+            out[c.node as usize] += c.n.component_mul(&c.n) * w;
         }
         for (o, m) in out.iter_mut().zip(&self.mass) {
             o.x = o.x.max(*m);

@@ -44,6 +44,7 @@ mod problem;
 #[cfg(test)]
 mod tests;
 
+pub use problem::ContactTerm;
 use problem::{AttractorTerm, BendElem, BendTerm, QuadElem, QuadTerm, Weights};
 
 use super::constitutive::YarnEnergy;
@@ -70,6 +71,9 @@ pub struct Problem {
     bends: Vec<BendElem>,
     bend_terms: Vec<BendTerm>,
     attractor: Option<AttractorTerm>,
+    /// The obstacles' normal law on the nodes in contact
+    /// ([`Problem::set_contacts`]).
+    contacts: Vec<ContactTerm>,
     /// Pin constraint rows (weights in unknown indices) and targets.
     rows: Vec<(Weights, Vec2, usize)>,
     /// Pivoted Cholesky factor of `S = A M^-1 A^T` ([`pins::PinFactor`]).

@@ -77,6 +77,23 @@ pub(super) struct AttractorTerm {
     pub x: Vec<Vec2>,
 }
 
+/// The normal law of an obstacle on one unknown node as an energy,
+/// `w / 2 min(v . n, 0)^2` (`n` the outward normal, `w = c m` with `c =
+/// share / (1 - share)`, capped): alone with the node's kinetic term
+/// `m / 2 |v - v*|^2` its minimiser is the explicit law's
+/// (`crate::mpm::contact::obstacle_normal`: the inward normal velocity
+/// of the touching share removed, `v . n = (1 - share) v* . n`), and its
+/// normal impulse `w max(-v . n, 0)`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ContactTerm {
+    /// Unknown index of the node.
+    pub node: u32,
+    /// Outward unit normal.
+    pub n: Vec2,
+    /// `w = c m`, kg.
+    pub w: f64,
+}
+
 /// The energy the implicit step minimises, as the substep passes it.
 #[derive(Clone, Copy, Debug)]
 pub struct Model {
@@ -282,6 +299,7 @@ impl Problem {
             bends,
             bend_terms,
             attractor,
+            contacts: Vec::new(),
             rows,
             chol: Default::default(),
         };
@@ -333,9 +351,19 @@ impl Problem {
     pub fn is_empty(&self) -> bool {
         self.nodes.is_empty()
     }
-    /// Whether an external potential (the attractor) acts: the elastic
-    /// energy alone keeps the momentum.
+    /// Whether an external potential (the attractor, an obstacle's
+    /// contact) acts: the elastic energy alone keeps the momentum.
     pub fn has_external(&self) -> bool {
-        self.attractor.is_some()
+        self.attractor.is_some() || !self.contacts.is_empty()
+    }
+
+    /// Sets the obstacles' contact terms (unknown indices).
+    pub fn set_contacts(&mut self, contacts: Vec<ContactTerm>) {
+        self.contacts = contacts;
+    }
+
+    /// The contact terms.
+    pub fn contacts(&self) -> &[ContactTerm] {
+        &self.contacts
     }
 }

@@ -143,6 +143,7 @@ fn problem(pinned: bool, attractor: bool) -> Problem {
         bends,
         bend_terms,
         attractor,
+        contacts: Vec::new(),
         rows,
         chol: Default::default(),
     };
@@ -539,4 +540,95 @@ fn closed_form_bending_projection_is_the_jacobi_projection() {
     }
     eprintln!("{indefinite} of 100 joints far from rest with two negative eigenvalues");
     assert!(indefinite == 100, "{indefinite} of 100");
+}
+
+/// The obstacles' contact terms: gradient and Hessian-vector product
+/// against central differences (away from the kink at `v . n = 0`), and
+/// on nodes with no element the solve's velocity is the explicit normal
+/// law's (`contact::obstacle_normal`: `share` of the inward normal
+/// velocity removed) for `c = share / (1 - share)`.
+#[test]
+fn contact_terms_are_the_explicit_normal_law() {
+    let mut p = problem(false, false);
+    let mut r = Lcg(11);
+    let contacts: Vec<ContactTerm> = (0..p.len())
+        .step_by(3)
+        .map(|i| {
+            let a = 6.0 * r.next();
+            ContactTerm {
+                node: i as u32,
+                n: Vec2::new(a.cos(), a.sin()),
+                w: 5.0 * r.next() * p.mass[i],
+            }
+        })
+        .collect();
+    p.set_contacts(contacts.clone());
+    let v = r.vec(p.len(), 2.0);
+    let active = contacts
+        .iter()
+        .filter(|c| v[c.node as usize].dot(&c.n) < 0.0)
+        .count();
+    assert!(active > 1 && active < contacts.len(), "{active}");
+    let g = p.gradient(&v);
+    let h = 1e-6;
+    let mut fd = vec![Vec2::zeros(); v.len()];
+    for i in 0..v.len() {
+        for c in 0..2 {
+            let (mut a, mut b) = (v.clone(), v.clone());
+            a[i][c] += h;
+            b[i][c] -= h;
+            fd[i][c] = (p.energy(&a) - p.energy(&b)) / (2.0 * h);
+        }
+    }
+    // tolerance 1e-6 relative, as for the elements
+    assert!(rel(&g, &fd) < 1e-6, "{:.3e}", rel(&g, &fd));
+    let d = r.vec(p.len(), 1.0);
+    let step = |s: f64| -> Vec<Vec2> { v.iter().zip(&d).map(|(v, d)| v + d * s).collect() };
+    let (ga, gb) = (p.gradient(&step(h)), p.gradient(&step(-h)));
+    let fd: Vec<Vec2> = ga
+        .iter()
+        .zip(&gb)
+        .map(|(a, b)| (a - b) / (2.0 * h))
+        .collect();
+    let hd = p.hess_vec(&v, &d);
+    assert!(rel(&hd, &fd) < 1e-6, "{:.3e}", rel(&hd, &fd));
+    // nodes without elements: the minimiser is the law, node by node
+    let n = 8;
+    let mut q = problem(false, false);
+    q.quads.clear();
+    q.quad_terms.clear();
+    q.bends.clear();
+    q.bend_terms.clear();
+    q.nodes.truncate(n);
+    q.mass.truncate(n);
+    q.vstar.truncate(n);
+    let shares = [0.0, 0.1, 0.3, 0.5, 0.7, 0.9, 0.99, 0.999];
+    let terms = (0..n)
+        .map(|i| {
+            let a = 0.8 * i as f64;
+            ContactTerm {
+                node: i as u32,
+                n: Vec2::new(a.cos(), a.sin()),
+                w: shares[i] / (1.0 - shares[i]) * q.mass[i],
+            }
+        })
+        .collect::<Vec<_>>();
+    q.set_contacts(terms.clone());
+    let sol = solve(&q, &Settings::default()).unwrap();
+    for (i, t) in terms.iter().enumerate() {
+        let vs = q.vstar[i];
+        let vn = vs.dot(&t.n);
+        let law = if vn < 0.0 {
+            vs - t.n * (vn * shares[i])
+        } else {
+            vs
+        };
+        let e = (sol.v[i] - law).norm() / vs.norm();
+        assert!(
+            e < 1e-9,
+            "node {i}, share {}: {:?} vs {law:?}",
+            shares[i],
+            sol.v[i]
+        );
+    }
 }

@@ -19,7 +19,7 @@ mod substep;
 use crate::scene::{
     SceneError, StepSize, TransferScheme, TransferSpec, WallMode, YarnScene, DEFAULT_SAFETY,
 };
-pub use cutback::MAX_CUTBACKS;
+pub use cutback::{ENERGY_TOL, MAX_CUTBACKS};
 pub use diagnostics::Diagnostics;
 pub use gridless::THETA;
 pub use implicit_grid::ImplicitStats;
