@@ -100,22 +100,10 @@ pub fn obstacle_normal(
     touching: f64,
     pool_reach: f64,
 ) -> Option<(Vec2, f64)> {
-    let c = Vec2::from(o.center);
-    let r = xi - c;
-    let dist = r.norm();
-    let share = if dist < o.radius {
-        1.0
-    } else {
-        touching.min(1.0)
-    };
+    let (share, n, dist) = normal_share(o, xi, touching);
     if share <= 0.0 && dist >= o.radius + pool_reach {
         return None;
     }
-    let n = if dist > 0.0 {
-        r / dist
-    } else {
-        Vec2::new(0.0, 1.0)
-    };
     let vn = v.dot(&n);
     let impulse = if vn < 0.0 {
         *v -= n * (vn * share);
@@ -124,6 +112,28 @@ pub fn obstacle_normal(
         0.0
     };
     Some((n, impulse))
+}
+
+/// The share of the mass of a grid node at `xi` that the normal part of
+/// the law acts on (1 inside the circle, else the touching fraction
+/// `touching` of its mass, at most 1), the outward normal there and the
+/// node's distance from the centre. Used by [`obstacle_normal`] and by the
+/// implicit solve's contact term.
+#[inline]
+pub fn normal_share(o: &Obstacle, xi: Vec2, touching: f64) -> (f64, Vec2, f64) {
+    let r = xi - Vec2::from(o.center);
+    let dist = r.norm();
+    let share = if dist < o.radius {
+        1.0
+    } else {
+        touching.min(1.0)
+    };
+    let n = if dist > 0.0 {
+        r / dist
+    } else {
+        Vec2::new(0.0, 1.0)
+    };
+    (share, n, dist)
 }
 
 /// Number of friction wedges around obstacle `o` on a grid of spacing `dx`.

@@ -2,7 +2,7 @@
 //! substep calls it.
 //!
 //! The obstacles' normal law is part of the solve: each node the explicit
-//! law would act on (`contact::obstacle_normal`, on the blocks
+//! law would act on (`contact::normal_share`, on the blocks
 //! `grid_update::block_near` finds) adds `w / 2 min(v . n, 0)^2` to the
 //! energy ([`ContactTerm`]), whose minimiser alone with the node's
 //! kinetic term is that law. Applied after the solve instead (Stomakhin
@@ -17,7 +17,7 @@
 //! (unchanged: normal law, pooled Coulomb friction, walls) returns them
 //! and pools its friction over the normal impulse the solve delivered.
 
-use super::super::contact::obstacle_normal;
+use super::super::contact::normal_share;
 use super::super::grid::{Grid, BLOCK};
 use super::super::grid_update::{self, GridForces};
 use super::super::implicit::{self, ContactTerm, Model, Problem};
@@ -206,8 +206,8 @@ fn contact_terms(
             let xi = Vec2::new((i0 + n / BLOCK) as f64, (j0 + n % BLOCK) as f64) * geom.dx;
             let touching = mc * (1.0 / m);
             for o in ext.obstacles {
-                let mut v = Vec2::zeros();
-                if let Some((share, normal, _)) = obstacle_normal(o, xi, &mut v, m, touching) {
+                let (share, normal, _) = normal_share(o, xi, touching);
+                if share > 0.0 {
                     let c = if share < 1.0 {
                         (share / (1.0 - share)).min(CONTACT_MAX)
                     } else {
