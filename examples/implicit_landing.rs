@@ -9,37 +9,14 @@
 //! cargo run --release --example implicit_landing -- K [DURATION] [SAFETY|-] [FRICTION]
 //! ```
 
-use yarnsim::scene::builtin::yarn_reference;
-use yarnsim::scene::{Integrator, Obstacle, StepSize, YarnScene, YarnSpec};
+use yarnsim::testing::implicit_landing_scene;
 use yarnsim::YarnSim;
-
-fn scene(k: f64) -> YarnScene {
-    let mut s = yarn_reference();
-    s.material.k = k;
-    s.time.integrator = Integrator::Implicit;
-    s.time.dt = StepSize::Auto;
-    s.obstacles = vec![Obstacle {
-        center: [0.5, 0.6],
-        radius: 0.08,
-        friction: 0.3,
-    }];
-    s.yarns = vec![YarnSpec {
-        start: Some([0.35, 0.745]),
-        direction: Some([1.0, 0.0]),
-        length: Some(0.3),
-        vertices: 75,
-        count: 3,
-        spacing: [0.0, 0.01],
-        ..Default::default()
-    }];
-    s
-}
 
 fn main() {
     let a: Vec<String> = std::env::args().collect();
     let k: f64 = a.get(1).map_or(1e3, |s| s.parse().unwrap());
     let dur: f64 = a.get(2).map_or(0.2, |s| s.parse().unwrap());
-    let mut s = scene(k);
+    let mut s = implicit_landing_scene(k, 0.3);
     if let Some(sf) = a.get(3).filter(|x| *x != "-") {
         s.time.safety = Some(sf.parse().unwrap());
     }
