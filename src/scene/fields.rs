@@ -11,7 +11,7 @@
 pub struct FieldDoc {
     /// Dotted path without entry indices: `material.k`, `yarns.start`.
     pub key: &'static str,
-    /// SI unit (`m`, `m/s^2`, `Pa`); `1` for a dimensionless ratio, empty
+    /// SI unit (`m`, `m/s^2`, `N/m`); `1` for a dimensionless ratio, empty
     /// for counts, indices, switches and names.
     pub unit: &'static str,
     /// The values the scene accepts, as the user writes them (`> 0`,
