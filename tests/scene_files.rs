@@ -133,3 +133,26 @@ fn implicit_integrator_loads_and_an_unknown_one_is_refused_naming_the_field_and_
         "{m}"
     );
 }
+
+/// Every built-in is a file under `scenes/` (`scenes/yarn/NAME.toml`,
+/// `scenes/massspring/NAME.toml`) that loads through the loader of users'
+/// files and gives the built-in's scene bit for bit (the `Debug` text
+/// prints every float in its shortest round-trip form and tells -0.0 from
+/// 0.0, which `==` does not).
+#[test]
+fn every_builtin_is_its_file_under_scenes() {
+    for (name, _) in builtin_names() {
+        let s = builtin(name).unwrap();
+        let folder = match s {
+            Scene::Yarn(_) => "yarn",
+            Scene::MassSpring(_) => "massspring",
+        };
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("scenes")
+            .join(folder)
+            .join(format!("{name}.toml"));
+        let file = Scene::from_file(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+        assert_eq!(file, s, "{name}");
+        assert_eq!(format!("{file:?}"), format!("{s:?}"), "{name}");
+    }
+}
