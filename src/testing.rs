@@ -18,9 +18,10 @@ pub fn reference_material() -> Material {
 /// falling from y = 0.75 onto one circle (centre (0.5, 0.55), radius 0.1),
 /// reference material, gravity -9.8, sticky walls, dt 1e-4. Used by the
 /// evidence studies (`yarnsim-evidence`) and by the library's own tests.
+/// Its name is `small-bundle` (`yarn-small` is `fmu/scenes/small.toml`).
 pub fn small_yarn_scene(yarns: u32, vertices: u32, resolution: u32) -> YarnScene {
     let mut s = yarn_reference();
-    s.name = "yarn-small".into();
+    s.name = "small-bundle".into();
     s.description =
         format!("{yarns} yarns x {vertices} vertices on {resolution}^2 falling onto one circle");
     s.grid.resolution = resolution;

@@ -1,6 +1,8 @@
 //! Scene files: round trip, and malformed files name the field and the line.
 
-use yarnsim::scene::{builtin, builtin_names, Integrator, Scene, SceneError, YarnScene};
+use yarnsim::scene::{
+    builtin, builtin_names, builtin_toml, Integrator, Scene, SceneError, YarnScene,
+};
 
 mod common;
 
@@ -135,10 +137,12 @@ fn implicit_integrator_loads_and_an_unknown_one_is_refused_naming_the_field_and_
 }
 
 /// Every built-in is a file under `scenes/` (`scenes/yarn/NAME.toml`,
-/// `scenes/massspring/NAME.toml`) that loads through the loader of users'
-/// files and gives the built-in's scene bit for bit (the `Debug` text
+/// `scenes/massspring/NAME.toml`), the text the library embeds; it loads
+/// through the loader of users' files, and its `scene show` text (and its
+/// plain TOML) reads back to the same scene bit for bit (the `Debug` text
 /// prints every float in its shortest round-trip form and tells -0.0 from
-/// 0.0, which `==` does not).
+/// 0.0, which `==` does not). While the Rust constructors still existed, this
+/// test compared each file with its constructor's scene.
 #[test]
 fn every_builtin_is_its_file_under_scenes() {
     for (name, _) in builtin_names() {
@@ -151,8 +155,14 @@ fn every_builtin_is_its_file_under_scenes() {
             .join("scenes")
             .join(folder)
             .join(format!("{name}.toml"));
+        let text = std::fs::read_to_string(&path).unwrap();
+        assert_eq!(Some(text.as_str()), builtin_toml(name), "{name}");
         let file = Scene::from_file(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-        assert_eq!(file, s, "{name}");
-        assert_eq!(format!("{file:?}"), format!("{s:?}"), "{name}");
+        assert_eq!(s.name(), name);
+        for back in [s.to_commented_toml(), s.to_toml_string()] {
+            let back = Scene::from_toml_str(&back).unwrap();
+            assert_eq!(format!("{back:?}"), format!("{file:?}"), "{name}");
+            assert_eq!(back, file, "{name}");
+        }
     }
 }

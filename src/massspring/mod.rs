@@ -3,8 +3,9 @@
 //! [`scenes`]) lives in [`crate::scene::massspring`]; this module holds the
 //! scene-independent forces, solvers and integrators ("driver").
 //!
-//! * [`scenes`]: the built-in `wire`, `three-particle` and `cloth`
-//!   (re-exported from [`crate::scene::massspring::builtin`]).
+//! * [`scenes`]: the built-in `wire`, `three-particle` and `cloth`, each
+//!   parsed from its file under `scenes/massspring/` by
+//!   [`crate::scene::builtin`].
 //! * [`forces`]: spring, damping and gravity forces, energies, Hessian blocks.
 //! * [`linear`]: sparse matrix, PCG with Jacobi / IC(0), dense direct solve.
 //! * [`integrators`]: forward / symplectic Euler, trapezoidal, backward Euler,
@@ -26,7 +27,6 @@ pub mod linear;
 
 use std::fmt;
 
-pub use crate::scene::massspring::builtin as scenes;
 pub use crate::scene::massspring::{MassSpringScene, System, V3};
 pub use driver::{Diagnostics, Energies, FrameReport, RunTotals, Simulation};
 pub use integrators::stability::StabilityInfo;
@@ -34,6 +34,33 @@ pub use integrators::{Integrator, IntegratorOptions, State, StepStats, StrainSol
 pub use linear::PreconditionerKind;
 
 use crate::scene::SceneError;
+
+/// The built-in mass-spring scenes, each parsed from its file under
+/// `scenes/massspring/` (the one list of built-ins is
+/// [`crate::scene::builtin`]).
+pub mod scenes {
+    use crate::scene::{builtin, builtin_names, Scene};
+
+    pub use crate::scene::builtin::{cloth, three_particle, wire};
+
+    use super::MassSpringScene;
+
+    /// `(name, one-line description)` of each built-in mass-spring scene.
+    pub fn names() -> Vec<(&'static str, &'static str)> {
+        builtin_names()
+            .into_iter()
+            .filter(|(name, _)| by_name(name).is_some())
+            .collect()
+    }
+
+    /// A built-in mass-spring scene by name.
+    pub fn by_name(name: &str) -> Option<MassSpringScene> {
+        match builtin(name) {
+            Some(Scene::MassSpring(s)) => Some(s),
+            _ => None,
+        }
+    }
+}
 
 /// Why a mass-spring simulation could not be built or advanced.
 #[derive(Debug, Clone, PartialEq)]

@@ -15,7 +15,7 @@ pub mod overrides;
 pub(crate) mod readers;
 pub mod yarn;
 
-pub use builtin::{builtin, builtin_names, DEFAULT_SCENE};
+pub use builtin::{builtin, builtin_names, builtin_toml, DEFAULT_SCENE};
 pub use error::SceneError;
 pub use fields::{FieldDoc, MASS_SPRING_FIELDS, YARN_FIELDS};
 pub use massspring::MassSpringScene;

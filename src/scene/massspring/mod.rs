@@ -8,12 +8,10 @@
 //! file form. See the README, "Mass-spring scene files", for every field with
 //! its unit and default.
 //!
-//! * [`builtin`]: the built-in `wire`, `three-particle` and `cloth`.
 //! * [`system`]: the expanded scene, flat arrays.
 //! * `build`: the expansion, one function per scene element.
 
 mod build;
-pub mod builtin;
 mod overlap;
 pub mod system;
 
@@ -388,7 +386,7 @@ damping = 100.0
     #[test]
     fn sheet_has_the_cloth_scripts_edge_count() {
         // the built-in cloth: the cloth scripts' 21 x 21 sheet over 10 m
-        let s = super::builtin::cloth().build().unwrap();
+        let s = crate::scene::builtin::cloth().build().unwrap();
         assert_eq!(s.len(), 441);
         // 20*21 horizontal + 20*21 vertical + 20*20 diagonals.
         assert_eq!(s.springs.len(), 1240);
