@@ -302,14 +302,21 @@ count = 2
 /// over a half circle).
 #[derive(Clone, Copy, Debug)]
 pub struct Capstan {
+    /// Grid resolution (cells per side).
     pub res: u32,
+    /// Substep in s.
     pub dt: f64,
     /// Gravity (the capstan's slip threshold does not depend on it).
     pub g: f64,
+    /// Fibre shear stiffness in N/m.
     pub gamma: f64,
+    /// Young's modulus of the cross-section in N/m.
     pub youngs_modulus: f64,
+    /// Mohr-Coulomb friction coefficient between fibres.
     pub friction: f64,
+    /// Bending stiffness in N m.
     pub bending: f64,
+    /// Whether the Mohr-Coulomb return mapping is on.
     pub plasticity: bool,
 }
 

@@ -10,7 +10,7 @@ use yarnsim::scene::{builtin, builtin_names, FieldDoc, Scene, MASS_SPRING_FIELDS
 /// safety and cap, an implicit integrator, a polyline, a yarn by
 /// direction, pins of every motion, a description with a line break.
 const RICH_YARN: &str = r#"
-name = "rich"
+name = "rich-yarn"
 description = """two lines,
 the second with "quotes" and x = 1"""
 gravity = [0.1, -3.0]
@@ -93,7 +93,7 @@ motion = "input"
 /// A mass-spring scene with every element kind and optional field.
 const RICH_MASS_SPRING: &str = r#"
 kind = "mass-spring"
-name = "rich"
+name = "rich-mass-spring"
 gravity = [0.0, -9.81, 0.5]
 pinned = [0, 3]
 

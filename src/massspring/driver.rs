@@ -27,7 +27,9 @@ use crate::scene::massspring::{MassSpringScene, System, V3};
 /// Energies of the current state in J.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Energies {
+    /// Kinetic energy `sum m v^2 / 2`.
     pub kinetic: f64,
+    /// Elastic energy of the springs `sum k (l - l0)^2 / 2`.
     pub elastic: f64,
     /// `-sum m g . x`.
     pub gravity: f64,
@@ -82,9 +84,13 @@ pub struct Diagnostics {
 /// Totals since the simulation was built.
 #[derive(Clone, Copy, Debug, PartialEq, Default)]
 pub struct RunTotals {
+    /// Steps taken.
     pub steps: u64,
+    /// Conjugate-gradient iterations over all linear solves.
     pub cg_iterations: u64,
+    /// Linear solves.
     pub linear_solves: u64,
+    /// Sphere collisions resolved (particles projected out of a sphere).
     pub collisions: u64,
 }
 
@@ -326,8 +332,11 @@ impl Simulation {
     pub fn state(&self) -> &State {
         &self.state
     }
-    /// Mutable state (for tests and perturbations; kinematic particles are
-    /// reset by the next step).
+    /// The state to set: the clock before a substep (the FMU and the CLI put
+    /// it on their substep grid, `k dt`, so the driven particles follow it),
+    /// positions and velocities when a saved state is restored (the FMU's
+    /// `fmi2SetFMUstate`), or a perturbed start. Kinematic particles are
+    /// reset by the next step.
     pub fn state_mut(&mut self) -> &mut State {
         &mut self.state
     }
@@ -347,9 +356,11 @@ impl Simulation {
     pub fn system(&self) -> &System {
         &self.system
     }
+    /// The integrator this simulation steps with.
     pub fn integrator(&self) -> Integrator {
         self.integrator
     }
+    /// The integrator's options.
     pub fn options(&self) -> &IntegratorOptions {
         &self.options
     }

@@ -69,13 +69,25 @@ pub enum MassSpringError {
     Scene(SceneError),
     /// The integrator makes no sense for this scene (or these options).
     Unsupported {
+        /// The integrator asked for.
         integrator: Integrator,
+        /// Why it cannot run the scene.
         reason: String,
     },
     /// A linear solve failed.
-    Solver { time: f64, message: String },
+    Solver {
+        /// Simulation time of the failed step in s.
+        time: f64,
+        /// The solver's message.
+        message: String,
+    },
     /// Positions or velocities became non-finite.
-    Diverged { time: f64, step: u64 },
+    Diverged {
+        /// Simulation time in s.
+        time: f64,
+        /// The step that diverged.
+        step: u64,
+    },
     /// A bad argument (step size, end time).
     Argument(String),
 }

@@ -15,8 +15,11 @@ pub struct Qr2 {
     pub c: f64,
     /// sin of the rotation angle.
     pub s: f64,
+    /// `R[0][0]`, never negative.
     pub r11: f64,
+    /// `R[0][1]`.
     pub r12: f64,
+    /// `R[1][1]`; negative when `f` is inverted (`det f < 0`).
     pub r22: f64,
 }
 

@@ -7,29 +7,49 @@ use std::fmt;
 #[derive(Debug, Clone, PartialEq)]
 pub enum SceneError {
     /// The file could not be read.
-    Io { path: String, message: String },
+    Io {
+        /// The path as given.
+        path: String,
+        /// The operating system's message.
+        message: String,
+    },
     /// The TOML text is malformed or a field has a bad value. `line` is 1-based.
     Parse {
+        /// 1-based line, where the file has one.
         line: Option<usize>,
+        /// The field's path (`material.friction`, `yarns[2].vertices`), where known.
         field: Option<String>,
+        /// What is wrong.
         message: String,
     },
     /// A value is valid on its own but not in combination with others.
     Invalid {
+        /// The field's path.
         field: String,
+        /// 1-based line, where the file has one.
         line: Option<usize>,
+        /// What is wrong.
         message: String,
     },
     /// No built-in scene has this name.
-    UnknownScene { name: String, known: Vec<String> },
+    UnknownScene {
+        /// The name asked for.
+        name: String,
+        /// The names of the built-ins.
+        known: Vec<String>,
+    },
     /// A `--set KEY=VALUE` override (see [`crate::scene::overrides`]) is
     /// malformed or gives the scene a bad value. `argument` is the 1-based
     /// position of the override among all of them; `field` is named when it
     /// is not the override's own key.
     Override {
+        /// 1-based position of the override among all of them.
         argument: usize,
+        /// The override as given (`KEY=VALUE`).
         text: String,
+        /// The field the message is about, when it is not the override's own key.
         field: Option<String>,
+        /// What is wrong.
         message: String,
     },
 }

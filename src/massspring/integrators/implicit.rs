@@ -34,7 +34,9 @@ use crate::scene::massspring::{System, V3};
 /// Which implicit scheme.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Scheme {
+    /// Backward Euler (Baraff and Witkin 1998): forces at the end of the step.
     BackwardEuler,
+    /// The trapezoidal rule: the mean of the forces at both ends of the step.
     Trapezoidal,
 }
 
@@ -51,6 +53,7 @@ impl Scheme {
 /// The linear system of one implicit step, exposed for tests and benchmarks.
 #[derive(Clone, Debug)]
 pub struct StepSystem {
+    /// Which particle dofs are free and where they sit in the system.
     pub map: DofMap,
     /// `M + theta h B + theta h c H` over the free dofs.
     pub matrix: CsrMatrix,

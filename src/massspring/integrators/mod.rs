@@ -27,7 +27,9 @@ pub use pbd::StrainSolver;
 /// Positions, velocities and time of a simulation.
 #[derive(Clone, Debug, PartialEq)]
 pub struct State {
+    /// Positions in m.
     pub x: Vec<V3>,
+    /// Velocities in m/s.
     pub v: Vec<V3>,
     /// Time in s.
     pub t: f64,

@@ -148,8 +148,11 @@ impl Ic0 {
 /// A ready-to-apply preconditioner.
 #[derive(Clone, Debug)]
 pub enum Preconditioner {
+    /// No preconditioning.
     None,
+    /// Jacobi: the inverse of the diagonal (1 where it is 0).
     Jacobi(Vec<f64>),
+    /// Incomplete Cholesky without fill-in.
     Ic0(Ic0),
 }
 
@@ -189,6 +192,7 @@ pub struct CgResult {
     pub iterations: usize,
     /// Final `|b - A x| / |b|` (0 when `b = 0`).
     pub relative_residual: f64,
+    /// Whether the residual reached the tolerance.
     pub converged: bool,
 }
 

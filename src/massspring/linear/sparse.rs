@@ -13,8 +13,11 @@ use crate::scene::massspring::Spring;
 pub struct CsrMatrix {
     /// Number of rows and columns.
     pub n: usize,
+    /// Start of each row in `col` and `val` (`n + 1` entries).
     pub row_ptr: Vec<usize>,
+    /// Column index of each stored entry.
     pub col: Vec<usize>,
+    /// Value of each stored entry.
     pub val: Vec<f64>,
 }
 

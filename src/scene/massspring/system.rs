@@ -10,7 +10,9 @@ pub type V3 = Vector3<f64>;
 /// One spring of the expanded system.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Spring {
+    /// Index of the first particle.
     pub a: usize,
+    /// Index of the second particle.
     pub b: usize,
     /// Stiffness in N/m.
     pub k: f64,
@@ -29,10 +31,15 @@ pub enum Kinematic {
     Pinned(V3),
     /// Driven on a circle.
     Circle {
+        /// Centre of the circle in m.
         center: V3,
+        /// Position relative to the centre at phase pi/2 (the `sin` axis) in m.
         u: V3,
+        /// Position relative to the centre at phase 0 (the `cos` axis) in m.
         v: V3,
+        /// Angular velocity in rad/s.
         omega: f64,
+        /// Phase at t = 0 in rad.
         phase: f64,
     },
 }
@@ -66,7 +73,9 @@ impl Kinematic {
 /// A sphere collider of the expanded system.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Sphere {
+    /// Centre in m.
     pub center: V3,
+    /// Radius in m.
     pub radius: f64,
 }
 
@@ -79,18 +88,25 @@ pub struct System {
     pub velocities: Vec<V3>,
     /// Masses in kg.
     pub masses: Vec<f64>,
+    /// Springs between particles.
     pub springs: Vec<Spring>,
     /// One entry per particle.
     pub kinematics: Vec<Kinematic>,
+    /// Sphere colliders.
     pub spheres: Vec<Sphere>,
     /// Gravity in m/s^2.
     pub gravity: V3,
+    /// Time between output frames in s.
     pub frame_time: f64,
+    /// Number of frames of a whole run.
     pub frames: u32,
     /// Step of the implicit integrators in s.
     pub time_step: f64,
+    /// Fraction of the explicit integrators' stability bound they step with.
     pub cfl_number: f64,
+    /// Fraction of the free particles' velocity kept per `frame_time`.
     pub velocity_damping: f64,
+    /// Largest spring strain `|l/l0 - 1|` the strain limiting allows, if any.
     pub strain_limit: Option<f64>,
 }
 

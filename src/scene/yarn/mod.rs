@@ -25,21 +25,28 @@ pub struct YarnScene {
     /// One line of description.
     #[serde(default)]
     pub description: String,
+    /// The background grid (`[grid]`).
     pub grid: GridSpec,
+    /// Substep, output frames and integrator (`[time]`).
     pub time: TimeSpec,
+    /// The yarns' material (`[material]`).
     pub material: Material,
     /// Gravity acceleration `[gx, gy]` in m/s^2 (default `[0, -9.8]`).
     #[serde(default = "default_gravity", deserialize_with = "finite2")]
     pub gravity: [f64; 2],
     #[serde(default)]
+    /// The point attractor (`[attractor]`, off by default).
     pub attractor: AttractorSpec,
     #[serde(default)]
+    /// The domain's walls (`[walls]`).
     pub walls: Walls,
     #[serde(default)]
+    /// Circular obstacles (`[[obstacles]]`).
     pub obstacles: Vec<Obstacle>,
     /// How particles take their velocity back from the grid.
     #[serde(default)]
     pub transfer: TransferSpec,
+    /// The yarns (`[[yarns]]`), each entry with its copies.
     pub yarns: Vec<YarnSpec>,
     /// Pinned or driven yarn vertices.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
@@ -488,30 +495,35 @@ pub struct YarnSpec {
         skip_serializing_if = "Option::is_none",
         deserialize_with = "opt_finite2"
     )]
+    /// First point of a straight yarn in m.
     pub start: Option<[f64; 2]>,
     #[serde(
         default,
         skip_serializing_if = "Option::is_none",
         deserialize_with = "opt_finite2"
     )]
+    /// Last point of a straight yarn in m (or give `direction` and `length`).
     pub end: Option<[f64; 2]>,
     #[serde(
         default,
         skip_serializing_if = "Option::is_none",
         deserialize_with = "opt_finite2"
     )]
+    /// Direction from `start` of a straight yarn given by `direction` and `length` (not zero).
     pub direction: Option<[f64; 2]>,
     #[serde(
         default,
         skip_serializing_if = "Option::is_none",
         deserialize_with = "opt_positive"
     )]
+    /// Length in m of a straight yarn given by `direction` and `length`.
     pub length: Option<f64>,
     #[serde(
         default,
         skip_serializing_if = "Option::is_none",
         deserialize_with = "opt_points"
     )]
+    /// The points of a polyline yarn in m (instead of `start`).
     pub points: Option<Vec<[f64; 2]>>,
     /// Number of type-2 vertices (2 or more).
     #[serde(deserialize_with = "vertex_count")]
