@@ -20,10 +20,12 @@
 //! assert_eq!(sim.positions().len(), 11);
 //! ```
 
-pub mod driver;
-pub mod forces;
+pub(crate) mod driver;
+pub(crate) mod forces;
 pub mod integrators;
-pub mod linear;
+pub(crate) mod linear;
+#[cfg(test)]
+mod solver_tests;
 
 use std::fmt;
 

@@ -7,13 +7,13 @@
 //! Built-in scenes are listed by [`builtin_names`].
 
 pub mod builtin;
-pub mod commented;
-pub mod error;
+pub(crate) mod commented;
+pub(crate) mod error;
 pub mod fields;
 pub mod massspring;
 pub mod overrides;
 pub(crate) mod readers;
-pub mod yarn;
+pub(crate) mod yarn;
 
 pub use builtin::{builtin, builtin_names, builtin_toml, DEFAULT_SCENE};
 pub use error::SceneError;

@@ -11,10 +11,10 @@
 //! * [`Integrator::Pbd`]: Müller et al. 2007's position-based model (inertia, gravity
 //!   and strain limiting, no spring forces).
 
-pub mod chebyshev;
-pub mod explicit;
-pub mod implicit;
-pub mod pbd;
+pub(crate) mod chebyshev;
+pub(crate) mod explicit;
+pub(crate) mod implicit;
+pub(crate) mod pbd;
 pub mod stability;
 
 use std::fmt;

@@ -53,8 +53,6 @@ pub struct Ic0 {
     col: Vec<usize>,
     val: Vec<f64>,
     diag: Vec<f64>,
-    /// Diagonal shift that was needed to avoid breakdown (0 normally).
-    pub shift: f64,
 }
 
 impl Ic0 {
@@ -120,7 +118,6 @@ impl Ic0 {
             col,
             val,
             diag,
-            shift,
         })
     }
 

@@ -4,7 +4,7 @@
 //! `(a,b)`, `(b,a)`. Rows are ordered particle by particle, `x, y, z` within
 //! a particle, so a chain gives a block-tridiagonal matrix.
 
-use nalgebra::{DMatrix, Matrix3};
+use nalgebra::Matrix3;
 
 use crate::scene::massspring::Spring;
 
@@ -47,14 +47,10 @@ impl CsrMatrix {
         (0..self.n).map(|i| self.get(i, i)).collect()
     }
 
-    /// Number of stored entries.
-    pub fn nnz(&self) -> usize {
-        self.val.len()
-    }
-
     /// The matrix as a dense nalgebra matrix.
-    pub fn to_dense(&self) -> DMatrix<f64> {
-        let mut d = DMatrix::zeros(self.n, self.n);
+    #[cfg(test)]
+    pub fn to_dense(&self) -> nalgebra::DMatrix<f64> {
+        let mut d = nalgebra::DMatrix::zeros(self.n, self.n);
         for i in 0..self.n {
             for k in self.row_ptr[i]..self.row_ptr[i + 1] {
                 d[(i, self.col[k])] = self.val[k];
@@ -64,6 +60,7 @@ impl CsrMatrix {
     }
 
     /// Largest `|A_ij - A_ji|`.
+    #[cfg(test)]
     pub fn asymmetry(&self) -> f64 {
         let mut worst: f64 = 0.0;
         for i in 0..self.n {

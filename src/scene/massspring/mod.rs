@@ -13,7 +13,7 @@
 
 mod build;
 mod overlap;
-pub mod system;
+pub(crate) mod system;
 
 use serde::{Deserialize, Deserializer, Serialize};
 

@@ -1,14 +1,15 @@
 //! Linear and iterative solvers of the mass-spring integrators: IC(0)-PCG on
 //! the wire, Baraff and Witkin 1998's 3-particle system against a dense direct solve,
-//! Chebyshev against plain Jacobi.
+//! Chebyshev against plain Jacobi. Unit tests: they call the solvers, which
+//! are the crate's machinery, not its API (moved from `tests/`).
 
-use nalgebra::{DMatrix, DVector, Matrix3};
-use yarnsim::massspring::integrators::chebyshev;
-use yarnsim::massspring::integrators::implicit::{step_system, Scheme};
-use yarnsim::massspring::linear::{dense_solve, pcg, Preconditioner};
-use yarnsim::massspring::{
+use crate::massspring::integrators::chebyshev;
+use crate::massspring::integrators::implicit::{step_system, Scheme};
+use crate::massspring::linear::{dense_solve, pcg, Preconditioner};
+use crate::massspring::{
     scenes, Integrator, IntegratorOptions, PreconditionerKind, Simulation, State, V3,
 };
+use nalgebra::{DMatrix, DVector, Matrix3};
 
 #[test]
 fn ic0_pcg_on_the_driven_wire_converges_in_one_iteration() {
