@@ -83,7 +83,7 @@ pub fn builtin(name: &str) -> Option<Scene> {
 ///
 /// # Panics
 /// If `name` is no built-in yarn scene.
-pub fn builtin_yarn(name: &str) -> YarnScene {
+fn builtin_yarn(name: &str) -> YarnScene {
     match builtin(name) {
         Some(Scene::Yarn(s)) => s,
         _ => panic!("{name:?} is no built-in yarn scene"),
@@ -95,7 +95,7 @@ pub fn builtin_yarn(name: &str) -> YarnScene {
 ///
 /// # Panics
 /// If `name` is no built-in mass-spring scene.
-pub fn builtin_mass_spring(name: &str) -> MassSpringScene {
+fn builtin_mass_spring(name: &str) -> MassSpringScene {
     match builtin(name) {
         Some(Scene::MassSpring(s)) => s,
         _ => panic!("{name:?} is no built-in mass-spring scene"),

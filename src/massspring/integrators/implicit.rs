@@ -50,7 +50,7 @@ impl Scheme {
     }
 }
 
-/// The linear system of one implicit step, exposed for tests and benchmarks.
+/// The linear system of one implicit step (its unit tests check it against a direct solve).
 #[derive(Clone, Debug)]
 pub struct StepSystem {
     /// Which particle dofs are free and where they sit in the system.
