@@ -9,7 +9,7 @@
 use std::fmt::Write as _;
 
 use yarnsim::scene::Scene;
-pub use YarnBundle::ffi::FMI2_FUNCTIONS;
+pub use YarnBundle::fmi2::FMI2_FUNCTIONS;
 pub use YarnBundle::fmi3::FMI3_FUNCTIONS;
 use YarnBundle::model::{xml_escape, SCENE_FILE};
 use YarnBundle::SceneFmu;

@@ -20,7 +20,7 @@ use std::ffi::CString;
 use std::hint::black_box;
 use std::time::Instant;
 
-use YarnBundle::ffi::*;
+use YarnBundle::fmi2::*;
 use YarnBundle::fmi3::common::*;
 use YarnBundle::fmi3::cosim::fmi3DoStep;
 use YarnBundle::fmi3::values::fmi3GetFloat64;

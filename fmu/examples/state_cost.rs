@@ -22,7 +22,7 @@ use std::sync::atomic::{AtomicUsize, Ordering::Relaxed};
 use std::time::Instant;
 
 use yarnsim::scene::{Scene, DEFAULT_SCENE};
-use YarnBundle::ffi::*;
+use YarnBundle::fmi2::*;
 use YarnBundle::yarn::variables::*;
 
 mod common;

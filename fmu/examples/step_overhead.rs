@@ -29,7 +29,7 @@ use std::time::Instant;
 use yarnsim::massspring::Simulation;
 use yarnsim::mpm::YarnSim;
 use yarnsim::scene::Scene;
-use YarnBundle::ffi::*;
+use YarnBundle::fmi2::*;
 use YarnBundle::fmu_model::FmuModel;
 use YarnBundle::massspring::{self as ms, MsModel};
 use YarnBundle::model::*;

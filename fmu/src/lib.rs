@@ -2,7 +2,7 @@
 //!
 //! The cdylib (`libYarnBundle.so`, shipped as `binaries/linux64/YarnBundle.so`,
 //! or as `binaries/linux64/MassSpring.so` in a mass-spring FMU) exports the 34
-//! `fmi2*` functions of FMI 2.0 Co-Simulation ([`ffi`]) and the 75 `fmi3*`
+//! `fmi2*` functions of FMI 2.0 Co-Simulation ([`fmi2`]) and the 75 `fmi3*`
 //! functions of FMI 3.0 ([`fmi3`]; Co-Simulation works, the rest returns
 //! fmi3Error with a logged reason). The FMI 3.0 FMU (`build-fmu
 //! --fmi-version 3`, the library under `binaries/x86_64-linux/`) has the same
@@ -37,9 +37,13 @@
 //! * [`models`]: the bundled scene's model, identifier, GUID and description
 //!   (the one module that knows both models).
 //! * [`instance`]: an instance around either model: stepping, values.
-//! * [`ffi`]: the FMI 2.0 C ABI; [`fmi3`]: the FMI 3.0 C ABI (the same
+//! * [`shell`]: the C-ABI shell both versions share (the instance check,
+//!   the logged failures, the caught panics, the pointer helpers, the
+//!   export macros, the FMU-state bodies).
+//! * [`fmi2`]: the FMI 2.0 C ABI; [`fmi3`]: the FMI 3.0 C ABI (the same
 //!   instance with [`state_machine::Api::Fmi3`]: the table's fmi3 rows, FMI
-//!   3.0 words in the log, the non-variadic logger).
+//!   3.0 words in the log, the non-variadic logger). Siblings: neither
+//!   imports the other.
 //!
 //! See `docs/fmu.md` for the FMI 2.0 FMUs (variables, build command) and
 //! `docs/fmu3.md` for the FMI 3.0 ones (arrays, fmpy, what differs).
@@ -47,12 +51,12 @@
 // The crate is named after the FMI modelIdentifier `YarnBundle`.
 #![allow(non_snake_case)]
 // Every unsafe operation sits in its own `unsafe` block with a SAFETY
-// comment, also inside `unsafe fn` (the C ABIs in `ffi/` and `fmi3/`): the workspace
+// comment, also inside `unsafe fn` (the C ABIs in `fmi2/`, `fmi3/` and `shell/`): the workspace
 // lints `unsafe_op_in_unsafe_fn` and `clippy::undocumented_unsafe_blocks`
 // (Cargo.toml) deny anything else.
 
 pub mod clock;
-pub mod ffi;
+pub mod fmi2;
 pub mod fmi3;
 pub mod fmu_model;
 pub mod instance;
@@ -61,6 +65,7 @@ pub mod massspring;
 pub mod model;
 pub mod models;
 pub mod resources;
+pub mod shell;
 pub mod snapshot;
 pub mod state_bytes;
 pub mod state_machine;

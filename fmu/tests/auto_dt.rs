@@ -10,7 +10,7 @@ use std::ffi::c_int;
 use common::*;
 use yarnsim::mpm::YarnSim;
 use yarnsim::scene::{StepSize, YarnScene};
-use YarnBundle::ffi::*;
+use YarnBundle::fmi2::*;
 use YarnBundle::model::*;
 use YarnBundle::yarn::variables::*;
 

@@ -9,7 +9,7 @@ use std::ffi::{c_int, CString};
 
 use common::*;
 use yarnsim::massspring::scenes::wire;
-use YarnBundle::ffi::*;
+use YarnBundle::fmi2::*;
 use YarnBundle::model::{self as neutral, Dependency, VarType, Variable, VR_SUBSTEPS};
 use YarnBundle::yarn::variables::{self as model, VR_INTEGRATOR, VR_SCENE};
 

@@ -7,7 +7,7 @@ use std::ffi::{c_char, CString};
 
 use common::*;
 use yarnsim::scene::YarnScene;
-use YarnBundle::ffi::*;
+use YarnBundle::fmi2::*;
 use YarnBundle::model::*;
 use YarnBundle::yarn::variables::*;
 

@@ -12,7 +12,7 @@ use common::assert_refused_state;
 use common3::*;
 use YarnBundle::fmi3::common::*;
 use YarnBundle::fmi3::cosim::*;
-use YarnBundle::fmi3::state::*;
+use YarnBundle::fmi3::fmu_state::*;
 use YarnBundle::fmi3::unsupported::*;
 use YarnBundle::fmi3::values::*;
 use YarnBundle::fmi3::*;

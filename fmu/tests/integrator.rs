@@ -15,7 +15,7 @@ use common3::Fmu3;
 use yarnsim::scene::{Integrator, StepSize, YarnScene};
 use yarnsim::testing::{hanging_chain_floor_period, hanging_chain_toml, ZeroCrossings};
 use yarnsim::YarnSim;
-use YarnBundle::ffi::*;
+use YarnBundle::fmi2::*;
 use YarnBundle::fmi3::common::*;
 use YarnBundle::fmi3::values::fmi3SetString;
 use YarnBundle::fmi3::*;

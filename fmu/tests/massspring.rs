@@ -11,7 +11,7 @@ use common::*;
 use yarnsim::massspring::scenes::{cloth, wire};
 use yarnsim::massspring::{Integrator, IntegratorOptions, MassSpringScene, Simulation, V3};
 use yarnsim::scene::Scene;
-use YarnBundle::ffi::*;
+use YarnBundle::fmi2::*;
 use YarnBundle::massspring::*;
 use YarnBundle::SceneFmu;
 

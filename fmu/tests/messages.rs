@@ -14,8 +14,8 @@ use std::ffi::{c_int, CString};
 
 use common::*;
 use common3::Fmu3;
-use YarnBundle::ffi::*;
-use YarnBundle::fmi3::state::*;
+use YarnBundle::fmi2::*;
+use YarnBundle::fmi3::fmu_state::*;
 use YarnBundle::fmi3::unsupported::fmi3GetFloat32;
 use YarnBundle::fmi3::values::*;
 use YarnBundle::fmi3::*;

@@ -11,7 +11,7 @@ use yarnsim::math::Vec2;
 use yarnsim::mpm::YarnSim;
 use yarnsim::scene::{PinMotionKind, TransferScheme, YarnScene, YarnSpec};
 use yarnsim::testing::{hanging_chain_toml, CHAIN_GRAVITY};
-use YarnBundle::ffi::*;
+use YarnBundle::fmi2::*;
 use YarnBundle::yarn::variables::*;
 
 const H: f64 = 0.01;

@@ -9,7 +9,7 @@ use std::time::Instant;
 
 use common::*;
 use yarnsim::massspring::scenes::wire;
-use YarnBundle::ffi::*;
+use YarnBundle::fmi2::*;
 use YarnBundle::model::*;
 use YarnBundle::yarn::variables::*;
 

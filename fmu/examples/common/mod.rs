@@ -5,7 +5,7 @@ use std::ffi::CString;
 use std::path::PathBuf;
 
 use yarnsim::scene::Scene;
-use YarnBundle::ffi::*;
+use YarnBundle::fmi2::*;
 use YarnBundle::model::*;
 use YarnBundle::SceneFmu;
 

@@ -1,8 +1,8 @@
 //! The FMI 3.0 C ABI: all 75 functions of `fmi3FunctionTypes.h` (FMI 3.0
 //! standard, chapter 2.2 and 4.2), exported by the same cdylib as the FMI 2.0
-//! functions ([`crate::ffi`]) and a thin shell over the same [`Instance`] and
+//! functions ([`crate::fmi2`]) and a thin shell over the same [`Instance`] and
 //! models. Co-Simulation without event mode works ([`common`], [`values`],
-//! [`state`], [`cosim`]); Model Exchange, Scheduled Execution, clocks,
+//! [`fmu_state`], [`cosim`]); Model Exchange, Scheduled Execution, clocks,
 //! intervals, Binary and the other integer and float types, directional and
 //! adjoint derivatives and output derivatives return `fmi3Error` with a
 //! logged reason ([`unsupported`]), as the modelDescription declares.
@@ -25,12 +25,12 @@ use std::ffi::{c_char, c_int, c_void};
 
 pub mod common;
 pub mod cosim;
-pub mod state;
+pub mod fmu_state;
 pub mod unsupported;
 pub mod values;
 
-use crate::ffi::call;
 use crate::instance::{Instance, Status};
+use crate::shell::call;
 
 pub type fmi3Instance = *mut c_void;
 pub type fmi3InstanceEnvironment = *mut c_void;

@@ -9,8 +9,8 @@
 use libc::size_t;
 
 use super::*;
-use crate::ffi::{exports, slice};
 use crate::instance::error;
+use crate::shell::{exports, slice};
 
 /// Exports functions that always refuse: `name(args) => reason;`.
 macro_rules! refused {

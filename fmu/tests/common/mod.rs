@@ -8,7 +8,7 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Mutex;
 
 use yarnsim::scene::YarnScene;
-use YarnBundle::ffi::*;
+use YarnBundle::fmi2::*;
 use YarnBundle::instance::Logger;
 use YarnBundle::model::*;
 use YarnBundle::yarn::variables::*;

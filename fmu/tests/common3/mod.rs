@@ -12,7 +12,7 @@ use crate::common::resources_with;
 use yarnsim::scene::Scene;
 use YarnBundle::fmi3::common::*;
 use YarnBundle::fmi3::cosim::*;
-use YarnBundle::fmi3::state::*;
+use YarnBundle::fmi3::fmu_state::*;
 use YarnBundle::fmi3::values::*;
 use YarnBundle::fmi3::*;
 use YarnBundle::SceneFmu;

@@ -5,7 +5,7 @@
 use libc::size_t;
 
 use super::*;
-use crate::ffi::{null, slice_mut, state_exports};
+use crate::shell::{null, slice_mut, state_exports};
 
 state_exports! { call3(fmi3Instance) -> fmi3Status, fmi3FMUState, fmi3Byte;
     fmi3GetFMUState, fmi3SetFMUState, fmi3FreeFMUState,
