@@ -68,7 +68,6 @@ pub mod resources;
 pub mod shell;
 pub mod snapshot;
 pub mod state_bytes;
-pub mod state_machine;
 pub mod yarn;
 
 pub use models::{new_model, scene_from_toml_str, SceneFmu};

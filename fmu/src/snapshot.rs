@@ -9,8 +9,8 @@ use yarnsim::mpm::state::fnv1a;
 
 use crate::clock::Clock;
 use crate::fmu_model::{FmuModel, ModelState};
+use crate::instance::Phase;
 use crate::state_bytes::{Reader, Writer, STATE_HEADER, STATE_MAGICS, STATE_VERSION};
-use crate::state_machine::Phase;
 
 /// A saved FMU state (`fmi2FMUstate`).
 pub struct Snapshot {

@@ -5,7 +5,7 @@
 use libc::size_t;
 
 use super::*;
-use crate::instance::{error, Res, Status, LOG_ALL};
+use crate::instance::{error, Operation, Res, Status, LOG_ALL};
 use crate::shell::{exports, null};
 
 exports! { call(fmi2Component) -> fmi2Status;
@@ -34,10 +34,11 @@ fn discard(msg: String) -> Res<Status> {
     })
 }
 
-/// Exports the status getters: `name(value type) |inst, kind, value| body;`
+/// Exports the status getters: `name(value type) operation |inst, kind,
+/// value| body;`
 /// after the state check and the null check of `value`.
 macro_rules! status_exports {
-    ($($name:ident($ty:ty) |$i:ident, $s:ident, $v:pat_param| $body:expr;)*) => {$(
+    ($($name:ident($ty:ty) $op:ident |$i:ident, $s:ident, $v:pat_param| $body:expr;)*) => {$(
         #[no_mangle]
         pub unsafe extern "C" fn $name(
             c: fmi2Component,
@@ -45,7 +46,7 @@ macro_rules! status_exports {
             value: *mut $ty,
         ) -> fmi2Status {
             call(c, stringify!($name), |$i| {
-                $i.require(stringify!($name))?;
+                $i.require(Operation::$op)?;
                 // SAFETY: `value` is null or points to a writable value (FMI contract).
                 let Some($v) = (unsafe { value.as_mut() }) else {
                     return null(stringify!($name), "value");
@@ -57,25 +58,25 @@ macro_rules! status_exports {
 }
 
 status_exports! {
-    fmi2GetStatus(fmi2Status) |_inst, s, _| {
+    fmi2GetStatus(fmi2Status) GetStatus |_inst, s, _| {
         discard(format!("status kind {s} is not available: fmi2DoStep never returns fmi2Pending"))
     };
-    fmi2GetRealStatus(fmi2Real) |inst, s, v| {
+    fmi2GetRealStatus(fmi2Real) GetRealStatus |inst, s, v| {
         if s != fmi2LastSuccessfulTime {
             return discard(format!("status kind {s} has no Real value"));
         }
         *v = inst.last_successful_time();
         Ok(Status::Ok)
     };
-    fmi2GetIntegerStatus(fmi2Integer) |_inst, s, _| discard(format!("status kind {s} has no Integer value"));
-    fmi2GetBooleanStatus(fmi2Boolean) |inst, s, v| {
+    fmi2GetIntegerStatus(fmi2Integer) GetIntegerStatus |_inst, s, _| discard(format!("status kind {s} has no Integer value"));
+    fmi2GetBooleanStatus(fmi2Boolean) GetBooleanStatus |inst, s, v| {
         if s != fmi2Terminated {
             return discard(format!("status kind {s} has no Boolean value"));
         }
         *v = inst.terminated() as fmi2Boolean;
         Ok(Status::Ok)
     };
-    fmi2GetStringStatus(fmi2String) |_inst, s, v| {
+    fmi2GetStringStatus(fmi2String) GetStringStatus |_inst, s, v| {
         *v = c"".as_ptr();
         discard(format!("status kind {s} has no String value: fmi2DoStep never returns fmi2Pending"))
     };

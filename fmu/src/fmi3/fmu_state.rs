@@ -5,6 +5,7 @@
 use libc::size_t;
 
 use super::*;
+use crate::instance::Operation;
 use crate::shell::{null, slice_mut, state_exports};
 
 state_exports! { call3(fmi3Instance) -> fmi3Status, fmi3FMUState, fmi3Byte;
@@ -20,7 +21,7 @@ pub unsafe extern "C" fn fmi3GetNumberOfVariableDependencies(
 ) -> fmi3Status {
     let func = "fmi3GetNumberOfVariableDependencies";
     call3(instance, func, |inst| {
-        inst.require(func)?;
+        inst.require(Operation::GetNumberOfVariableDependencies)?;
         // SAFETY: null or a writable size_t (FMI contract).
         let Some(n) = (unsafe { nDependencies.as_mut() }) else {
             return null(func, "nDependencies");
@@ -42,7 +43,7 @@ pub unsafe extern "C" fn fmi3GetVariableDependencies(
 ) -> fmi3Status {
     let func = "fmi3GetVariableDependencies";
     call3(instance, func, |inst| {
-        inst.require(func)?;
+        inst.require(Operation::GetVariableDependencies)?;
         let deps = inst.variable_dependencies(dependent)?;
         if deps.len() != nDependencies {
             return crate::instance::error(format!(

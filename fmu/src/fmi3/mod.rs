@@ -11,7 +11,7 @@
 //! `fmi3Fatal` for that instance and never unwinds into the host) and logs
 //! every failure through the `fmi3LogMessageCallback`, which is not variadic
 //! (`(instanceEnvironment, status, category, message)`). The state table is
-//! [`crate::state_machine::ALLOWED`]'s `fmi3` rows.
+//! [`crate::instance::Operation::allowed`]'s FMI 3.0 rows.
 
 #![allow(
     non_snake_case,

@@ -24,7 +24,7 @@ impl Instance {
     /// (row-major); `out.len()` (nValues) must be their total. Never a
     /// non-finite value.
     pub fn get_float64(&mut self, vrs: &[u32], out: &mut [f64]) -> Res {
-        self.require("fmi2GetReal")?;
+        self.require(Operation::GetFloat)?;
         let physics = &self.model.physics;
         if vrs.iter().any(|&vr| physics.array_len(vr).is_some()) {
             self.model.ensure_built(self.count)?;
@@ -77,7 +77,7 @@ impl Instance {
 
     /// Sets Float64 inputs and parameters (no array is an input).
     pub fn set_float64(&mut self, vrs: &[u32], vals: &[f64]) -> Res {
-        self.require("fmi2SetReal")?;
+        self.require(Operation::SetFloat)?;
         if let Some(vr) = vrs
             .iter()
             .find(|&&vr| vr == VR_TIME || self.model.physics.array_len(vr).is_some())

@@ -8,7 +8,7 @@ use std::ffi::c_void;
 use libc::size_t;
 
 use super::{null, ok, slice};
-use crate::instance::{error, Instance, Res, Snapshot, Status};
+use crate::instance::{error, Instance, Operation, Res, Snapshot, Status};
 
 /// Exports the six FMU-state functions of either version over the bodies
 /// below: `call(instance type) -> status type, state type, byte type; get,
@@ -148,7 +148,7 @@ pub(crate) unsafe fn state_size(
     let Some(size) = (unsafe { size.as_mut() }) else {
         return null(func, "size");
     };
-    *size = inst.serialize(func, s)?.len();
+    *size = inst.serialize(Operation::SerializedFmuStateSize, s)?.len();
     Ok(Status::Ok)
 }
 
@@ -170,7 +170,7 @@ pub(crate) unsafe fn serialize_state(
     let Some(s) = (unsafe { Snapshot::from_ptr(FMUstate) }) else {
         return error("FMUstate is null or not an FMU state of this FMU");
     };
-    let bytes = inst.serialize(func, s)?;
+    let bytes = inst.serialize(Operation::SerializeFmuState, s)?;
     if size < bytes.len() {
         return error(format!(
             "buffer of {size} bytes is smaller than the state's {} ({size_func})",

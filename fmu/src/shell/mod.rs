@@ -28,7 +28,7 @@ const STATUS_ERROR: CStatus = Status::Error as CStatus;
 const STATUS_FATAL: CStatus = Status::Fatal as CStatus;
 
 use crate::instance::{
-    error, message_in, Instance, Phase, Res, Status, LOG_ALL, LOG_DISCARD, LOG_ERROR, LOG_FATAL,
+    error, Instance, Operation, Phase, Res, Status, LOG_ALL, LOG_DISCARD, LOG_ERROR, LOG_FATAL,
 };
 
 pub(crate) fn panic_message(p: &(dyn std::any::Any + Send)) -> String {
@@ -55,12 +55,11 @@ pub(crate) fn call(
         return STATUS_ERROR;
     };
     if inst.phase == Phase::Fatal {
+        let free = inst.op_name(Operation::FreeInstance);
         inst.log(
             Status::Fatal,
             LOG_FATAL,
-            &format!(
-                "{func}: the instance is in the fatal state; only fmi2FreeInstance is allowed"
-            ),
+            &format!("{func}: the instance is in the fatal state; only {free} is allowed"),
         );
         return STATUS_FATAL;
     }
@@ -80,12 +79,10 @@ pub(crate) fn call(
                 Status::Fatal => LOG_FATAL,
                 _ => LOG_ERROR,
             };
-            // An FMI 3.0 instance's messages in FMI 3.0 words (FMI 2.0: unchanged).
-            let shown = message_in(inst.api, &fail.msg);
-            let msg = if shown.starts_with(func) {
-                shown
+            let msg = if fail.msg.starts_with(func) {
+                fail.msg
             } else {
-                format!("{func}: {shown}")
+                format!("{func}: {}", fail.msg)
             };
             inst.log(fail.status, cat, &msg);
             match fail.status {
