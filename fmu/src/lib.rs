@@ -48,30 +48,27 @@
 //! See `docs/fmu.md` for the FMI 2.0 FMUs (variables, build command) and
 //! `docs/fmu3.md` for the FMI 3.0 ones (arrays, fmpy, what differs).
 
-// The crate is named after the FMI modelIdentifier `YarnBundle`.
-#![allow(non_snake_case)]
 // Every unsafe operation sits in its own `unsafe` block with a SAFETY
 // comment, also inside `unsafe fn` (the C ABIs in `fmi2/`, `fmi3/` and `shell/`): the workspace
 // lints `unsafe_op_in_unsafe_fn` and `clippy::undocumented_unsafe_blocks`
 // (Cargo.toml) deny anything else.
 
-pub mod clock;
 pub mod fmi2;
 pub mod fmi3;
-pub mod fmu_model;
 pub mod instance;
-pub mod logging;
-pub mod massspring;
-pub mod model;
+pub mod model_description;
 pub mod models;
-pub mod resources;
 pub mod shell;
-pub mod snapshot;
-pub mod state_bytes;
-pub mod yarn;
 
 pub use models::{new_model, scene_from_toml_str, SceneFmu};
-pub use yarn::variables::{guid, model_description, MODEL_IDENTIFIER};
+
+/// The shared library cargo builds (`target/<profile>/libyarnsim_fmu.so`):
+/// named after the crate, not after a model, since it hosts both
+/// (`YarnBundle`, `MassSpring`); the packager copies it into the FMU as
+/// `binaries/<platform>/<modelIdentifier>.so`, the name FMI requires
+/// (FMI 2.0.4, section 2.3; FMI 3.0, section 2.5, "FMU Distribution").
+pub const LIBRARY_FILE: &str = "libyarnsim_fmu.so";
+pub use models::yarn::variables::{guid, model_description, MODEL_IDENTIFIER};
 
 /// The exit code of a command-line tool of the FMU crates (`fmu-replay`,
 /// and `build-fmu` in yarnsim-fmu-pack): success, or failure with the error

@@ -8,7 +8,7 @@ use libc::size_t;
 
 use super::*;
 use crate::instance::{escape_nul, LOG_ERROR};
-use crate::model::LOG_CATEGORIES;
+use crate::model_description::LOG_CATEGORIES;
 use crate::shell::{debug_logging, exports, instantiate, ok, string};
 
 #[no_mangle]

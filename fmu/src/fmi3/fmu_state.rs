@@ -1,5 +1,5 @@
 //! FMI 3.0 FMU states (get, set, free, serialize, deserialize; the bytes
-//! are the FMI 2.0 FMU's framing, [`crate::state_bytes`]) and the variable
+//! are the FMI 2.0 FMU's framing, [`crate::models::state_bytes`]) and the variable
 //! dependencies of the outputs.
 
 use libc::size_t;

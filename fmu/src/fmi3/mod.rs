@@ -62,7 +62,7 @@ pub const fmi3Fatal: fmi3Status = Status::Fatal as c_int;
 pub const fmi3Dependent: fmi3DependencyKind = 5;
 
 /// `fmi3LogMessageCallback`.
-pub type fmi3LogMessageCallback = crate::logging::Logger3;
+pub type fmi3LogMessageCallback = crate::instance::logging::Logger3;
 /// `fmi3IntermediateUpdateCallback` (never called: no intermediate update).
 pub type fmi3IntermediateUpdateCallback = Option<
     unsafe extern "C" fn(

@@ -1,38 +1,42 @@
 //! One FMU instance: the time keeping, the stepping and the values around a
-//! [`FmuModel`] (the yarn bundle of [`crate::yarn`] or the mass-spring system
-//! of [`crate::massspring`]), independent of the C ABI (which lives in
-//! [`crate::ffi`]). The state table is in [`crate::state_machine`], the FMU
-//! state bytes in [`crate::state_bytes`], the resource location in
-//! [`crate::resources`], the logger in [`crate::logging`]; their items are
+//! [`FmuModel`] (the yarn bundle of [`crate::models::yarn`] or the mass-spring system
+//! of [`crate::models::massspring`]), independent of the C ABI (which lives in
+//! [`crate::fmi2`]). The state table is in [`crate::instance::phase`], the FMU
+//! state bytes in [`crate::models::state_bytes`], the resource location in
+//! [`crate::instance::resources`], the logger in [`crate::instance::logging`]; their items are
 //! re-exported here.
 
 use std::ffi::{c_int, c_void, CString};
 use std::path::PathBuf;
 
-mod fmi3;
+mod arrays;
+pub mod clock;
+mod fmu_state;
+pub mod logging;
 pub mod phase;
-mod states;
+pub mod resources;
+pub mod snapshot;
 mod values;
 
 use yarnsim::scene::Scene;
 
-pub use crate::clock::Clock;
-pub use crate::fmu_model::{
+pub use crate::models::model::{
     shown, FmuModel, ModelError, ModelResult, ModelState, ParamCheck, SetContext, StepFailure,
     VarName,
 };
-pub use crate::logging::*;
+pub use crate::models::state_bytes::*;
 pub use crate::models::{new_model, SceneFmu};
-use crate::resources::read_scene;
-pub use crate::resources::resource_path;
-pub use crate::snapshot::*;
-pub use crate::state_bytes::*;
+pub use clock::Clock;
+pub use logging::*;
 pub use phase::{
     error, parameter_settable, phase_name, phase_name_in, status_name, Api, Fail, Operation, Phase,
     Res, Status,
 };
+use resources::read_scene;
+pub use resources::resource_path;
+pub use snapshot::*;
 
-use crate::model::{
+use crate::model_description::{
     DEFAULT_MAX_SUBSTEPS, DEFAULT_THREADS, LOG_CATEGORIES, MAX_THREADS, SCENE_FILE,
     VR_MAX_SUBSTEPS, VR_SUBSTEPS, VR_THREADS,
 };
@@ -294,13 +298,13 @@ impl Instance {
     }
 
     /// The name and causality of any variable of the instance: the model's,
-    /// the common ones ([`crate::model::COMMON_VARIABLES`]) and, for FMI
+    /// the common ones ([`crate::model_description::COMMON_VARIABLES`]) and, for FMI
     /// 3.0, `time`.
     pub fn variable(&self, vr: u32) -> Option<VarName> {
-        if let Some((name, causality)) = crate::model::common_name(vr) {
+        if let Some((name, causality)) = crate::model_description::common_name(vr) {
             return Some(VarName::new(name, causality));
         }
-        if self.api == Api::Fmi3 && vr == crate::model::VR_TIME {
+        if self.api == Api::Fmi3 && vr == crate::model_description::VR_TIME {
             return Some(VarName::new("time", "independent"));
         }
         self.model.physics.variable(vr)

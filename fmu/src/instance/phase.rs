@@ -41,8 +41,8 @@ pub struct Fail {
 pub type Res<T = ()> = Result<T, Fail>;
 
 /// A model's refusal is an error status.
-impl From<crate::fmu_model::ModelError> for Fail {
-    fn from(e: crate::fmu_model::ModelError) -> Self {
+impl From<crate::models::model::ModelError> for Fail {
+    fn from(e: crate::models::model::ModelError) -> Self {
         Fail {
             status: Status::Error,
             msg: e.0,

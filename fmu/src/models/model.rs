@@ -1,11 +1,11 @@
 //! The interface between the FMI front end ([`crate::instance`],
-//! [`crate::ffi`]) and the models it runs: [`FmuModel`], implemented by the
-//! yarn bundle ([`crate::yarn::YarnModel`]) and the mass-spring system
-//! ([`crate::massspring::MsModel`]). The models know nothing of FMI
+//! [`crate::fmi2`]) and the models it runs: [`FmuModel`], implemented by the
+//! yarn bundle ([`crate::models::yarn::YarnModel`]) and the mass-spring system
+//! ([`crate::models::massspring::MsModel`]). The models know nothing of FMI
 //! statuses, function names or C types: they answer with typed errors
 //! ([`ModelError`], [`StepFailure`]) and Rust values, and the front end turns
 //! them into fmi2 and fmi3 statuses and log lines: the FMI 2.0 front end
-//! ([`crate::ffi`]) and the FMI 3.0 one ([`crate::fmi3`]) drive the same
+//! ([`crate::fmi2`]) and the FMI 3.0 one ([`crate::fmi3`]) drive the same
 //! models.
 
 use std::any::Any;
@@ -14,7 +14,7 @@ use std::path::Path;
 
 use yarnsim::scene::Scene;
 
-use crate::state_bytes::{Reader, Writer};
+use crate::models::state_bytes::{Reader, Writer};
 
 /// A model refused a call: a value out of range, an unknown variable, a
 /// scene or parameter set it cannot build. The front end answers fmi2Error
@@ -148,7 +148,7 @@ pub trait FmuModel: fmt::Debug + Send {
     /// Puts back a [`Self::checkpoint`] of this model.
     fn restore(&mut self, c: Checkpoint);
     /// The name and causality of the model's own variable `vr` (scalars of
-    /// every type and the FMI 3.0 arrays; not the [`crate::model::COMMON_VARIABLES`],
+    /// every type and the FMI 3.0 arrays; not the [`crate::model_description::COMMON_VARIABLES`],
     /// which the instance serves), `None` if it has none.
     fn variable(&self, vr: u32) -> Option<VarName>;
     /// The name of the model's own variable `vr` as a message shows it

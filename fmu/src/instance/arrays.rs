@@ -4,7 +4,7 @@
 //! `ModelStructure` dependencies of the outputs.
 
 use super::*;
-use crate::model::{fmi3_outputs, VR_TIME};
+use crate::model_description::{fmi3_outputs, VR_TIME};
 
 impl Instance {
     /// Fails unless `n_values` is the number of values of `vrs` (each a

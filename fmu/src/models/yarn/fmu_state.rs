@@ -8,7 +8,7 @@ use yarnsim::scene::{Integrator, TransferScheme, YarnScene};
 
 use super::variables::*;
 use super::{effective_scene, Config, Inputs, PinForces, YarnModel, YarnState};
-use crate::state_bytes::{Reader, Writer};
+use crate::models::state_bytes::{Reader, Writer};
 
 impl YarnModel {
     /// A saved state's part of a serialized FMU state: the pin inputs, the

@@ -1,16 +1,16 @@
 //! FMU states: the snapshots `fmi2GetFMUstate` hands out (the wrapper's
 //! clock and the model's dynamic state, [`FmuModel::save`]; no scratch) and
 //! their bytes (`fmi2SerializeFMUstate`): header, checksum, the clock and
-//! the model's part, framed by [`crate::state_bytes`].
+//! the model's part, framed by [`crate::models::state_bytes`].
 
 use std::ffi::c_void;
 
 use yarnsim::mpm::state::fnv1a;
 
-use crate::clock::Clock;
-use crate::fmu_model::{FmuModel, ModelState};
-use crate::instance::Phase;
-use crate::state_bytes::{Reader, Writer, STATE_HEADER, STATE_MAGICS, STATE_VERSION};
+use super::phase::Phase;
+use crate::instance::clock::Clock;
+use crate::models::model::{FmuModel, ModelState};
+use crate::models::state_bytes::{Reader, Writer, STATE_HEADER, STATE_MAGICS, STATE_VERSION};
 
 /// A saved FMU state (`fmi2FMUstate`).
 pub struct Snapshot {
@@ -54,8 +54,8 @@ impl Drop for Snapshot {
 /// [`MsModel::write`]) of `physics`, a state saved by a model of the kind of
 /// `current` (the instance's model). No pointers.
 ///
-/// [`YarnModel::write`]: crate::yarn::YarnModel::write
-/// [`MsModel::write`]: crate::massspring::MsModel::write
+/// [`YarnModel::write`]: crate::models::yarn::YarnModel::write
+/// [`MsModel::write`]: crate::models::massspring::MsModel::write
 pub fn serialize(
     phase: Phase,
     c: &Clock,

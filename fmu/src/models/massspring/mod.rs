@@ -10,14 +10,14 @@
 
 use yarnsim::massspring::{Integrator, IntegratorOptions, MassSpringScene, Simulation, V3};
 
-use crate::fmu_model::{
+use crate::model_description::{
+    output, table_name, var, Causality::*, Description, Start, VarSpec, VarType, Variable,
+};
+use crate::models::model::{
     refuse, Checkpoint, FmuModel, ModelResult, ModelState, ParamCheck, SetContext, StepFailure,
     VarName,
 };
-use crate::model::{
-    output, table_name, var, Causality::*, Description, Start, VarSpec, VarType, Variable,
-};
-use crate::state_bytes::{Reader, Writer};
+use crate::models::state_bytes::{Reader, Writer};
 
 /// The FMI model identifier of a mass-spring FMU.
 pub const MODEL_IDENTIFIER: &str = "MassSpring";
@@ -40,8 +40,8 @@ pub const VR_ELASTIC_ENERGY: u32 = 101;
 pub const VR_GRAVITY_ENERGY: u32 = 102;
 pub const VR_TOTAL_ENERGY: u32 = 103;
 pub const VR_MAX_STRAIN: u32 = 104;
-/// The substep count, common to every model ([`crate::model::COMMON_VARIABLES`]).
-pub use crate::model::VR_SUBSTEPS;
+/// The substep count, common to every model ([`crate::model_description::COMMON_VARIABLES`]).
+pub use crate::model_description::VR_SUBSTEPS;
 /// `particle[i].x` has `VR_PARTICLE_BASE + 3 i`, then `.y`, `.z`.
 pub const VR_PARTICLE_BASE: u32 = 1000;
 
@@ -54,7 +54,7 @@ pub fn num_particles(layout: &MassSpringScene) -> Result<usize, String> {
 }
 
 /// The MassSpring's variables before the ones every model has
-/// ([`crate::model::COMMON_VARIABLES`]) and the per-particle outputs, in
+/// ([`crate::model_description::COMMON_VARIABLES`]) and the per-particle outputs, in
 /// `ModelVariables` order; start values come from the layout.
 pub static MASS_SPRING_VARIABLES: [VarSpec<MassSpringScene>; 10] = [
     var(Input, "gravity.x", VR_GRAVITY_X, Some("m/s2"), Start::Real(|l| l.gravity[0]), "Gravity x, |g| at most 1e6"),
@@ -80,7 +80,7 @@ pub fn variables(layout: &MassSpringScene) -> Result<Vec<Variable>, String> {
         .iter()
         .map(|s| s.variable(layout))
         .collect();
-    v.extend(crate::model::common_variables());
+    v.extend(crate::model_description::common_variables());
     for i in 0..n {
         for (k, axis) in ["x", "y", "z"].into_iter().enumerate() {
             v.push(Variable {
@@ -119,11 +119,11 @@ mod table_tests {
 /// set (`-sum m g . x` with the current gravity), at initialization and
 /// between steps; every other output depends on no input and no parameter
 /// at the same instant (`dt` and `integrator` act through the substeps).
-pub fn dependencies() -> Vec<crate::model::Dependency> {
+pub fn dependencies() -> Vec<crate::model_description::Dependency> {
     let gravity = vec![VR_GRAVITY_X, VR_GRAVITY_Y, VR_GRAVITY_Z];
     [VR_GRAVITY_ENERGY, VR_TOTAL_ENERGY]
         .into_iter()
-        .map(|output| crate::model::Dependency {
+        .map(|output| crate::model_description::Dependency {
             output,
             step: gravity.clone(),
             initial: gravity.clone(),
@@ -132,12 +132,12 @@ pub fn dependencies() -> Vec<crate::model::Dependency> {
 }
 
 /// `positions`, the FMI 3.0 array of all particle positions.
-pub const VR_POSITIONS: u32 = crate::model::VR_ARRAY_BASE;
+pub const VR_POSITIONS: u32 = crate::model_description::VR_ARRAY_BASE;
 
 /// The FMI 3.0 array output `positions` (`[n, 3]`, row-major: x, y, z of
 /// particle 0, then of particle 1, ...) of `n` particles.
-pub fn positions_array(n: usize) -> crate::model::ArrayVariable {
-    crate::model::ArrayVariable {
+pub fn positions_array(n: usize) -> crate::model_description::ArrayVariable {
+    crate::model_description::ArrayVariable {
         name: "positions".into(),
         vr: VR_POSITIONS,
         dims: vec![n, 3],
@@ -152,7 +152,7 @@ pub fn positions_array(n: usize) -> crate::model::ArrayVariable {
 /// The GUID of the FMU for this layout: a hash of the interface version and
 /// the layout's normalized TOML text.
 pub fn guid(layout: &MassSpringScene) -> String {
-    crate::model::guid_of(&format!(
+    crate::model_description::guid_of(&format!(
         "{MODEL_IDENTIFIER} fmi2 interface {INTERFACE_VERSION}\n{}",
         layout.to_toml_string()
     ))
@@ -483,7 +483,7 @@ impl FmuModel for MsModel {
         Ok(changed)
     }
     fn state_magic(&self) -> &'static [u8; 8] {
-        crate::state_bytes::MASS_SPRING_STATE_MAGIC
+        crate::models::state_bytes::MASS_SPRING_STATE_MAGIC
     }
     fn stable_dt(&self) -> Option<f64> {
         self.sim.stable_dt()

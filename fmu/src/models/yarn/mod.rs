@@ -9,17 +9,17 @@ use yarnsim::mpm::state::DynamicState;
 use yarnsim::mpm::{Diagnostics, SimError, YarnSim};
 use yarnsim::scene::{Integrator, TransferScheme, YarnScene};
 
-use crate::fmu_model::{
+use crate::model_description::*;
+use crate::models::model::{
     refuse, Checkpoint, FmuModel, ModelError, ModelResult, ModelState, ParamCheck, SetContext,
     StepFailure, VarName,
 };
-use crate::model::*;
-use crate::state_bytes::{Reader, Writer};
+use crate::models::state_bytes::{Reader, Writer};
 
 pub mod arrays;
+mod fmu_state;
 mod forces;
 mod inputs;
-mod state;
 pub mod variables;
 
 pub use forces::PinForces;
@@ -579,7 +579,7 @@ impl FmuModel for YarnModel {
         Ok(changed)
     }
     fn state_magic(&self) -> &'static [u8; 8] {
-        crate::state_bytes::YARN_STATE_MAGIC
+        crate::models::state_bytes::YARN_STATE_MAGIC
     }
     fn stable_dt(&self) -> Option<f64> {
         Some(self.sim.stable_dt())
