@@ -21,7 +21,7 @@ mod values;
 use yarnsim::scene::Scene;
 
 pub use crate::models::model::{
-    shown, FmuModel, ModelError, ModelResult, ModelState, ParamCheck, SetContext, StepFailure,
+    shown, FmuModel, ModelError, ModelResult, ModelSnapshot, ParamCheck, SetContext, StepFailure,
     VarName,
 };
 pub use crate::models::state_bytes::*;

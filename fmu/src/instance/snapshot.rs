@@ -9,7 +9,7 @@ use yarnsim::mpm::state::fnv1a;
 
 use super::phase::Phase;
 use crate::instance::clock::Clock;
-use crate::models::model::{FmuModel, ModelState};
+use crate::models::model::{FmuModel, ModelSnapshot};
 use crate::models::state_bytes::{Reader, Writer, STATE_HEADER, STATE_MAGICS, STATE_VERSION};
 
 /// A saved FMU state (`fmi2FMUstate`).
@@ -18,7 +18,7 @@ pub struct Snapshot {
     pub(crate) phase: Phase,
     pub(crate) clock: Clock,
     /// The model's part ([`FmuModel::save`]).
-    pub(crate) physics: ModelState,
+    pub(crate) physics: ModelSnapshot,
     /// The state magic of the model that made it ([`FmuModel::state_magic`]).
     pub(crate) kind: &'static [u8; 8],
     /// Its number of output objects ([`FmuModel::count`]).
@@ -60,7 +60,7 @@ pub fn serialize(
     phase: Phase,
     c: &Clock,
     current: &dyn FmuModel,
-    physics: &ModelState,
+    physics: &ModelSnapshot,
 ) -> Result<Vec<u8>, String> {
     // The header goes in front once the body is written.
     let mut w = Writer::with_header(STATE_HEADER);
@@ -93,7 +93,7 @@ pub fn deserialize(
     current: &dyn FmuModel,
     built: bool,
     count: usize,
-) -> Result<(Phase, Clock, ModelState), String> {
+) -> Result<(Phase, Clock, ModelSnapshot), String> {
     if bytes.len() < STATE_HEADER {
         return Err(format!(
             "state has {} bytes, at least {STATE_HEADER} needed",

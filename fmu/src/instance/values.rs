@@ -7,7 +7,7 @@ impl Instance {
     /// Values that depend on the simulated state need a built simulation.
     /// After a diverged step they are those of the last good state (at
     /// `lastSuccessfulTime`), which the failed step restored.
-    fn require_state(&mut self) -> Res {
+    fn require_built(&mut self) -> Res {
         self.model.ensure_built(self.count)
     }
 
@@ -31,8 +31,8 @@ impl Instance {
     pub fn get_real(&mut self, vrs: &[u32], out: &mut [f64]) -> Res {
         self.require(Operation::GetFloat)?;
         for (k, &vr) in vrs.iter().enumerate() {
-            if self.model.physics.is_state_output(vr) {
-                self.require_state()?;
+            if self.model.physics.is_simulated_output(vr) {
+                self.require_built()?;
             }
             let Some(v) = self.model.physics.get_real(vr) else {
                 return error(format!(

@@ -93,9 +93,9 @@ pub type Checkpoint = Box<dyn Any + Send>;
 
 /// A model's part of an FMU state (`fmi2GetFMUstate`,
 /// [`FmuModel::save`]): what determines its future outputs, bit for bit
-/// (the simulated state, inputs, parameters), never scratch such as the
+/// (the simulation's values, inputs, parameters), never scratch such as the
 /// MPM grid; only a model of the kind that made it reads it.
-pub type ModelState = Box<dyn Any + Send>;
+pub type ModelSnapshot = Box<dyn Any + Send>;
 
 /// A model behind the FMU: its outputs, inputs and parameters by value
 /// reference, its substeps and its part of the FMU state.
@@ -156,8 +156,9 @@ pub trait FmuModel: fmt::Debug + Send {
     fn shown(&self, vr: u32) -> String {
         shown(self.variable(vr), vr)
     }
-    /// Whether the Real variable `vr` depends on the simulated state.
-    fn is_state_output(&self, vr: u32) -> bool;
+    /// Whether the Real variable `vr` reads the simulation's values (positions,
+    /// velocities, energies), which need a built simulation.
+    fn is_simulated_output(&self, vr: u32) -> bool;
     /// The value of the Real variable `vr`, `None` if there is none.
     fn get_real(&mut self, vr: u32) -> Option<f64>;
     /// FMI 3.0 Float64 arrays: the number of values of the array output
@@ -196,20 +197,20 @@ pub trait FmuModel: fmt::Debug + Send {
         ctx: &SetContext,
     ) -> ModelResult<bool>;
     /// This model's part of an FMU state (`fmi2GetFMUstate`).
-    fn save(&self) -> ModelState;
+    fn save(&self) -> ModelSnapshot;
     /// Puts back a [`Self::save`] of a model of this kind (`fmi2SetFMUstate`),
     /// reusing this model's simulation where the state's scene and
     /// parameters are those it was built from. A refused state changes
     /// nothing.
-    fn load(&mut self, s: &ModelState) -> ModelResult;
+    fn load(&mut self, s: &ModelSnapshot) -> ModelResult;
     /// A saved state's part of a serialized FMU state; `self` (the
     /// instance's current model) may lend what the state shares with its
     /// scene.
-    fn write(&self, s: &ModelState, w: &mut Writer) -> Result<(), String>;
+    fn write(&self, s: &ModelSnapshot, w: &mut Writer) -> Result<(), String>;
     /// Reads what [`Self::write`] wrote into a state of this model's kind;
     /// `self` (with `built`: its simulation matches its scene and
     /// parameters) is used where the stored scene and parameters match.
-    fn read(&self, r: &mut Reader, built: bool, count: usize) -> Result<ModelState, String>;
+    fn read(&self, r: &mut Reader, built: bool, count: usize) -> Result<ModelSnapshot, String>;
     /// A boxed copy.
     fn box_clone(&self) -> Box<dyn FmuModel>;
 }
