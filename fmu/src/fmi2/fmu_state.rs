@@ -1,6 +1,6 @@
 //! The FMI 2.0 FMU-state functions (`fmi2GetFMUstate` ...
 //! `fmi2DeSerializeFMUstate`) over the bodies both versions share
-//! ([`crate::shell::fmu_state`]).
+//! (`shell/fmu_state.rs`).
 
 use super::*;
 use crate::shell::state_exports;

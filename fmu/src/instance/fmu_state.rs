@@ -1,10 +1,12 @@
-//! The instance's FMU states: get, set, serialize and deserialize.
+//! The instance's FMU states (the one meaning of "state" in this crate):
+//! get, set, serialize and deserialize.
 
 use super::*;
 
 impl Instance {
-    /// Saves the clock and the model's dynamic state (no scratch such as
-    /// the MPM grid), into `into` or a new snapshot.
+    /// Saves the clock and the model's part ([`FmuModel::save`]: its
+    /// values, no scratch such as the MPM grid), into `into` or a new
+    /// snapshot.
     pub fn get_fmu_state(&mut self, into: Option<&mut Snapshot>) -> Res<Option<Box<Snapshot>>> {
         self.require(Operation::GetFmuState)?;
         // A snapshot always holds the state of a simulation built from its

@@ -1,10 +1,13 @@
-//! One FMU instance: the time keeping, the stepping and the values around a
-//! [`FmuModel`] (the yarn bundle of [`crate::models::yarn`] or the mass-spring system
-//! of [`crate::models::massspring`]), independent of the C ABI (which lives in
-//! [`crate::fmi2`]). The state table is in [`crate::instance::phase`], the FMU
-//! state bytes in [`crate::models::state_bytes`], the resource location in
-//! [`crate::instance::resources`], the logger in [`crate::instance::logging`]; their items are
-//! re-exported here.
+//! One FMU instance, model- and version-neutral: the time keeping, the
+//! stepping and the values around a [`FmuModel`] (the yarn bundle of
+//! [`crate::models::yarn`] or the mass-spring system of
+//! [`crate::models::massspring`]), independent of the C ABIs
+//! ([`crate::fmi2`], [`crate::fmi3`], [`crate::shell`]). Its phase and the
+//! state table keyed by [`Operation`] are in [`phase`], the FMU states
+//! (snapshots and their bytes) in [`snapshot`] and `fmu_state.rs`, the
+//! FMI 3.0 arrays and `nValues` counts in `arrays.rs`, the clock in
+//! [`clock`], the resource location in [`resources`], the logger in
+//! [`logging`]; their items are re-exported here.
 
 use std::ffi::{c_int, c_void, CString};
 use std::path::PathBuf;

@@ -1,9 +1,10 @@
 //! The models behind the FMUs, chosen by the bundled scene
 //! ([`yarnsim::scene::Scene`]): a yarn scene runs the yarn bundle of
 //! [`crate::models::yarn`] (`YarnBundle`), a mass-spring scene the system of
-//! [`crate::models::massspring`] (`MassSpring`). The one place that knows both; the
-//! model-neutral modules ([`crate::model_description`], [`crate::models::model`],
-//! [`crate::models::state_bytes`]) know neither.
+//! [`crate::models::massspring`] (`MassSpring`), each a folder of the same
+//! files. This module is the one place that knows both; the model-neutral
+//! ones ([`crate::model_description`], [`model`], [`state_bytes`]) know
+//! neither.
 
 use yarnsim::scene::Scene;
 

@@ -1,5 +1,5 @@
-//! The interface between the FMI front end ([`crate::instance`],
-//! [`crate::fmi2`]) and the models it runs: [`FmuModel`], implemented by the
+//! The interface between the instance ([`crate::instance`]) and the models
+//! it runs (as `model.h` in modelica/Reference-FMUs): [`FmuModel`], implemented by the
 //! yarn bundle ([`crate::models::yarn::YarnModel`]) and the mass-spring system
 //! ([`crate::models::massspring::MsModel`]). The models know nothing of FMI
 //! statuses, function names or C types: they answer with typed errors

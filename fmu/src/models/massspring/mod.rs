@@ -1,9 +1,9 @@
 //! The mass-spring physics behind the `MassSpring` FMU (the same shared
 //! library as `YarnBundle`, packed under the modelIdentifier `MassSpring`
 //! when the bundled scene is a mass-spring layout such as `wire` or
-//! `cloth`): its variables, GUID and model description ([`variables`]),
+//! `cloth`): its variables, GUID and model description ([`variables`](mod@variables)),
 //! its FMI 3.0 array output ([`arrays`]), the [`Simulation`] an instance
-//! drives (here) and its part of an FMU state ([`fmu_state`]); the same
+//! drives (here) and its part of an FMU state (`fmu_state.rs`); the same
 //! files as the yarn bundle's ([`crate::models::yarn`]).
 //!
 //! Inputs `gravity.x/y/z`; parameters `dt` (0: the integrator's own step)
