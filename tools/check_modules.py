@@ -9,9 +9,18 @@ the folder>::B`, or `super::B` from a file directly inside the folder (or a
 `#[cfg(test)]` line (the unit-test module at the end of a file) is left out:
 tests may reach across. Re-exports count like any other use.
 
+Second rule, the FMU's sibling front ends (`SIBLINGS`): no file under
+`fmu/src/fmi3/` names the FMI 2.0 front end (`crate::fmi2`, the old
+`crate::ffi`, an `fmi2...` C function or type), and no file under
+`fmu/src/fmi2/` names the FMI 3.0 one; both build on the version-neutral
+`shell/` and `instance/`, as modelica/Reference-FMUs' `fmi2Functions.c` and
+`fmi3Functions.c` build on one `model.h`. Comments and strings do not count
+(a message may name the other version's function).
+
 Usage: tools/check_modules.py [CRATE_SRC ...]   (default: every crate's src/)
        tools/check_modules.py --self-test
-Prints each circle as `crate folder: a -> b -> a` and exits 1 if any.
+Prints each circle as `crate folder: a -> b -> a`, each sibling import as
+`file: names ...`, and exits 1 if any.
 """
 import re
 import sys
@@ -145,9 +154,50 @@ def self_test():
     print("check_modules self-test: ok")
 
 
+# The FMU's FMI front ends: (folder, what no file in it may name).
+SIBLINGS = [
+    ("fmu/src/fmi3", r"\bcrate::(?:fmi2|ffi)\b|(?<![A-Za-z0-9_:])(?:super::)+fmi2\b|\bfmi2[A-Z][A-Za-z0-9_]*"),
+    ("fmu/src/fmi2", r"\bcrate::fmi3\b|(?<![A-Za-z0-9_:])(?:super::)+fmi3\b|\bfmi3[A-Z][A-Za-z0-9_]*"),
+]
+
+
+def sibling_imports(root=ROOT, table=SIBLINGS):
+    """Files of one FMI front end that name the other (see SIBLINGS)."""
+    found = []
+    for folder, pattern in table:
+        for f in sorted((root / folder).rglob("*.rs")):
+            names = sorted(set(re.findall(pattern, strip(f.read_text()))))
+            if names:
+                found.append(f"{f.relative_to(root)}: names {', '.join(names)}")
+    return found
+
+
+def self_test_siblings():
+    import tempfile
+    with tempfile.TemporaryDirectory() as t:
+        root = Path(t)
+        (root / "fmu/src/fmi2").mkdir(parents=True)
+        (root / "fmu/src/fmi3").mkdir(parents=True)
+        (root / "fmu/src/fmi2/mod.rs").write_text(
+            "use crate::shell::call;\n// fmi3DoStep in a comment\nconst M: &str = \"not fmi3DoStep\";\n")
+        (root / "fmu/src/fmi3/mod.rs").write_text(
+            "use crate::shell::free_instance;\nconst M: &str = \"made by fmi2Instantiate\";\n")
+        assert sibling_imports(root) == [], sibling_imports(root)
+        (root / "fmu/src/fmi3/common.rs").write_text(
+            "unsafe { crate::ffi::fmi2FreeInstance(i) }\nuse super::super::fmi2::X;\n")
+        (root / "fmu/src/fmi2/cosim.rs").write_text("use crate::fmi3::values;\n")
+        got = sibling_imports(root)
+        assert got == [
+            "fmu/src/fmi3/common.rs: names crate::ffi, fmi2FreeInstance, super::super::fmi2",
+            "fmu/src/fmi2/cosim.rs: names crate::fmi3",
+        ], got
+    print("check_modules sibling self-test: ok")
+
+
 def main(argv):
     if argv[1:] == ["--self-test"]:
         self_test()
+        self_test_siblings()
         return 0
     srcs = [Path(a).resolve() for a in argv[1:]] or [ROOT / c for c in CRATES]
     bad = []
@@ -156,9 +206,13 @@ def main(argv):
             bad += check(src)
     for b in bad:
         print(f"import circle: {b}")
-    if bad:
+    siblings = [] if argv[1:] else sibling_imports()
+    for b in siblings:
+        print(f"FMI front end names its sibling: {b}")
+    if bad or siblings:
         return 1
-    print(f"module graphs of {len(srcs)} crates have no circle")
+    print(f"module graphs of {len(srcs)} crates have no circle"
+          + ("" if argv[1:] else "; the FMU's fmi2/ and fmi3/ do not name each other"))
     return 0
 
 

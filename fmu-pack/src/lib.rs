@@ -9,10 +9,10 @@
 use std::fmt::Write as _;
 
 use yarnsim::scene::Scene;
-pub use YarnBundle::ffi::FMI2_FUNCTIONS;
-pub use YarnBundle::fmi3::FMI3_FUNCTIONS;
-use YarnBundle::model::{xml_escape, SCENE_FILE};
-use YarnBundle::SceneFmu;
+pub use yarnsim_fmu::fmi2::FMI2_FUNCTIONS;
+pub use yarnsim_fmu::fmi3::FMI3_FUNCTIONS;
+use yarnsim_fmu::model_description::{xml_escape, SCENE_FILE};
+use yarnsim_fmu::SceneFmu;
 
 /// CRC-32 (IEEE 802.3, reflected, as zip uses it).
 pub fn crc32(data: &[u8]) -> u32 {
@@ -217,7 +217,7 @@ pub fn documentation_html_of(scene: &Scene, version: FmiVersion) -> Result<Strin
                 "{}, frame time {} s, default integrator {}",
                 scene.summary(),
                 l.time.frame_time,
-                YarnBundle::massspring::DEFAULT_INTEGRATOR
+                yarnsim_fmu::models::massspring::DEFAULT_INTEGRATOR
             ),
         ),
     };
@@ -251,7 +251,7 @@ pub fn documentation_html_of(scene: &Scene, version: FmiVersion) -> Result<Strin
             xml_escape(v.start.as_deref().unwrap_or("")),
             xml_escape(&match version {
                 FmiVersion::Fmi2 => v.description.clone(),
-                FmiVersion::Fmi3 => YarnBundle::model::fmi3_words(&v.description),
+                FmiVersion::Fmi3 => yarnsim_fmu::model_description::fmi3_words(&v.description),
             })
         );
     }

@@ -13,8 +13,8 @@ use yarnsim_fmu_pack::*;
 #[path = "../../fmu/tests/common/mod.rs"]
 mod common;
 use common::cdylib_path;
-use YarnBundle::yarn::variables::*;
-use YarnBundle::SceneFmu;
+use yarnsim_fmu::models::yarn::variables::*;
+use yarnsim_fmu::SceneFmu;
 
 /// The bytes that stand in for the FMU's library in an archive.
 const STAND_IN: &[u8] = b"\x7fELF not really";
@@ -121,7 +121,7 @@ fn mass_spring_archive_layout() {
     let scene = Scene::MassSpring(wire());
     let (_, entries) = archive(&scene, "MassSpring");
     let packed =
-        YarnBundle::scene_from_toml_str(std::str::from_utf8(&entries[2].1).unwrap()).unwrap();
+        yarnsim_fmu::scene_from_toml_str(std::str::from_utf8(&entries[2].1).unwrap()).unwrap();
     assert_eq!(packed.guid(), scene.guid());
     let doc = String::from_utf8(entries[3].1.clone()).unwrap();
     assert!(doc.contains("particle[10].x") && doc.contains("mass-spring"));
@@ -156,10 +156,10 @@ fn fmi3_archives_of_the_yarn_and_the_mass_spring_scenes() {
     let wire = Scene::MassSpring(wire());
     let e = archive3(&wire, "MassSpring");
     let xml = String::from_utf8(e[0].1.clone()).unwrap();
-    let n = YarnBundle::massspring::num_particles(&wire_layout()).unwrap();
+    let n = yarnsim_fmu::models::massspring::num_particles(&wire_layout()).unwrap();
     assert!(xml.contains(&format!(
         "name=\"positions\" valueReference=\"{}\"",
-        YarnBundle::massspring::VR_POSITIONS
+        yarnsim_fmu::models::massspring::VR_POSITIONS
     )));
     assert!(xml.contains(&format!(
         "<Dimension start=\"{n}\"/>\n      <Dimension start=\"3\"/>"

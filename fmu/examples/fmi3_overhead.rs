@@ -20,13 +20,13 @@ use std::ffi::CString;
 use std::hint::black_box;
 use std::time::Instant;
 
-use YarnBundle::ffi::*;
-use YarnBundle::fmi3::common::*;
-use YarnBundle::fmi3::cosim::fmi3DoStep;
-use YarnBundle::fmi3::values::fmi3GetFloat64;
-use YarnBundle::fmi3::*;
-use YarnBundle::model::{ArrayVariable, VarType};
-use YarnBundle::SceneFmu;
+use yarnsim_fmu::fmi2::*;
+use yarnsim_fmu::fmi3::common::*;
+use yarnsim_fmu::fmi3::cosim::fmi3DoStep;
+use yarnsim_fmu::fmi3::values::fmi3GetFloat64;
+use yarnsim_fmu::fmi3::*;
+use yarnsim_fmu::model_description::{ArrayVariable, VarType};
+use yarnsim_fmu::SceneFmu;
 
 mod common;
 
@@ -102,7 +102,7 @@ fn main() {
             fmi3OK
         );
         assert!(fmi3ExitInitializationMode(three) <= fmi3Warning);
-        let dt = YarnBundle::new_model(&fx.scene).unwrap().dt();
+        let dt = yarnsim_fmu::new_model(&fx.scene).unwrap().dt();
         let (mut ev, mut term, mut early, mut last) = (false, false, false, 0.0);
         let mut t2 = 0.0;
         let mut t3 = 0.0;

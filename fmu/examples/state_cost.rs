@@ -22,8 +22,8 @@ use std::sync::atomic::{AtomicUsize, Ordering::Relaxed};
 use std::time::Instant;
 
 use yarnsim::scene::{Scene, DEFAULT_SCENE};
-use YarnBundle::ffi::*;
-use YarnBundle::yarn::variables::*;
+use yarnsim_fmu::fmi2::*;
+use yarnsim_fmu::models::yarn::variables::*;
 
 mod common;
 
@@ -87,7 +87,7 @@ fn main() {
         let mut dt = 0.0;
         let vr_dt = match scene {
             Scene::Yarn(_) => VR_DT,
-            Scene::MassSpring(_) => YarnBundle::massspring::VR_DT,
+            Scene::MassSpring(_) => yarnsim_fmu::models::massspring::VR_DT,
         };
         assert_eq!(fmi2GetReal(c, &vr_dt, 1, &mut dt), fmi2OK);
         // MassSpring's dt = 0 means the integrator's own step.

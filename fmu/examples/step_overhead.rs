@@ -29,11 +29,11 @@ use std::time::Instant;
 use yarnsim::massspring::Simulation;
 use yarnsim::mpm::YarnSim;
 use yarnsim::scene::Scene;
-use YarnBundle::ffi::*;
-use YarnBundle::fmu_model::FmuModel;
-use YarnBundle::massspring::{self as ms, MsModel};
-use YarnBundle::model::*;
-use YarnBundle::yarn::variables::*;
+use yarnsim_fmu::fmi2::*;
+use yarnsim_fmu::model_description::*;
+use yarnsim_fmu::models::massspring::{self as ms, MsModel};
+use yarnsim_fmu::models::model::FmuModel;
+use yarnsim_fmu::models::yarn::variables::*;
 
 mod common;
 
@@ -202,7 +202,7 @@ fn main() {
             // The yarn's diagnostics are cleared before each check, as a
             // substep does; its checkpoint is the library's dynamic state.
             Scene::Yarn(s) => end_of_step_costs(
-                YarnBundle::yarn::YarnModel::new(s.clone()).unwrap(),
+                yarnsim_fmu::models::yarn::YarnModel::new(s.clone()).unwrap(),
                 reps,
                 |m| m.diag = None,
             ),

@@ -10,9 +10,9 @@ use std::ffi::c_int;
 use common::*;
 use yarnsim::mpm::YarnSim;
 use yarnsim::scene::{StepSize, YarnScene};
-use YarnBundle::ffi::*;
-use YarnBundle::model::*;
-use YarnBundle::yarn::variables::*;
+use yarnsim_fmu::fmi2::*;
+use yarnsim_fmu::model_description::*;
+use yarnsim_fmu::models::yarn::variables::*;
 
 const H: f64 = 0.01;
 

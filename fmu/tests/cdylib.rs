@@ -7,8 +7,8 @@ mod common;
 use std::ffi::{c_char, c_int, c_void, CString};
 
 use common::*;
-use YarnBundle::ffi::*;
-use YarnBundle::yarn::variables::*;
+use yarnsim_fmu::fmi2::*;
+use yarnsim_fmu::models::yarn::variables::*;
 
 type Setup = unsafe extern "C" fn(fmi2Component, c_int, f64, f64, c_int, f64) -> fmi2Status;
 type Unary = unsafe extern "C" fn(fmi2Component) -> fmi2Status;
@@ -49,7 +49,7 @@ fn shared_library_loads_and_runs_like_the_rlib() {
     unsafe {
         let lib = libc::dlopen(cpath.as_ptr(), libc::RTLD_NOW | libc::RTLD_LOCAL);
         assert!(!lib.is_null(), "dlopen {} failed", path.display());
-        for f in YarnBundle::ffi::FMI2_FUNCTIONS {
+        for f in yarnsim_fmu::fmi2::FMI2_FUNCTIONS {
             let n = CString::new(f).unwrap();
             assert!(!libc::dlsym(lib, n.as_ptr()).is_null(), "{f}");
         }

@@ -9,9 +9,9 @@ use std::ffi::{c_int, CString};
 
 use common::*;
 use yarnsim::massspring::scenes::wire;
-use YarnBundle::ffi::*;
-use YarnBundle::model::{self as neutral, Dependency, VarType, Variable, VR_SUBSTEPS};
-use YarnBundle::yarn::variables::{self as model, VR_INTEGRATOR, VR_SCENE};
+use yarnsim_fmu::fmi2::*;
+use yarnsim_fmu::model_description::{self as neutral, Dependency, VarType, Variable, VR_SUBSTEPS};
+use yarnsim_fmu::models::yarn::variables::{self as model, VR_INTEGRATOR, VR_SCENE};
 
 /// How a variable is changed in the test.
 #[derive(Clone, Debug)]
@@ -244,14 +244,14 @@ fn pin_inputs_feed_through_nothing() {
 #[test]
 fn mass_spring_energies_declare_gravity_and_nothing_else_does() {
     let layout = wire();
-    let d = YarnBundle::massspring::description(&layout).unwrap();
+    let d = yarnsim_fmu::models::massspring::description(&layout).unwrap();
     let new = || Fmu::mass_spring(&layout);
     assert!(check_outputs(&new, &d, 0.05) > 0);
     // Gravity changes gravity_energy and total_energy in initialization
     // mode too, and those declare it.
     let seen = check_initial(&new, &d, "unused.toml");
     assert!(seen >= 2, "{seen}");
-    let xml = YarnBundle::massspring::description(&layout)
+    let xml = yarnsim_fmu::models::massspring::description(&layout)
         .map(|d| neutral::write_model_description(&d))
         .unwrap();
     let index = |name: &str| 1 + d.variables.iter().position(|v| v.name == name).unwrap();

@@ -7,9 +7,9 @@ use std::ffi::{c_char, CString};
 
 use common::*;
 use yarnsim::scene::YarnScene;
-use YarnBundle::ffi::*;
-use YarnBundle::model::*;
-use YarnBundle::yarn::variables::*;
+use yarnsim_fmu::fmi2::*;
+use yarnsim_fmu::model_description::*;
+use yarnsim_fmu::models::yarn::variables::*;
 
 const H: f64 = 0.01;
 

@@ -11,13 +11,13 @@ use common::{fmt_row, small_scene, Fmu};
 use common3::*;
 use yarnsim::mpm::YarnSim;
 use yarnsim::scene::Scene;
-use YarnBundle::ffi::fmi2OK;
-use YarnBundle::fmi3::state::*;
-use YarnBundle::fmi3::*;
-use YarnBundle::model::*;
-use YarnBundle::yarn::arrays::array_vr;
-use YarnBundle::yarn::variables::*;
-use YarnBundle::SceneFmu;
+use yarnsim_fmu::fmi2::fmi2OK;
+use yarnsim_fmu::fmi3::fmu_state::*;
+use yarnsim_fmu::fmi3::*;
+use yarnsim_fmu::model_description::*;
+use yarnsim_fmu::models::yarn::arrays::array_vr;
+use yarnsim_fmu::models::yarn::variables::*;
+use yarnsim_fmu::SceneFmu;
 
 const H: f64 = 0.01;
 

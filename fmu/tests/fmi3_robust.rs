@@ -10,16 +10,16 @@ mod common3;
 
 use common::assert_refused_state;
 use common3::*;
-use YarnBundle::fmi3::common::*;
-use YarnBundle::fmi3::cosim::*;
-use YarnBundle::fmi3::state::*;
-use YarnBundle::fmi3::unsupported::*;
-use YarnBundle::fmi3::values::*;
-use YarnBundle::fmi3::*;
-use YarnBundle::instance::{Instance, Phase};
-use YarnBundle::model::*;
-use YarnBundle::yarn::arrays::array_vr;
-use YarnBundle::yarn::variables::*;
+use yarnsim_fmu::fmi3::common::*;
+use yarnsim_fmu::fmi3::cosim::*;
+use yarnsim_fmu::fmi3::fmu_state::*;
+use yarnsim_fmu::fmi3::unsupported::*;
+use yarnsim_fmu::fmi3::values::*;
+use yarnsim_fmu::fmi3::*;
+use yarnsim_fmu::instance::{Instance, Phase};
+use yarnsim_fmu::model_description::*;
+use yarnsim_fmu::models::yarn::arrays::array_vr;
+use yarnsim_fmu::models::yarn::variables::*;
 
 const H: f64 = 0.01;
 
@@ -124,7 +124,7 @@ fn instantiation_refuses_what_the_fmu_cannot_do() {
         .unwrap();
     assert!(bad[0].2.contains("instantiationToken"), "{bad:?}");
     let scene = yarnsim::scene::Scene::from_toml_str(SMALL_SCENE).unwrap();
-    let token = YarnBundle::SceneFmu::guid(&scene);
+    let token = yarnsim_fmu::SceneFmu::guid(&scene);
     let ev = Fmu3::try_new(SMALL_SCENE, &token, true).err().unwrap();
     assert!(ev[0].2.contains("eventModeUsed"), "{ev:?}");
     assert_eq!(ev[0].0, fmi3Error);

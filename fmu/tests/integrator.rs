@@ -15,11 +15,11 @@ use common3::Fmu3;
 use yarnsim::scene::{Integrator, StepSize, YarnScene};
 use yarnsim::testing::{hanging_chain_floor_period, hanging_chain_toml, ZeroCrossings};
 use yarnsim::YarnSim;
-use YarnBundle::ffi::*;
-use YarnBundle::fmi3::common::*;
-use YarnBundle::fmi3::values::fmi3SetString;
-use YarnBundle::fmi3::*;
-use YarnBundle::yarn::variables::*;
+use yarnsim_fmu::fmi2::*;
+use yarnsim_fmu::fmi3::common::*;
+use yarnsim_fmu::fmi3::values::fmi3SetString;
+use yarnsim_fmu::fmi3::*;
+use yarnsim_fmu::models::yarn::variables::*;
 
 /// The hanging chain (25 vertices, 16^2, dt 1e-3), explicit as written.
 fn chain_text() -> String {
@@ -128,7 +128,7 @@ fn integrator_changes_no_output_at_initialization() {
     let vrs = [VR_KINETIC_ENERGY, VR_ELASTIC_ENERGY, VR_MAX_STRETCH];
     assert_eq!(a.get_real(&vrs).unwrap(), b.get_real(&vrs).unwrap());
     assert_eq!(a.outputs(), b.outputs());
-    let d = YarnBundle::yarn::variables::description(&scene);
+    let d = yarnsim_fmu::models::yarn::variables::description(&scene);
     assert!(d
         .dependencies
         .iter()

@@ -11,9 +11,9 @@ use common::*;
 use yarnsim::massspring::scenes::{cloth, wire};
 use yarnsim::massspring::{Integrator, IntegratorOptions, MassSpringScene, Simulation, V3};
 use yarnsim::scene::Scene;
-use YarnBundle::ffi::*;
-use YarnBundle::massspring::*;
-use YarnBundle::SceneFmu;
+use yarnsim_fmu::fmi2::*;
+use yarnsim_fmu::models::massspring::*;
+use yarnsim_fmu::SceneFmu;
 
 /// The wire's frame time, used as the communication step.
 const H: f64 = 0.05;

@@ -14,14 +14,14 @@ use std::ffi::{c_int, CString};
 
 use common::*;
 use common3::Fmu3;
-use YarnBundle::ffi::*;
-use YarnBundle::fmi3::state::*;
-use YarnBundle::fmi3::unsupported::fmi3GetFloat32;
-use YarnBundle::fmi3::values::*;
-use YarnBundle::fmi3::*;
-use YarnBundle::model::*;
-use YarnBundle::yarn::arrays::array_vr;
-use YarnBundle::yarn::variables::*;
+use yarnsim_fmu::fmi2::*;
+use yarnsim_fmu::fmi3::fmu_state::*;
+use yarnsim_fmu::fmi3::unsupported::fmi3GetFloat32;
+use yarnsim_fmu::fmi3::values::*;
+use yarnsim_fmu::fmi3::*;
+use yarnsim_fmu::model_description::*;
+use yarnsim_fmu::models::yarn::arrays::array_vr;
+use yarnsim_fmu::models::yarn::variables::*;
 
 const H: f64 = 0.01;
 
@@ -173,7 +173,7 @@ fn fmi2_pin_and_mass_spring_messages_name_the_variable() {
          within 1e6 m and 1e6 m/s",
     );
 
-    use YarnBundle::massspring as ms;
+    use yarnsim_fmu::models::massspring as ms;
     let wire = yarnsim::massspring::scenes::wire();
     let init = || {
         let f = Fmu::mass_spring(&wire);

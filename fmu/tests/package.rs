@@ -6,7 +6,7 @@ mod common;
 
 use yarnsim::scene::builtin::yarn_reference;
 use yarnsim::scene::YarnScene;
-use YarnBundle::yarn::variables::*;
+use yarnsim_fmu::models::yarn::variables::*;
 
 #[test]
 fn checked_in_model_description_is_current() {
@@ -27,7 +27,7 @@ fn model_description_structure() {
     let xml = model_description(&scene);
     let yarns = num_yarns(&scene);
     assert_eq!(yarns, 3);
-    let outputs = YarnBundle::model::output_indices(&vars);
+    let outputs = yarnsim_fmu::model_description::output_indices(&vars);
     assert_eq!(outputs.len(), 4 * yarns + 4);
     for i in &outputs {
         // Listed in <Outputs> and <InitialUnknowns>, always with dependencies.

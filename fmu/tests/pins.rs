@@ -11,8 +11,8 @@ use yarnsim::math::Vec2;
 use yarnsim::mpm::YarnSim;
 use yarnsim::scene::{PinMotionKind, TransferScheme, YarnScene, YarnSpec};
 use yarnsim::testing::{hanging_chain_toml, CHAIN_GRAVITY};
-use YarnBundle::ffi::*;
-use YarnBundle::yarn::variables::*;
+use yarnsim_fmu::fmi2::*;
+use yarnsim_fmu::models::yarn::variables::*;
 
 const H: f64 = 0.01;
 

@@ -9,9 +9,9 @@ use std::time::Instant;
 
 use common::*;
 use yarnsim::massspring::scenes::wire;
-use YarnBundle::ffi::*;
-use YarnBundle::model::*;
-use YarnBundle::yarn::variables::*;
+use yarnsim_fmu::fmi2::*;
+use yarnsim_fmu::model_description::*;
+use yarnsim_fmu::models::yarn::variables::*;
 
 const H: f64 = 0.01;
 
@@ -91,7 +91,7 @@ fn a_step_beyond_the_substep_budget_is_refused_before_it_runs() {
     // The same on the MassSpring FMU.
     let m = Fmu::mass_spring(&wire());
     assert_eq!(
-        m.set_real(&[YarnBundle::massspring::VR_DT], &[1e-9]),
+        m.set_real(&[yarnsim_fmu::models::massspring::VR_DT], &[1e-9]),
         fmi2OK
     );
     assert_eq!(exit_init(&m), fmi2OK, "{:?}", m.lines());
@@ -133,7 +133,7 @@ fn a_substep_beyond_the_stability_bound_gives_a_warning() {
 
     // Mass-spring: symplectic Euler beyond its bound warns; backward Euler
     // (A-stable) never does.
-    use YarnBundle::massspring::{VR_DT as MS_DT, VR_INTEGRATOR};
+    use yarnsim_fmu::models::massspring::{VR_DT as MS_DT, VR_INTEGRATOR};
     let layout = wire();
     let lib = yarnsim::massspring::Simulation::new(
         &layout,
@@ -197,7 +197,7 @@ fn threads_parameter_gives_identical_bits() {
             assert_eq!(m.do_step(k as f64 / 30.0, 1.0 / 30.0), fmi2OK);
         }
         let vrs: Vec<u32> = (0..3 * m.yarns as u32)
-            .map(|k| YarnBundle::massspring::VR_PARTICLE_BASE + k)
+            .map(|k| yarnsim_fmu::models::massspring::VR_PARTICLE_BASE + k)
             .collect();
         m.get_real(&vrs).unwrap()
     };

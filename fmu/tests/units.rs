@@ -11,8 +11,8 @@ mod common;
 use yarnsim::massspring::scenes::{cloth, wire};
 use yarnsim::scene::builtin::yarn_reference;
 use yarnsim::scene::YarnScene;
-use YarnBundle::model::{Variable, UNITS};
-use YarnBundle::yarn::variables::*;
+use yarnsim_fmu::model_description::{Variable, UNITS};
+use yarnsim_fmu::models::yarn::variables::*;
 
 const FMU_MD: &str = include_str!("../../docs/fmu.md");
 const SCENE_FILES_MD: &str = include_str!("../../docs/scene-files.md");
@@ -130,7 +130,7 @@ fn docs_fmu_md_tables_match_the_generated_descriptions() {
         assert!(checked.iter().any(|n| n == pin), "{pin} unchecked");
     }
     // MassSpring: the wire (modelDescription/MassSpring-wire.xml)
-    let vars = YarnBundle::massspring::variables(&wire()).unwrap();
+    let vars = yarnsim_fmu::models::massspring::variables(&wire()).unwrap();
     let checked = check_fmu_md_table(1, &vars, |_| true);
     for v in vars.iter().filter(|v| !v.name.contains('[')) {
         assert!(
@@ -208,7 +208,7 @@ fn fmu_units_and_starts_match_the_scene_file_reference() {
     for v in &vars {
         if v.causality == "output"
             || v.name == "scene"
-            || v.ty == YarnBundle::model::VarType::Integer
+            || v.ty == yarnsim_fmu::model_description::VarType::Integer
         {
             continue; // outputs, the scene file, the execution parameters: no scene field
         }
@@ -254,8 +254,8 @@ fn every_unit_is_declared_in_unit_definitions() {
     let driven = YarnScene::from_toml_str(DRIVEN_SCENE).unwrap();
     let mut all = variables(&yarn_reference());
     all.extend(variables(&driven));
-    all.extend(YarnBundle::massspring::variables(&wire()).unwrap());
-    all.extend(YarnBundle::massspring::variables(&cloth()).unwrap());
+    all.extend(yarnsim_fmu::models::massspring::variables(&wire()).unwrap());
+    all.extend(yarnsim_fmu::models::massspring::variables(&cloth()).unwrap());
     for v in &all {
         if let Some(u) = v.unit {
             assert!(
@@ -275,6 +275,8 @@ fn every_unit_is_declared_in_unit_definitions() {
     }
 }
 
-fn yarn_description_arrays(scene: &YarnScene) -> Vec<YarnBundle::model::ArrayVariable> {
+fn yarn_description_arrays(
+    scene: &YarnScene,
+) -> Vec<yarnsim_fmu::model_description::ArrayVariable> {
     description(scene).arrays
 }

@@ -2,7 +2,7 @@
 //!
 //! ```text
 //! cargo run --release -p yarnsim-fmu-pack --bin build-fmu -- [--scene NAME_OR_FILE] [-o OUT.fmu]
-//!     [--lib libYarnBundle.so | --no-build] [--model-description FILE] [--fmi-version 2|3]
+//!     [--lib libyarnsim_fmu.so | --no-build] [--model-description FILE] [--fmi-version 2|3]
 //! ```
 //!
 //! Without `--scene` it packs the default scene (`yarn-reference`) into
@@ -21,10 +21,10 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use yarnsim::scene::{Scene, DEFAULT_SCENE};
+use yarnsim_fmu::{SceneFmu, MODEL_IDENTIFIER};
 use yarnsim_fmu_pack::{build_fmu_of, check_library, zip_entries, FmiVersion};
-use YarnBundle::{SceneFmu, MODEL_IDENTIFIER};
 
-const USAGE: &str = "usage: build-fmu [--scene NAME_OR_FILE] [-o OUT.fmu] [--lib libYarnBundle.so | --no-build] [--model-description FILE] [--fmi-version 2|3]";
+const USAGE: &str = "usage: build-fmu [--scene NAME_OR_FILE] [-o OUT.fmu] [--lib libyarnsim_fmu.so | --no-build] [--model-description FILE] [--fmi-version 2|3]";
 
 fn run() -> Result<(), String> {
     let mut scene_arg: Option<String> = None;
@@ -63,7 +63,7 @@ fn run() -> Result<(), String> {
         Scene::Yarn(s) => yarnsim::mpm::YarnSim::new(s)
             .map(|_| ())
             .map_err(|e| e.to_string()),
-        Scene::MassSpring(l) => YarnBundle::massspring::MsModel::new(l.clone())
+        Scene::MassSpring(l) => yarnsim_fmu::models::massspring::MsModel::new(l.clone())
             .map(|_| ())
             .map_err(|e| e.0),
     }
@@ -88,7 +88,7 @@ fn run() -> Result<(), String> {
             if !no_build {
                 build_cdylib(&exe_dir)?;
             }
-            exe_dir.join(format!("lib{MODEL_IDENTIFIER}.so"))
+            exe_dir.join(yarnsim_fmu::LIBRARY_FILE)
         }
     };
     let so = std::fs::read(&lib).map_err(|e| {
@@ -172,5 +172,5 @@ fn build_cdylib(exe_dir: &std::path::Path) -> Result<(), String> {
 }
 
 fn main() -> ExitCode {
-    YarnBundle::tool_exit("build-fmu", run())
+    yarnsim_fmu::tool_exit("build-fmu", run())
 }

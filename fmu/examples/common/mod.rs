@@ -5,9 +5,9 @@ use std::ffi::CString;
 use std::path::PathBuf;
 
 use yarnsim::scene::Scene;
-use YarnBundle::ffi::*;
-use YarnBundle::model::*;
-use YarnBundle::SceneFmu;
+use yarnsim_fmu::fmi2::*;
+use yarnsim_fmu::model_description::*;
+use yarnsim_fmu::SceneFmu;
 
 /// A scene in a resource directory of its own (under the system's temporary
 /// directory, named after `tag` and the process), with the strings and

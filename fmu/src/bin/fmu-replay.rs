@@ -110,7 +110,7 @@ fn run() -> Result<(), String> {
         Scene::MassSpring(l) => {
             let integrator = match integrator {
                 Some(name) => name.parse()?,
-                None => YarnBundle::massspring::DEFAULT_INTEGRATOR,
+                None => yarnsim_fmu::models::massspring::DEFAULT_INTEGRATOR,
             };
             replay_mass_spring(&l, integrator, &read_rows(&inputs, 4)?, h, stop)?
         }
@@ -308,5 +308,5 @@ fn replay_mass_spring(
 }
 
 fn main() -> ExitCode {
-    YarnBundle::tool_exit("fmu-replay", run())
+    yarnsim_fmu::tool_exit("fmu-replay", run())
 }

@@ -7,9 +7,9 @@ use std::ffi::c_char;
 use libc::size_t;
 
 use super::*;
-use crate::ffi::{debug_logging, exports, instantiate, ok, string};
 use crate::instance::{escape_nul, LOG_ERROR};
-use crate::model::LOG_CATEGORIES;
+use crate::model_description::LOG_CATEGORIES;
+use crate::shell::{debug_logging, exports, instantiate, ok, string};
 
 #[no_mangle]
 pub extern "C" fn fmi3GetVersion() -> *const c_char {
@@ -127,9 +127,9 @@ pub unsafe extern "C" fn fmi3InstantiateCoSimulation(
 
 #[no_mangle]
 pub unsafe extern "C" fn fmi3FreeInstance(instance: fmi3Instance) {
-    // SAFETY: the same contract as fmi2FreeInstance: null (a no-op) or an
-    // instance this FMU handed out and the environment has not freed.
-    unsafe { crate::ffi::fmi2FreeInstance(instance) }
+    // SAFETY: null (a no-op) or an instance this FMU handed out and the
+    // environment has not freed (FMI contract).
+    unsafe { crate::shell::free_instance(instance) }
 }
 
 exports! { call3(fmi3Instance) -> fmi3Status;

@@ -5,12 +5,12 @@
 use libc::size_t;
 
 use super::*;
-use crate::instance::{error, LOG_ALL};
+use crate::instance::{error, Operation, LOG_ALL};
 
 #[no_mangle]
 pub unsafe extern "C" fn fmi3EnterStepMode(instance: fmi3Instance) -> fmi3Status {
     call3(instance, "fmi3EnterStepMode", |inst| {
-        inst.require("fmi3EnterStepMode")?;
+        inst.require(Operation::EnterStepMode)?;
         Ok(Status::Ok)
     })
 }

@@ -1,8 +1,8 @@
 //! The FMI 3.0 C ABI: all 75 functions of `fmi3FunctionTypes.h` (FMI 3.0
 //! standard, chapter 2.2 and 4.2), exported by the same cdylib as the FMI 2.0
-//! functions ([`crate::ffi`]) and a thin shell over the same [`Instance`] and
+//! functions ([`crate::fmi2`]) and a thin shell over the same [`Instance`] and
 //! models. Co-Simulation without event mode works ([`common`], [`values`],
-//! [`state`], [`cosim`]); Model Exchange, Scheduled Execution, clocks,
+//! [`fmu_state`], [`cosim`]); Model Exchange, Scheduled Execution, clocks,
 //! intervals, Binary and the other integer and float types, directional and
 //! adjoint derivatives and output derivatives return `fmi3Error` with a
 //! logged reason ([`unsupported`]), as the modelDescription declares.
@@ -11,7 +11,7 @@
 //! `fmi3Fatal` for that instance and never unwinds into the host) and logs
 //! every failure through the `fmi3LogMessageCallback`, which is not variadic
 //! (`(instanceEnvironment, status, category, message)`). The state table is
-//! [`crate::state_machine::ALLOWED`]'s `fmi3` rows.
+//! [`crate::instance::Operation::allowed`]'s FMI 3.0 rows.
 
 #![allow(
     non_snake_case,
@@ -25,12 +25,12 @@ use std::ffi::{c_char, c_int, c_void};
 
 pub mod common;
 pub mod cosim;
-pub mod state;
+pub mod fmu_state;
 pub mod unsupported;
 pub mod values;
 
-use crate::ffi::call;
 use crate::instance::{Instance, Status};
+use crate::shell::call;
 
 pub type fmi3Instance = *mut c_void;
 pub type fmi3InstanceEnvironment = *mut c_void;
@@ -62,7 +62,7 @@ pub const fmi3Fatal: fmi3Status = Status::Fatal as c_int;
 pub const fmi3Dependent: fmi3DependencyKind = 5;
 
 /// `fmi3LogMessageCallback`.
-pub type fmi3LogMessageCallback = crate::logging::Logger3;
+pub type fmi3LogMessageCallback = crate::instance::logging::Logger3;
 /// `fmi3IntermediateUpdateCallback` (never called: no intermediate update).
 pub type fmi3IntermediateUpdateCallback = Option<
     unsafe extern "C" fn(

@@ -9,8 +9,8 @@
 use libc::size_t;
 
 use super::*;
-use crate::ffi::{exports, slice};
 use crate::instance::error;
+use crate::shell::{exports, slice};
 
 /// Exports functions that always refuse: `name(args) => reason;`.
 macro_rules! refused {
@@ -51,12 +51,12 @@ fn no_variable(
 }
 
 /// Exports getters and setters of types without variables: `name(the
-/// arguments after nValueReferences) "the state table's row" => "type";`.
+/// arguments after nValueReferences) the operation whose state-table row it checks => "type";`.
 macro_rules! no_variable {
-    ($($name:ident($($arg:ident: $ty:ty),*) $row:literal => $tyname:literal;)*) => {$(
+    ($($name:ident($($arg:ident: $ty:ty),*) $op:ident => $tyname:literal;)*) => {$(
         exports! { call3(fmi3Instance) -> fmi3Status;
             $name(valueReferences: *const fmi3ValueReference, nValueReferences: size_t, $($arg: $ty),*) |inst| {
-                inst.require($row)?;
+                inst.require(crate::instance::Operation::$op)?;
                 no_variable(inst, $tyname, valueReferences, nValueReferences)
             };
         }
@@ -71,8 +71,8 @@ macro_rules! no_such_type {
         #[doc = concat!("`", stringify!($elem), "` (no variable of this type).")]
         pub type $elem = $rust;
         no_variable! {
-            $get(_values: *mut $elem, _nValues: size_t) "fmi2GetReal" => $tyname;
-            $set(_values: *const $elem, _nValues: size_t) "fmi2SetReal" => $tyname;
+            $get(_values: *mut $elem, _nValues: size_t) GetFloat => $tyname;
+            $set(_values: *const $elem, _nValues: size_t) SetFloat => $tyname;
         }
     )*};
 }
@@ -89,8 +89,8 @@ no_such_type! {
 }
 
 no_variable! {
-    fmi3GetBinary(_valueSizes: *mut size_t, _values: *mut fmi3Binary, _nValues: size_t) "fmi2GetReal" => "Binary";
-    fmi3SetBinary(_valueSizes: *const size_t, _values: *const fmi3Binary, _nValues: size_t) "fmi2SetReal" => "Binary";
+    fmi3GetBinary(_valueSizes: *mut size_t, _values: *mut fmi3Binary, _nValues: size_t) GetFloat => "Binary";
+    fmi3SetBinary(_valueSizes: *const size_t, _values: *const fmi3Binary, _nValues: size_t) SetFloat => "Binary";
 }
 
 const NO_CLOCKS: &str = "not supported: this FMU has no clocks";

@@ -2,13 +2,13 @@
 //! (scalars and the array outputs, `nValues` checked against the sum of the
 //! array sizes), Int32 (the substep count and the execution parameters),
 //! Boolean (a C `bool`) and String. The table is that of the FMI 2.0 ones
-//! ([`crate::ffi::value_exports`]), with `nValues`.
+//! ([`crate::shell::value_exports`]), with `nValues`.
 
 use std::ffi::c_int;
 
 use super::*;
-use crate::ffi::{get_strings, ok, set_strings, value_exports};
 use crate::instance::Res;
+use crate::shell::{get_strings, ok, set_strings, value_exports};
 
 /// The FMI 3.0 C `bool`s as the FMI 2.0 `int`s that [`Instance`] reads.
 fn ints_of(vals: &[u8]) -> Vec<c_int> {

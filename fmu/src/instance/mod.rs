@@ -1,36 +1,45 @@
-//! One FMU instance: the time keeping, the stepping and the values around a
-//! [`FmuModel`] (the yarn bundle of [`crate::yarn`] or the mass-spring system
-//! of [`crate::massspring`]), independent of the C ABI (which lives in
-//! [`crate::ffi`]). The state table is in [`crate::state_machine`], the FMU
-//! state bytes in [`crate::state_bytes`], the resource location in
-//! [`crate::resources`], the logger in [`crate::logging`]; their items are
-//! re-exported here.
+//! One FMU instance, model- and version-neutral: the time keeping, the
+//! stepping and the values around a [`FmuModel`] (the yarn bundle of
+//! [`crate::models::yarn`] or the mass-spring system of
+//! [`crate::models::massspring`]), independent of the C ABIs
+//! ([`crate::fmi2`], [`crate::fmi3`], [`crate::shell`]). Its phase and the
+//! state table keyed by [`Operation`] are in [`phase`], the FMU states
+//! (snapshots and their bytes) in [`snapshot`] and `fmu_state.rs`, the
+//! FMI 3.0 arrays and `nValues` counts in `arrays.rs`, the clock in
+//! [`clock`], the resource location in [`resources`], the logger in
+//! [`logging`]; their items are re-exported here.
 
 use std::ffi::{c_int, c_void, CString};
 use std::path::PathBuf;
 
-mod fmi3;
-mod states;
+mod arrays;
+pub mod clock;
+mod fmu_state;
+pub mod logging;
+pub mod phase;
+pub mod resources;
+pub mod snapshot;
 mod values;
 
 use yarnsim::scene::Scene;
 
-pub use crate::clock::Clock;
-pub use crate::fmu_model::{
-    shown, FmuModel, ModelError, ModelResult, ModelState, ParamCheck, SetContext, StepFailure,
+pub use crate::models::model::{
+    shown, FmuModel, ModelError, ModelResult, ModelSnapshot, ParamCheck, SetContext, StepFailure,
     VarName,
 };
-pub use crate::logging::*;
+pub use crate::models::state_bytes::*;
 pub use crate::models::{new_model, SceneFmu};
-use crate::resources::read_scene;
-pub use crate::resources::resource_path;
-pub use crate::snapshot::*;
-pub use crate::state_bytes::*;
-pub use crate::state_machine::{
-    error, message_in, name_in, parameter_settable, phase_name, Api, Fail, Phase, Res, Status,
+pub use clock::Clock;
+pub use logging::*;
+pub use phase::{
+    error, parameter_settable, phase_name, phase_name_in, status_name, Api, Fail, Operation, Phase,
+    Res, Status,
 };
+use resources::read_scene;
+pub use resources::resource_path;
+pub use snapshot::*;
 
-use crate::model::{
+use crate::model_description::{
     DEFAULT_MAX_SUBSTEPS, DEFAULT_THREADS, LOG_CATEGORIES, MAX_THREADS, SCENE_FILE,
     VR_MAX_SUBSTEPS, VR_SUBSTEPS, VR_THREADS,
 };
@@ -261,7 +270,7 @@ impl Instance {
         }
         let cat = CString::new(LOG_CATEGORIES[category].0).expect("no NUL");
         if let Some(logger) = self.logger3 {
-            let text = escape_nul(&message_in(self.api, msg));
+            let text = escape_nul(msg);
             // SAFETY: the environment's fmi3LogMessageCallback, called with
             // its instance environment and NUL-terminated strings.
             unsafe { logger(self.env, status as c_int, cat.as_ptr(), text.as_ptr()) };
@@ -292,13 +301,13 @@ impl Instance {
     }
 
     /// The name and causality of any variable of the instance: the model's,
-    /// the common ones ([`crate::model::COMMON_VARIABLES`]) and, for FMI
+    /// the common ones ([`crate::model_description::COMMON_VARIABLES`]) and, for FMI
     /// 3.0, `time`.
     pub fn variable(&self, vr: u32) -> Option<VarName> {
-        if let Some((name, causality)) = crate::model::common_name(vr) {
+        if let Some((name, causality)) = crate::model_description::common_name(vr) {
             return Some(VarName::new(name, causality));
         }
-        if self.api == Api::Fmi3 && vr == crate::model::VR_TIME {
+        if self.api == Api::Fmi3 && vr == crate::model_description::VR_TIME {
             return Some(VarName::new("time", "independent"));
         }
         self.model.physics.variable(vr)
@@ -316,16 +325,20 @@ impl Instance {
             .map_or_else(|| format!("value reference {vr}"), |v| v.name)
     }
 
-    /// Fails unless the state table allows `func` in the current state
-    /// ([`crate::state_machine::ALLOWED`]).
-    /// `func` is the FMI 2.0 name; an [`Api::Fmi3`] instance checks the
-    /// FMI 3.0 function's row ([`name_in`]).
-    pub fn require(&self, func: &str) -> Res {
-        crate::state_machine::require(self.phase, name_in(self.api, func))
+    /// Fails unless the state table allows `op` in the current phase when
+    /// the instance's FMI version calls it ([`Operation::allowed`]).
+    pub fn require(&self, op: Operation) -> Res {
+        phase::require(self.phase, self.api, op)
+    }
+
+    /// The name of the function that calls `op` in the instance's FMI
+    /// version (`fmi2GetReal`, `fmi3GetFloat64`): what its messages say.
+    pub fn op_name(&self, op: Operation) -> &'static str {
+        op.name(self.api)
     }
 
     pub fn set_debug_logging(&mut self, on: bool, cats: &[&str]) -> Res {
-        self.require("fmi2SetDebugLogging")?;
+        self.require(Operation::SetDebugLogging)?;
         let mut idx = Vec::new();
         for c in cats {
             match LOG_CATEGORIES.iter().position(|(n, _)| n == c) {
@@ -346,7 +359,7 @@ impl Instance {
     }
 
     pub fn setup_experiment(&mut self, start: f64, stop: Option<f64>) -> Res {
-        self.require("fmi2SetupExperiment")?;
+        self.require(Operation::SetupExperiment)?;
         if !start.is_finite() || start.abs() > 1e12 {
             return error(format!("start time {start} must be finite"));
         }
@@ -366,14 +379,14 @@ impl Instance {
     }
 
     pub fn enter_initialization_mode(&mut self) -> Res {
-        self.require("fmi2EnterInitializationMode")?;
+        self.require(Operation::EnterInitializationMode)?;
         self.phase = Phase::InitializationMode;
         self.log(Status::Ok, LOG_EVENTS, "entered initialization mode");
         Ok(())
     }
 
     pub fn exit_initialization_mode(&mut self) -> Res<Status> {
-        self.require("fmi2ExitInitializationMode")?;
+        self.require(Operation::ExitInitializationMode)?;
         let threads = self.execution.threads;
         if threads == 0 {
             self.pool = None;
@@ -413,8 +426,11 @@ impl Instance {
                 Status::Warning,
                 LOG_WARNING,
                 &format!(
-                    "fmi2ExitInitializationMode: substep dt = {dt} s exceeds the stability bound {bound:.6e} s of this {} model; the run may diverge (fmi2DoStep then returns fmi2Discard)",
-                    self.bundled.identifier()
+                    "{}: substep dt = {dt} s exceeds the stability bound {bound:.6e} s of this {} model; the run may diverge ({} then returns {})",
+                    self.op_name(Operation::ExitInitializationMode),
+                    self.bundled.identifier(),
+                    self.op_name(Operation::DoStep),
+                    status_name(self.api, Status::Discard)
                 ),
             );
             return Ok(Status::Warning);
@@ -423,14 +439,14 @@ impl Instance {
     }
 
     pub fn terminate(&mut self) -> Res {
-        self.require("fmi2Terminate")?;
+        self.require(Operation::Terminate)?;
         self.phase = Phase::Terminated;
         self.log(Status::Ok, LOG_EVENTS, "terminated");
         Ok(())
     }
 
     pub fn reset(&mut self) -> Res {
-        self.require("fmi2Reset")?;
+        self.require(Operation::Reset)?;
         self.model = Model::new(&self.bundled)?;
         self.execution = Execution::default();
         self.phase = Phase::Instantiated;
@@ -440,7 +456,7 @@ impl Instance {
 
     /// One communication step from `t` to `t + h`.
     pub fn do_step(&mut self, t: f64, h: f64) -> Res<Status> {
-        self.require("fmi2DoStep")?;
+        self.require(Operation::DoStep)?;
         let m = &mut self.model;
         if !(t.is_finite() && h.is_finite()) {
             return error(format!(

@@ -7,7 +7,7 @@ impl Instance {
     /// Values that depend on the simulated state need a built simulation.
     /// After a diverged step they are those of the last good state (at
     /// `lastSuccessfulTime`), which the failed step restored.
-    fn require_state(&mut self) -> Res {
+    fn require_built(&mut self) -> Res {
         self.model.ensure_built(self.count)
     }
 
@@ -29,17 +29,22 @@ impl Instance {
     }
 
     pub fn get_real(&mut self, vrs: &[u32], out: &mut [f64]) -> Res {
-        self.require("fmi2GetReal")?;
+        self.require(Operation::GetFloat)?;
         for (k, &vr) in vrs.iter().enumerate() {
-            if self.model.physics.is_state_output(vr) {
-                self.require_state()?;
+            if self.model.physics.is_simulated_output(vr) {
+                self.require_built()?;
             }
             let Some(v) = self.model.physics.get_real(vr) else {
-                return error(format!("fmi2GetReal: {}", self.not_a(vr, "Real variable")));
+                return error(format!(
+                    "{}: {}",
+                    self.op_name(Operation::GetFloat),
+                    self.not_a(vr, "Real variable")
+                ));
             };
             if !v.is_finite() {
                 return error(format!(
-                    "fmi2GetReal: {} is not finite ({v}) at t = {}",
+                    "{}: {} is not finite ({v}) at t = {}",
+                    self.op_name(Operation::GetFloat),
                     self.shown(vr),
                     self.model.clock.time
                 ));
@@ -50,7 +55,7 @@ impl Instance {
     }
 
     pub fn get_integer(&mut self, vrs: &[u32], out: &mut [c_int]) -> Res {
-        self.require("fmi2GetInteger")?;
+        self.require(Operation::GetInteger)?;
         for (k, &vr) in vrs.iter().enumerate() {
             out[k] = match vr {
                 // Saturates instead of wrapping past 2^31 - 1 substeps.
@@ -59,7 +64,8 @@ impl Instance {
                 VR_THREADS => self.execution.threads as c_int,
                 _ => {
                     return error(format!(
-                        "fmi2GetInteger: {}",
+                        "{}: {}",
+                        self.op_name(Operation::GetInteger),
                         self.not_a(vr, "Integer variable")
                     ))
                 }
@@ -69,11 +75,12 @@ impl Instance {
     }
 
     pub fn get_boolean(&mut self, vrs: &[u32], out: &mut [c_int]) -> Res {
-        self.require("fmi2GetBoolean")?;
+        self.require(Operation::GetBoolean)?;
         for (k, &vr) in vrs.iter().enumerate() {
             let Some(v) = self.model.physics.get_boolean(vr) else {
                 return error(format!(
-                    "fmi2GetBoolean: {}",
+                    "{}: {}",
+                    self.op_name(Operation::GetBoolean),
                     self.not_a(vr, "Boolean variable")
                 ));
             };
@@ -84,12 +91,13 @@ impl Instance {
 
     /// Returns the strings; they stay valid until the next call.
     pub fn get_string(&mut self, vrs: &[u32]) -> Res<&[CString]> {
-        self.require("fmi2GetString")?;
+        self.require(Operation::GetString)?;
         self.strings.clear();
         for &vr in vrs {
             let Some(v) = self.model.physics.get_string(vr) else {
                 return error(format!(
-                    "fmi2GetString: {}",
+                    "{}: {}",
+                    self.op_name(Operation::GetString),
                     self.not_a(vr, "String variable")
                 ));
             };
@@ -103,13 +111,13 @@ impl Instance {
     /// marks the simulation for rebuilding.
     fn set_values(
         &mut self,
-        func: &str,
+        op: Operation,
         set: impl FnOnce(&mut dyn FmuModel, ParamCheck, &SetContext) -> ModelResult<bool>,
     ) -> Res {
-        self.require(func)?;
-        let phase = self.phase;
+        self.require(op)?;
+        let (phase, api) = (self.phase, self.api);
         let check =
-            |name: &str| parameter_settable(phase, func, name).map_err(|f| ModelError(f.msg));
+            |name: &str| parameter_settable(phase, api, op, name).map_err(|f| ModelError(f.msg));
         let ctx = SetContext {
             resources: &self.resources,
             bundled: &self.bundled,
@@ -122,7 +130,7 @@ impl Instance {
 
     pub fn set_real(&mut self, vrs: &[u32], vals: &[f64]) -> Res {
         if let Some((&vr, v)) = vrs.iter().zip(vals).find(|(_, v)| !v.is_finite()) {
-            self.require("fmi2SetReal")?;
+            self.require(Operation::SetFloat)?;
             let what = match self.variable(vr) {
                 Some(VarName { name, causality }) => {
                     let kind = if causality == "parameter" {
@@ -134,25 +142,29 @@ impl Instance {
                 }
                 None => format!("{v} for value reference {vr} refused: values must be finite"),
             };
-            return error(format!("fmi2SetReal: {what}"));
+            return error(format!("{}: {what}", self.op_name(Operation::SetFloat)));
         }
-        self.set_values("fmi2SetReal", |m, check, _| m.set_real(vrs, vals, check))
+        self.set_values(Operation::SetFloat, |m, check, _| {
+            m.set_real(vrs, vals, check)
+        })
     }
 
     /// Sets the execution parameters `max_substeps_per_step` and `threads`
     /// (fixed: only before `fmi2ExitInitializationMode`). A rejected call
     /// changes nothing.
     pub fn set_integer(&mut self, vrs: &[u32], vals: &[c_int]) -> Res {
-        self.require("fmi2SetInteger")?;
+        self.require(Operation::SetInteger)?;
         let mut e = self.execution;
         for (&vr, &v) in vrs.iter().zip(vals) {
             match vr {
                 VR_MAX_SUBSTEPS | VR_THREADS => {
-                    parameter_settable(self.phase, "fmi2SetInteger", &self.name_of(vr))?
+                    let op = Operation::SetInteger;
+                    parameter_settable(self.phase, self.api, op, &self.name_of(vr))?
                 }
                 _ => {
                     return error(format!(
-                        "fmi2SetInteger: {}",
+                        "{}: {}",
+                        self.op_name(Operation::SetInteger),
                         self.not_a(vr, "Integer input or parameter")
                     ))
                 }
@@ -160,14 +172,16 @@ impl Instance {
             if vr == VR_MAX_SUBSTEPS {
                 if v < 1 {
                     return error(format!(
-                        "fmi2SetInteger: max_substeps_per_step = {v} must be at least 1"
+                        "{}: max_substeps_per_step = {v} must be at least 1",
+                        self.op_name(Operation::SetInteger)
                     ));
                 }
                 e.max_substeps = v as u32;
             } else {
                 if !(0..=MAX_THREADS as c_int).contains(&v) {
                     return error(format!(
-                        "fmi2SetInteger: threads = {v} must be 0 (all cores) to {MAX_THREADS}"
+                        "{}: threads = {v} must be 0 (all cores) to {MAX_THREADS}",
+                        self.op_name(Operation::SetInteger)
                     ));
                 }
                 e.threads = v as u32;
@@ -179,13 +193,13 @@ impl Instance {
 
     pub fn set_boolean(&mut self, vrs: &[u32], vals: &[c_int]) -> Res {
         let vals: Vec<bool> = vals.iter().map(|&v| v != 0).collect();
-        self.set_values("fmi2SetBoolean", |m, check, _| {
+        self.set_values(Operation::SetBoolean, |m, check, _| {
             m.set_boolean(vrs, &vals, check)
         })
     }
 
     pub fn set_string(&mut self, vrs: &[u32], vals: &[Option<String>]) -> Res {
-        self.set_values("fmi2SetString", |m, check, ctx| {
+        self.set_values(Operation::SetString, |m, check, ctx| {
             m.set_string(vrs, vals, check, ctx)
         })
     }

@@ -8,21 +8,21 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Mutex;
 
 use yarnsim::scene::YarnScene;
-use YarnBundle::ffi::*;
-use YarnBundle::instance::Logger;
-use YarnBundle::model::*;
-use YarnBundle::yarn::variables::*;
+use yarnsim_fmu::fmi2::*;
+use yarnsim_fmu::instance::Logger;
+use yarnsim_fmu::model_description::*;
+use yarnsim_fmu::models::yarn::variables::*;
 
 pub const SMALL_SCENE: &str = include_str!("../../scenes/small.toml");
 
-/// The cdylib cargo built for this test run: `deps/libYarnBundle.so` next to
+/// The cdylib cargo built for this test run: `deps/libyarnsim_fmu.so` next to
 /// the test executable (`cargo test` does not copy it up to `target/<profile>/`;
 /// a `cargo build` does, which is the fallback).
 pub fn cdylib_path() -> PathBuf {
     let exe = std::env::current_exe().unwrap();
     let deps = exe.parent().unwrap();
-    let name = format!("lib{}.so", YarnBundle::MODEL_IDENTIFIER);
-    [deps.join(&name), deps.parent().unwrap().join(&name)]
+    let name = yarnsim_fmu::LIBRARY_FILE;
+    [deps.join(name), deps.parent().unwrap().join(name)]
         .into_iter()
         .find(|p| p.exists())
         .unwrap_or_else(|| panic!("{name} was not built next to {}", deps.display()))
@@ -204,8 +204,8 @@ impl Fmu {
 
     /// Instantiates the mass-spring FMU for `layout`.
     pub fn mass_spring(layout: &yarnsim::massspring::MassSpringScene) -> Fmu {
-        let n = YarnBundle::massspring::num_particles(layout).unwrap();
-        let guid = YarnBundle::massspring::guid(layout);
+        let n = yarnsim_fmu::models::massspring::num_particles(layout).unwrap();
+        let guid = yarnsim_fmu::models::massspring::guid(layout);
         Self::try_with(&layout.to_toml_string(), n, &guid, "test").expect("fmi2Instantiate failed")
     }
 

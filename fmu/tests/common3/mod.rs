@@ -10,12 +10,12 @@ use std::sync::Mutex;
 
 use crate::common::resources_with;
 use yarnsim::scene::Scene;
-use YarnBundle::fmi3::common::*;
-use YarnBundle::fmi3::cosim::*;
-use YarnBundle::fmi3::state::*;
-use YarnBundle::fmi3::values::*;
-use YarnBundle::fmi3::*;
-use YarnBundle::SceneFmu;
+use yarnsim_fmu::fmi3::common::*;
+use yarnsim_fmu::fmi3::cosim::*;
+use yarnsim_fmu::fmi3::fmu_state::*;
+use yarnsim_fmu::fmi3::values::*;
+use yarnsim_fmu::fmi3::*;
+use yarnsim_fmu::SceneFmu;
 
 pub const SMALL_SCENE: &str = include_str!("../../scenes/small.toml");
 

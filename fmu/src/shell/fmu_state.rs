@@ -1,13 +1,14 @@
-//! The FMU-state functions of FMI 2.0 (`fmi2GetFMUstate` ...
-//! `fmi2DeSerializeFMUstate`) and their bodies, which the FMI 3.0 ones
-//! ([`crate::fmi3::state`]) share: the same snapshots and state bytes.
+//! The bodies of the FMU-state functions both versions export
+//! (`fmi2GetFMUstate` ... `fmi2DeSerializeFMUstate`, [`crate::fmi2::fmu_state`];
+//! `fmi3GetFMUState` ... `fmi3DeserializeFMUState`, [`crate::fmi3::fmu_state`]):
+//! the same snapshots and state bytes.
 
 use std::ffi::c_void;
 
 use libc::size_t;
 
-use super::{call, fmi2Byte, fmi2Component, fmi2FMUstate, fmi2Status, null, ok, slice};
-use crate::instance::{error, Instance, Res, Snapshot, Status};
+use super::{null, ok, slice};
+use crate::instance::{error, Instance, Operation, Res, Snapshot, Status};
 
 /// Exports the six FMU-state functions of either version over the bodies
 /// below: `call(instance type) -> status type, state type, byte type; get,
@@ -15,43 +16,38 @@ use crate::instance::{error, Instance, Res, Snapshot, Status};
 macro_rules! state_exports {
     ($call:ident($inst:ty) -> $status:ty, $state:ty, $byte:ty;
      $get:ident, $set:ident, $free:ident, $size:ident, $ser:ident, $deser:ident) => {
-        $crate::ffi::exports! { $call($inst) -> $status;
+        $crate::shell::exports! { $call($inst) -> $status;
             $get(FMUstate: *mut $state) |inst| {
                 // SAFETY: forwarded from the caller (FMI contract).
-                unsafe { $crate::ffi::get_state(inst, stringify!($get), FMUstate) }
+                unsafe { $crate::shell::get_state(inst, stringify!($get), FMUstate) }
             };
             $set(FMUstate: $state) |inst| {
                 // SAFETY: forwarded from the caller (FMI contract).
-                unsafe { $crate::ffi::set_state(inst, FMUstate) }
+                unsafe { $crate::shell::set_state(inst, FMUstate) }
             };
             $free(FMUstate: *mut $state) |_| {
                 // SAFETY: forwarded from the caller (FMI contract).
-                unsafe { $crate::ffi::free_state(FMUstate) }
+                unsafe { $crate::shell::free_state(FMUstate) }
             };
             $size(FMUstate: $state, size: *mut libc::size_t) |inst| {
                 // SAFETY: forwarded from the caller (FMI contract).
-                unsafe { $crate::ffi::state_size(inst, stringify!($size), FMUstate, size) }
+                unsafe { $crate::shell::state_size(inst, stringify!($size), FMUstate, size) }
             };
             $ser(FMUstate: $state, serializedState: *mut $byte, size: libc::size_t) |inst| {
                 let (func, size_func) = (stringify!($ser), stringify!($size));
                 let buf = serializedState.cast::<u8>();
                 // SAFETY: forwarded from the caller (FMI contract).
-                unsafe { $crate::ffi::serialize_state(inst, func, size_func, FMUstate, buf, size) }
+                unsafe { $crate::shell::serialize_state(inst, func, size_func, FMUstate, buf, size) }
             };
             $deser(serializedState: *const $byte, size: libc::size_t, FMUstate: *mut $state) |inst| {
                 let bytes = serializedState.cast::<u8>();
                 // SAFETY: forwarded from the caller (FMI contract).
-                unsafe { $crate::ffi::deserialize_state(inst, stringify!($deser), bytes, size, FMUstate) }
+                unsafe { $crate::shell::deserialize_state(inst, stringify!($deser), bytes, size, FMUstate) }
             };
         }
     };
 }
 pub(crate) use state_exports;
-
-state_exports! { call(fmi2Component) -> fmi2Status, fmi2FMUstate, fmi2Byte;
-    fmi2GetFMUstate, fmi2SetFMUstate, fmi2FreeFMUstate,
-    fmi2SerializedFMUstateSize, fmi2SerializeFMUstate, fmi2DeSerializeFMUstate
-}
 
 /// The environment's state slot and the state already in it (none where
 /// the slot holds null), for the functions that write a state into it.
@@ -92,7 +88,7 @@ pub(crate) unsafe fn get_state(
     // SAFETY: as this function's contract.
     let (slot, existing) = unsafe { state_slot(func, FMUstate) }?;
     if let Some(new) = inst.get_fmu_state(existing)? {
-        *slot = Box::into_raw(new) as fmi2FMUstate;
+        *slot = Box::into_raw(new) as *mut c_void;
     }
     Ok(Status::Ok)
 }
@@ -152,7 +148,7 @@ pub(crate) unsafe fn state_size(
     let Some(size) = (unsafe { size.as_mut() }) else {
         return null(func, "size");
     };
-    *size = inst.serialize(func, s)?.len();
+    *size = inst.serialize(Operation::SerializedFmuStateSize, s)?.len();
     Ok(Status::Ok)
 }
 
@@ -174,7 +170,7 @@ pub(crate) unsafe fn serialize_state(
     let Some(s) = (unsafe { Snapshot::from_ptr(FMUstate) }) else {
         return error("FMUstate is null or not an FMU state of this FMU");
     };
-    let bytes = inst.serialize(func, s)?;
+    let bytes = inst.serialize(Operation::SerializeFmuState, s)?;
     if size < bytes.len() {
         return error(format!(
             "buffer of {size} bytes is smaller than the state's {} ({size_func})",

@@ -1,11 +1,11 @@
-//! The interface between the FMI front end ([`crate::instance`],
-//! [`crate::ffi`]) and the models it runs: [`FmuModel`], implemented by the
-//! yarn bundle ([`crate::yarn::YarnModel`]) and the mass-spring system
-//! ([`crate::massspring::MsModel`]). The models know nothing of FMI
+//! The interface between the instance ([`crate::instance`]) and the models
+//! it runs (as `model.h` in modelica/Reference-FMUs): [`FmuModel`], implemented by the
+//! yarn bundle ([`crate::models::yarn::YarnModel`]) and the mass-spring system
+//! ([`crate::models::massspring::MsModel`]). The models know nothing of FMI
 //! statuses, function names or C types: they answer with typed errors
 //! ([`ModelError`], [`StepFailure`]) and Rust values, and the front end turns
 //! them into fmi2 and fmi3 statuses and log lines: the FMI 2.0 front end
-//! ([`crate::ffi`]) and the FMI 3.0 one ([`crate::fmi3`]) drive the same
+//! ([`crate::fmi2`]) and the FMI 3.0 one ([`crate::fmi3`]) drive the same
 //! models.
 
 use std::any::Any;
@@ -14,7 +14,7 @@ use std::path::Path;
 
 use yarnsim::scene::Scene;
 
-use crate::state_bytes::{Reader, Writer};
+use crate::models::state_bytes::{Reader, Writer};
 
 /// A model refused a call: a value out of range, an unknown variable, a
 /// scene or parameter set it cannot build. The front end answers fmi2Error
@@ -93,9 +93,9 @@ pub type Checkpoint = Box<dyn Any + Send>;
 
 /// A model's part of an FMU state (`fmi2GetFMUstate`,
 /// [`FmuModel::save`]): what determines its future outputs, bit for bit
-/// (the simulated state, inputs, parameters), never scratch such as the
+/// (the simulation's values, inputs, parameters), never scratch such as the
 /// MPM grid; only a model of the kind that made it reads it.
-pub type ModelState = Box<dyn Any + Send>;
+pub type ModelSnapshot = Box<dyn Any + Send>;
 
 /// A model behind the FMU: its outputs, inputs and parameters by value
 /// reference, its substeps and its part of the FMU state.
@@ -148,7 +148,7 @@ pub trait FmuModel: fmt::Debug + Send {
     /// Puts back a [`Self::checkpoint`] of this model.
     fn restore(&mut self, c: Checkpoint);
     /// The name and causality of the model's own variable `vr` (scalars of
-    /// every type and the FMI 3.0 arrays; not the [`crate::model::COMMON_VARIABLES`],
+    /// every type and the FMI 3.0 arrays; not the [`crate::model_description::COMMON_VARIABLES`],
     /// which the instance serves), `None` if it has none.
     fn variable(&self, vr: u32) -> Option<VarName>;
     /// The name of the model's own variable `vr` as a message shows it
@@ -156,8 +156,9 @@ pub trait FmuModel: fmt::Debug + Send {
     fn shown(&self, vr: u32) -> String {
         shown(self.variable(vr), vr)
     }
-    /// Whether the Real variable `vr` depends on the simulated state.
-    fn is_state_output(&self, vr: u32) -> bool;
+    /// Whether the Real variable `vr` reads the simulation's values (positions,
+    /// velocities, energies), which need a built simulation.
+    fn is_simulated_output(&self, vr: u32) -> bool;
     /// The value of the Real variable `vr`, `None` if there is none.
     fn get_real(&mut self, vr: u32) -> Option<f64>;
     /// FMI 3.0 Float64 arrays: the number of values of the array output
@@ -196,20 +197,20 @@ pub trait FmuModel: fmt::Debug + Send {
         ctx: &SetContext,
     ) -> ModelResult<bool>;
     /// This model's part of an FMU state (`fmi2GetFMUstate`).
-    fn save(&self) -> ModelState;
+    fn save(&self) -> ModelSnapshot;
     /// Puts back a [`Self::save`] of a model of this kind (`fmi2SetFMUstate`),
     /// reusing this model's simulation where the state's scene and
     /// parameters are those it was built from. A refused state changes
     /// nothing.
-    fn load(&mut self, s: &ModelState) -> ModelResult;
+    fn load(&mut self, s: &ModelSnapshot) -> ModelResult;
     /// A saved state's part of a serialized FMU state; `self` (the
     /// instance's current model) may lend what the state shares with its
     /// scene.
-    fn write(&self, s: &ModelState, w: &mut Writer) -> Result<(), String>;
+    fn write(&self, s: &ModelSnapshot, w: &mut Writer) -> Result<(), String>;
     /// Reads what [`Self::write`] wrote into a state of this model's kind;
     /// `self` (with `built`: its simulation matches its scene and
     /// parameters) is used where the stored scene and parameters match.
-    fn read(&self, r: &mut Reader, built: bool, count: usize) -> Result<ModelState, String>;
+    fn read(&self, r: &mut Reader, built: bool, count: usize) -> Result<ModelSnapshot, String>;
     /// A boxed copy.
     fn box_clone(&self) -> Box<dyn FmuModel>;
 }

@@ -1,6 +1,6 @@
 //! The FMU's resources: the resource location URI handed to
 //! `fmi2Instantiate` and the bundled scene file read from it (size and file
-//! type limits in [`crate::model::read_scene_text`]).
+//! type limits in [`crate::model_description::read_scene_text`]).
 
 use std::path::{Path, PathBuf};
 
@@ -53,6 +53,6 @@ pub fn resource_path(uri: &str) -> Result<PathBuf, String> {
 }
 
 pub fn read_scene(path: &Path) -> Result<Scene, String> {
-    let text = crate::model::read_scene_text(path)?;
+    let text = crate::model_description::read_scene_text(path)?;
     scene_from_toml_str(&text).map_err(|e| format!("scene file {}: {e}", path.display()))
 }

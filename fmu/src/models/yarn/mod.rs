@@ -1,6 +1,6 @@
 //! The yarn-bundle physics behind the `YarnBundle` FMU: inputs, parameter
 //! overrides, the [`YarnSim`] they build, the values of its variables
-//! ([`variables`] lists them; [`inputs`] holds the inputs) and its part of
+//! ([`variables`](mod@variables) lists them; [`inputs`] holds the inputs) and its part of
 //! a serialized FMU state.
 
 use std::path::Path;
@@ -9,17 +9,17 @@ use yarnsim::mpm::state::DynamicState;
 use yarnsim::mpm::{Diagnostics, SimError, YarnSim};
 use yarnsim::scene::{Integrator, TransferScheme, YarnScene};
 
-use crate::fmu_model::{
-    refuse, Checkpoint, FmuModel, ModelError, ModelResult, ModelState, ParamCheck, SetContext,
+use crate::model_description::*;
+use crate::models::model::{
+    refuse, Checkpoint, FmuModel, ModelError, ModelResult, ModelSnapshot, ParamCheck, SetContext,
     StepFailure, VarName,
 };
-use crate::model::*;
-use crate::state_bytes::{Reader, Writer};
+use crate::models::state_bytes::{Reader, Writer};
 
 pub mod arrays;
+mod fmu_state;
 mod forces;
 mod inputs;
-mod state;
 pub mod variables;
 
 pub use forces::PinForces;
@@ -118,7 +118,7 @@ pub struct YarnModel {
 /// parameters, the scene, the inputs, the pin force sums and the
 /// simulation's dynamic state, without its grid or other scratch.
 #[derive(Clone, Debug)]
-pub struct YarnState {
+pub struct YarnSnapshot {
     pub config: Config,
     pub base: YarnScene,
     pub inputs: Inputs,
@@ -126,7 +126,7 @@ pub struct YarnState {
     pub sim: DynamicState,
 }
 
-impl YarnState {
+impl YarnSnapshot {
     /// The scene its simulation runs: the base scene with the parameters.
     fn scene(&self) -> YarnScene {
         effective_scene(&self.base, &self.config)
@@ -251,8 +251,8 @@ impl YarnModel {
     }
 
     /// This model's part of an FMU state: no grid, no scratch.
-    pub fn save(&self) -> YarnState {
-        YarnState {
+    pub fn save(&self) -> YarnSnapshot {
+        YarnSnapshot {
             config: self.config.clone(),
             base: self.base.clone(),
             inputs: self.inputs.clone(),
@@ -264,7 +264,7 @@ impl YarnModel {
     /// Puts back a [`Self::save`]: into this model's simulation when it runs
     /// the state's scene (the usual case: same parameters), else into a new
     /// simulation of that scene. A refused state changes nothing.
-    pub fn load(&mut self, s: &YarnState) -> ModelResult {
+    pub fn load(&mut self, s: &YarnSnapshot) -> ModelResult {
         let scene = s.scene();
         if *self.sim.scene() == scene {
             self.sim
@@ -383,8 +383,9 @@ impl FmuModel for YarnModel {
         }
         arrays::array_name(vr, self.count()).map(|n| VarName::new(n, "output"))
     }
-    /// Whether the Real variable `vr` depends on the simulated state.
-    fn is_state_output(&self, vr: u32) -> bool {
+    /// Whether the Real variable `vr` reads the simulation's values (positions,
+    /// velocities, energies), which need a built simulation.
+    fn is_simulated_output(&self, vr: u32) -> bool {
         matches!(vr, VR_KINETIC_ENERGY | VR_ELASTIC_ENERGY | VR_MAX_STRETCH)
             || ((VR_YARN_BASE..VR_PIN_BASE).contains(&vr)
                 && ((vr - VR_YARN_BASE) / 4) < self.count() as u32)
@@ -417,7 +418,7 @@ impl FmuModel for YarnModel {
                     _ => return None,
                 }
             }
-            _ if self.is_state_output(vr) => {
+            _ if self.is_simulated_output(vr) => {
                 let i = (vr - VR_YARN_BASE) as usize;
                 let (l, r) = self.sim.yarn_endpoints(i / 4);
                 [l.x, l.y, r.x, r.y][i % 4]
@@ -579,7 +580,7 @@ impl FmuModel for YarnModel {
         Ok(changed)
     }
     fn state_magic(&self) -> &'static [u8; 8] {
-        crate::state_bytes::YARN_STATE_MAGIC
+        crate::models::state_bytes::YARN_STATE_MAGIC
     }
     fn stable_dt(&self) -> Option<f64> {
         Some(self.sim.stable_dt())
@@ -617,22 +618,22 @@ impl FmuModel for YarnModel {
         };
         YarnModel::set_string(self, vrs, vals, check, ctx.resources, bundled)
     }
-    fn save(&self) -> ModelState {
+    fn save(&self) -> ModelSnapshot {
         Box::new(YarnModel::save(self))
     }
-    fn load(&mut self, s: &ModelState) -> ModelResult {
-        let Some(s) = s.downcast_ref::<YarnState>() else {
+    fn load(&mut self, s: &ModelSnapshot) -> ModelResult {
+        let Some(s) = s.downcast_ref::<YarnSnapshot>() else {
             return refuse("not the state of a yarn model");
         };
         YarnModel::load(self, s)
     }
-    fn write(&self, s: &ModelState, w: &mut Writer) -> Result<(), String> {
+    fn write(&self, s: &ModelSnapshot, w: &mut Writer) -> Result<(), String> {
         let s = s
-            .downcast_ref::<YarnState>()
+            .downcast_ref::<YarnSnapshot>()
             .ok_or("not the state of a yarn model")?;
         YarnModel::write(self, s, w)
     }
-    fn read(&self, r: &mut Reader, _built: bool, count: usize) -> Result<ModelState, String> {
+    fn read(&self, r: &mut Reader, _built: bool, count: usize) -> Result<ModelSnapshot, String> {
         Ok(Box::new(YarnModel::read(r, self, count)?))
     }
     fn box_clone(&self) -> Box<dyn FmuModel> {

@@ -1,19 +1,27 @@
 //! The models behind the FMUs, chosen by the bundled scene
 //! ([`yarnsim::scene::Scene`]): a yarn scene runs the yarn bundle of
-//! [`crate::yarn`] (`YarnBundle`), a mass-spring scene the system of
-//! [`crate::massspring`] (`MassSpring`). The one place that knows both; the
-//! model-neutral modules ([`crate::model`], [`crate::fmu_model`],
-//! [`crate::state_bytes`]) know neither.
+//! [`crate::models::yarn`] (`YarnBundle`), a mass-spring scene the system of
+//! [`crate::models::massspring`] (`MassSpring`), each a folder of the same
+//! files. This module is the one place that knows both; the model-neutral
+//! ones ([`crate::model_description`], [`model`], [`state_bytes`]) know
+//! neither.
 
 use yarnsim::scene::Scene;
 
-use crate::fmu_model::{FmuModel, ModelResult};
-use crate::massspring::MsModel;
-use crate::model::{write_model_description, write_model_description_fmi3, Description};
-use crate::yarn::variables::{
+pub mod massspring;
+pub mod model;
+pub mod state_bytes;
+pub mod yarn;
+
+use crate::model_description::{
+    write_model_description, write_model_description_fmi3, Description,
+};
+use crate::models::massspring::MsModel;
+use crate::models::model::{FmuModel, ModelResult};
+use crate::models::yarn::variables::{
     check_value_references, description, guid, num_yarns, MODEL_IDENTIFIER,
 };
-use crate::yarn::YarnModel;
+use crate::models::yarn::YarnModel;
 
 /// What an FMU needs of its bundled scene: its identifier, GUID and model
 /// description.
@@ -44,21 +52,21 @@ impl SceneFmu for Scene {
     fn identifier(&self) -> &'static str {
         match self {
             Scene::Yarn(_) => MODEL_IDENTIFIER,
-            Scene::MassSpring(_) => crate::massspring::MODEL_IDENTIFIER,
+            Scene::MassSpring(_) => crate::models::massspring::MODEL_IDENTIFIER,
         }
     }
 
     fn guid(&self) -> String {
         match self {
             Scene::Yarn(s) => guid(s),
-            Scene::MassSpring(l) => crate::massspring::guid(l),
+            Scene::MassSpring(l) => crate::models::massspring::guid(l),
         }
     }
 
     fn description(&self) -> Result<Description, String> {
         match self {
             Scene::Yarn(s) => check_value_references(s).map(|_| description(s)),
-            Scene::MassSpring(l) => crate::massspring::description(l),
+            Scene::MassSpring(l) => crate::models::massspring::description(l),
         }
     }
 
@@ -72,7 +80,7 @@ impl SceneFmu for Scene {
     fn summary(&self) -> String {
         let n = match self {
             Scene::Yarn(s) => Ok(num_yarns(s)),
-            Scene::MassSpring(l) => crate::massspring::num_particles(l),
+            Scene::MassSpring(l) => crate::models::massspring::num_particles(l),
         };
         match n {
             // `1 yarn`, `12 yarns`.

@@ -4,7 +4,7 @@
 use std::ffi::{c_char, c_int, c_void, CString};
 
 #[allow(unused_imports)] // for the doc links
-use crate::model::LOG_CATEGORIES;
+use crate::model_description::LOG_CATEGORIES;
 
 /// The logger callback: `(componentEnvironment, instanceName, status, category, message, ...)`.
 pub type Logger =

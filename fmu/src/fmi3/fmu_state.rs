@@ -1,11 +1,12 @@
 //! FMI 3.0 FMU states (get, set, free, serialize, deserialize; the bytes
-//! are the FMI 2.0 FMU's framing, [`crate::state_bytes`]) and the variable
+//! are the FMI 2.0 FMU's framing, [`crate::models::state_bytes`]) and the variable
 //! dependencies of the outputs.
 
 use libc::size_t;
 
 use super::*;
-use crate::ffi::{null, slice_mut, state_exports};
+use crate::instance::Operation;
+use crate::shell::{null, slice_mut, state_exports};
 
 state_exports! { call3(fmi3Instance) -> fmi3Status, fmi3FMUState, fmi3Byte;
     fmi3GetFMUState, fmi3SetFMUState, fmi3FreeFMUState,
@@ -20,7 +21,7 @@ pub unsafe extern "C" fn fmi3GetNumberOfVariableDependencies(
 ) -> fmi3Status {
     let func = "fmi3GetNumberOfVariableDependencies";
     call3(instance, func, |inst| {
-        inst.require(func)?;
+        inst.require(Operation::GetNumberOfVariableDependencies)?;
         // SAFETY: null or a writable size_t (FMI contract).
         let Some(n) = (unsafe { nDependencies.as_mut() }) else {
             return null(func, "nDependencies");
@@ -42,7 +43,7 @@ pub unsafe extern "C" fn fmi3GetVariableDependencies(
 ) -> fmi3Status {
     let func = "fmi3GetVariableDependencies";
     call3(instance, func, |inst| {
-        inst.require(func)?;
+        inst.require(Operation::GetVariableDependencies)?;
         let deps = inst.variable_dependencies(dependent)?;
         if deps.len() != nDependencies {
             return crate::instance::error(format!(

@@ -1,7 +1,7 @@
 //! The framing of a serialized FMU state, model-neutral: the state magics,
 //! the format version, the header size, and the little-endian writer and
 //! bounds-checked reader the models write and read their parts with. The
-//! snapshots and their header live in [`crate::snapshot`].
+//! snapshots and their header live in [`crate::instance::snapshot`].
 
 /// First bytes of a serialized FMU state of a yarn bundle.
 pub const YARN_STATE_MAGIC: &[u8; 8] = b"YBFMUST\0";

@@ -1,5 +1,5 @@
 //! The YarnBundle's part of a serialized FMU state: writing a saved
-//! [`YarnState`] and reading it back ([`YarnModel::write`],
+//! [`YarnSnapshot`] and reading it back ([`YarnModel::write`],
 //! [`YarnModel::read`]).
 
 use yarnsim::math::Vec2;
@@ -7,8 +7,8 @@ use yarnsim::mpm::YarnSim;
 use yarnsim::scene::{Integrator, TransferScheme, YarnScene};
 
 use super::variables::*;
-use super::{effective_scene, Config, Inputs, PinForces, YarnModel, YarnState};
-use crate::state_bytes::{Reader, Writer};
+use super::{effective_scene, Config, Inputs, PinForces, YarnModel, YarnSnapshot};
+use crate::models::state_bytes::{Reader, Writer};
 
 impl YarnModel {
     /// A saved state's part of a serialized FMU state: the pin inputs, the
@@ -16,7 +16,7 @@ impl YarnModel {
     /// carry their own header and checksum; encoded by this model's
     /// simulation when it runs the state's scene, else by one built for
     /// it).
-    pub fn write(&self, s: &YarnState, w: &mut Writer) -> Result<(), String> {
+    pub fn write(&self, s: &YarnSnapshot, w: &mut Writer) -> Result<(), String> {
         // Gravity and the attractor are in the library's state bytes.
         for p in &s.inputs.pins {
             w.f64(p.position[0]);
@@ -64,7 +64,7 @@ impl YarnModel {
     /// Reads what [`Self::write`] wrote; the library's state bytes are
     /// checked and decoded by `current`'s simulation when it runs the
     /// stored scene with the stored parameters, else by one built for them.
-    pub fn read(r: &mut Reader, current: &YarnModel, yarns: usize) -> Result<YarnState, String> {
+    pub fn read(r: &mut Reader, current: &YarnModel, yarns: usize) -> Result<YarnSnapshot, String> {
         let mut inputs = Inputs {
             pins: current.inputs.pins.clone(),
         };
@@ -144,7 +144,7 @@ impl YarnModel {
             sim.decode_state(sim_bytes)
         }
         .map_err(|e| e.to_string())?;
-        Ok(YarnState {
+        Ok(YarnSnapshot {
             config,
             base,
             inputs,

@@ -1,16 +1,16 @@
 //! FMU states: the snapshots `fmi2GetFMUstate` hands out (the wrapper's
 //! clock and the model's dynamic state, [`FmuModel::save`]; no scratch) and
 //! their bytes (`fmi2SerializeFMUstate`): header, checksum, the clock and
-//! the model's part, framed by [`crate::state_bytes`].
+//! the model's part, framed by [`crate::models::state_bytes`].
 
 use std::ffi::c_void;
 
 use yarnsim::mpm::state::fnv1a;
 
-use crate::clock::Clock;
-use crate::fmu_model::{FmuModel, ModelState};
-use crate::state_bytes::{Reader, Writer, STATE_HEADER, STATE_MAGICS, STATE_VERSION};
-use crate::state_machine::Phase;
+use super::phase::Phase;
+use crate::instance::clock::Clock;
+use crate::models::model::{FmuModel, ModelSnapshot};
+use crate::models::state_bytes::{Reader, Writer, STATE_HEADER, STATE_MAGICS, STATE_VERSION};
 
 /// A saved FMU state (`fmi2FMUstate`).
 pub struct Snapshot {
@@ -18,7 +18,7 @@ pub struct Snapshot {
     pub(crate) phase: Phase,
     pub(crate) clock: Clock,
     /// The model's part ([`FmuModel::save`]).
-    pub(crate) physics: ModelState,
+    pub(crate) physics: ModelSnapshot,
     /// The state magic of the model that made it ([`FmuModel::state_magic`]).
     pub(crate) kind: &'static [u8; 8],
     /// Its number of output objects ([`FmuModel::count`]).
@@ -54,13 +54,13 @@ impl Drop for Snapshot {
 /// [`MsModel::write`]) of `physics`, a state saved by a model of the kind of
 /// `current` (the instance's model). No pointers.
 ///
-/// [`YarnModel::write`]: crate::yarn::YarnModel::write
-/// [`MsModel::write`]: crate::massspring::MsModel::write
+/// [`YarnModel::write`]: crate::models::yarn::YarnModel::write
+/// [`MsModel::write`]: crate::models::massspring::MsModel::write
 pub fn serialize(
     phase: Phase,
     c: &Clock,
     current: &dyn FmuModel,
-    physics: &ModelState,
+    physics: &ModelSnapshot,
 ) -> Result<Vec<u8>, String> {
     // The header goes in front once the body is written.
     let mut w = Writer::with_header(STATE_HEADER);
@@ -93,7 +93,7 @@ pub fn deserialize(
     current: &dyn FmuModel,
     built: bool,
     count: usize,
-) -> Result<(Phase, Clock, ModelState), String> {
+) -> Result<(Phase, Clock, ModelSnapshot), String> {
     if bytes.len() < STATE_HEADER {
         return Err(format!(
             "state has {} bytes, at least {STATE_HEADER} needed",

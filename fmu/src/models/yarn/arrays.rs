@@ -5,7 +5,7 @@
 
 use yarnsim::scene::YarnScene;
 
-use crate::model::{ArrayVariable, VR_ARRAY_BASE};
+use crate::model_description::{ArrayVariable, VR_ARRAY_BASE};
 
 use super::YarnModel;
 

@@ -1,10 +1,10 @@
-//! What the FMI 3.0 front end ([`crate::fmi3`]) needs of an instance beyond
-//! the FMI 2.0 functions: values counted with `nValues` (arrays count with
-//! all their elements), the independent variable `time`, and the
+//! What an FMI 3.0 instance offers beyond the FMI 2.0 operations: values
+//! counted with `nValues` (arrays count with all their elements), the
+//! Float64 arrays, the independent variable `time`, and the
 //! `ModelStructure` dependencies of the outputs.
 
 use super::*;
-use crate::model::{fmi3_outputs, VR_TIME};
+use crate::model_description::{fmi3_outputs, VR_TIME};
 
 impl Instance {
     /// Fails unless `n_values` is the number of values of `vrs` (each a
@@ -24,7 +24,7 @@ impl Instance {
     /// (row-major); `out.len()` (nValues) must be their total. Never a
     /// non-finite value.
     pub fn get_float64(&mut self, vrs: &[u32], out: &mut [f64]) -> Res {
-        self.require("fmi2GetReal")?;
+        self.require(Operation::GetFloat)?;
         let physics = &self.model.physics;
         if vrs.iter().any(|&vr| physics.array_len(vr).is_some()) {
             self.model.ensure_built(self.count)?;
@@ -36,7 +36,8 @@ impl Instance {
             .sum();
         if total != out.len() {
             return error(format!(
-                "fmi3GetFloat64: nValues = {} but the {} value references have {total} values (an array counts with all its elements)",
+                "{}: nValues = {} but the {} value references have {total} values (an array counts with all its elements)",
+                self.op_name(Operation::GetFloat),
                 out.len(),
                 vrs.len()
             ));
@@ -49,13 +50,15 @@ impl Instance {
                     let dst = &mut out[k..k + n];
                     if !self.model.physics.get_real_array(vr, dst) {
                         return error(format!(
-                            "fmi3GetFloat64: the array {} cannot be read",
+                            "{}: the array {} cannot be read",
+                            self.op_name(Operation::GetFloat),
                             self.shown(vr)
                         ));
                     }
                     if let Some(v) = dst.iter().find(|v| !v.is_finite()) {
                         return error(format!(
-                            "fmi3GetFloat64: the array {} has a non-finite element ({v}) at t = {}",
+                            "{}: the array {} has a non-finite element ({v}) at t = {}",
+                            self.op_name(Operation::GetFloat),
                             self.shown(vr),
                             self.model.clock.time
                         ));
@@ -77,17 +80,18 @@ impl Instance {
 
     /// Sets Float64 inputs and parameters (no array is an input).
     pub fn set_float64(&mut self, vrs: &[u32], vals: &[f64]) -> Res {
-        self.require("fmi2SetReal")?;
+        self.require(Operation::SetFloat)?;
         if let Some(vr) = vrs
             .iter()
             .find(|&&vr| vr == VR_TIME || self.model.physics.array_len(vr).is_some())
         {
             return error(format!(
-                "fmi3SetFloat64: {} is an output or the independent variable, not an input or parameter",
+                "{}: {} is an output or the independent variable, not an input or parameter",
+                self.op_name(Operation::SetFloat),
                 self.shown(*vr)
             ));
         }
-        self.check_scalars("fmi3SetFloat64", vrs, vals.len())?;
+        self.check_scalars(self.op_name(Operation::SetFloat), vrs, vals.len())?;
         self.set_real(vrs, vals)
     }
 

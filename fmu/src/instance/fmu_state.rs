@@ -1,12 +1,14 @@
-//! The instance's FMU states: get, set, serialize and deserialize.
+//! The instance's FMU states (the one meaning of "state" in this crate):
+//! get, set, serialize and deserialize.
 
 use super::*;
 
 impl Instance {
-    /// Saves the clock and the model's dynamic state (no scratch such as
-    /// the MPM grid), into `into` or a new snapshot.
+    /// Saves the clock and the model's part ([`FmuModel::save`]: its
+    /// values, no scratch such as the MPM grid), into `into` or a new
+    /// snapshot.
     pub fn get_fmu_state(&mut self, into: Option<&mut Snapshot>) -> Res<Option<Box<Snapshot>>> {
-        self.require("fmi2GetFMUstate")?;
+        self.require(Operation::GetFmuState)?;
         // A snapshot always holds the state of a simulation built from its
         // parameters.
         self.model.ensure_built(self.count)?;
@@ -37,16 +39,17 @@ impl Instance {
     /// scratch) when the snapshot's scene and parameters are those it was
     /// built from, else builds one of them first.
     pub fn set_fmu_state(&mut self, s: &Snapshot) -> Res {
-        self.require("fmi2SetFMUstate")?;
+        self.require(Operation::SetFmuState)?;
         if s.kind != self.model.physics.state_magic() || s.count != self.count {
-            return error(
-                "fmi2SetFMUstate: the state belongs to another FMU (other model or number of outputs)",
-            );
+            return error(format!(
+                "{}: the state belongs to another FMU (other model or number of outputs)",
+                self.op_name(Operation::SetFmuState)
+            ));
         }
         self.model
             .physics
             .load(&s.physics)
-            .or_else(|e| error(format!("fmi2SetFMUstate: {e}")))?;
+            .or_else(|e| error(format!("{}: {e}", self.op_name(Operation::SetFmuState))))?;
         self.model.set_clock(&s.clock);
         self.phase = s.phase;
         self.log(
@@ -58,8 +61,11 @@ impl Instance {
     }
 
     /// The serialized bytes of a snapshot (made once, then cached).
-    pub fn serialize<'a>(&self, func: &str, s: &'a mut Snapshot) -> Res<&'a [u8]> {
-        self.require(func)?;
+    /// `op`: [`Operation::SerializedFmuStateSize`] or
+    /// [`Operation::SerializeFmuState`], the function its messages name.
+    pub fn serialize<'a>(&self, op: Operation, s: &'a mut Snapshot) -> Res<&'a [u8]> {
+        self.require(op)?;
+        let func = self.op_name(op);
         if s.bytes.is_none() {
             if s.kind != self.model.physics.state_magic() || s.count != self.count {
                 return error(format!(
@@ -74,11 +80,13 @@ impl Instance {
     }
 
     pub fn deserialize(&mut self, bytes: &[u8]) -> Res<Box<Snapshot>> {
-        self.require("fmi2DeSerializeFMUstate")?;
+        self.require(Operation::DeserializeFmuState)?;
         let m = &self.model;
         let (phase, clock, physics) =
-            deserialize(bytes, m.physics.as_ref(), !m.clock.dirty, self.count)
-                .or_else(|e| error(format!("fmi2DeSerializeFMUstate: {e}")))?;
+            deserialize(bytes, m.physics.as_ref(), !m.clock.dirty, self.count).or_else(|e| {
+                let func = self.op_name(Operation::DeserializeFmuState);
+                error(format!("{func}: {e}"))
+            })?;
         Ok(Box::new(Snapshot {
             magic: SNAPSHOT_MAGIC,
             phase,

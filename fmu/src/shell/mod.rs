@@ -1,15 +1,34 @@
-//! The shell around every export of either FMI version: [`call`] (the
-//! instance check, the logged failures, the caught panics) and the helpers
-//! that turn C pointers into Rust values.
+//! The shell around every export of either FMI version, model- and
+//! version-neutral: [`call`] (the instance check, the logged failures, the
+//! caught panics), the helpers that turn C pointers into Rust values, the
+//! export macros both front ends ([`crate::fmi2`], [`crate::fmi3`]) build
+//! their tables with, and the bodies of the FMU-state functions
+//! ([`fmu_state`]). The C types it takes are those the two versions share:
+//! an instance is a `void*`, a status a C `int` of the same values, a
+//! string a `const char*`.
 
-use std::ffi::CStr;
+#![allow(non_snake_case)]
+
+use std::ffi::{c_char, c_int, c_void, CStr};
 use std::panic::{catch_unwind, AssertUnwindSafe};
 
 use libc::size_t;
 
-use super::{fmi2Component, fmi2Error, fmi2Fatal, fmi2Status, fmi2String};
+mod fmu_state;
+
+pub(crate) use fmu_state::*;
+
+/// An instance as both versions pass it (`fmi2Component`, `fmi3Instance`).
+type Component = *mut c_void;
+/// A status as both versions return it (`fmi2Status`, `fmi3Status`).
+type CStatus = c_int;
+/// A C string (`fmi2String`, `fmi3String`).
+type CText = *const c_char;
+const STATUS_ERROR: CStatus = Status::Error as CStatus;
+const STATUS_FATAL: CStatus = Status::Fatal as CStatus;
+
 use crate::instance::{
-    error, message_in, Instance, Phase, Res, Status, LOG_ALL, LOG_DISCARD, LOG_ERROR, LOG_FATAL,
+    error, Instance, Operation, Phase, Res, Status, LOG_ALL, LOG_DISCARD, LOG_ERROR, LOG_FATAL,
 };
 
 pub(crate) fn panic_message(p: &(dyn std::any::Any + Send)) -> String {
@@ -22,28 +41,27 @@ pub(crate) fn panic_message(p: &(dyn std::any::Any + Send)) -> String {
     }
 }
 
-/// Runs `f` on the instance behind `c`: null or foreign pointers give
-/// fmi2Error, failures are logged (fmi2Error moves the instance to the error
-/// state), panics are caught and give fmi2Fatal.
+/// Runs `f` on the instance behind `c`: null or foreign pointers give an
+/// error status, failures are logged (an error moves the instance to the
+/// error state), panics are caught and give a fatal status.
 pub(crate) fn call(
-    c: fmi2Component,
+    c: Component,
     func: &str,
     f: impl FnOnce(&mut Instance) -> Res<Status>,
-) -> fmi2Status {
+) -> CStatus {
     // SAFETY: `c` is null or a component this FMU handed out (FMI contract);
     // the magic number rejects freed or foreign pointers in most cases.
     let Some(inst) = (unsafe { Instance::from_ptr(c) }) else {
-        return fmi2Error;
+        return STATUS_ERROR;
     };
     if inst.phase == Phase::Fatal {
+        let free = inst.op_name(Operation::FreeInstance);
         inst.log(
             Status::Fatal,
             LOG_FATAL,
-            &format!(
-                "{func}: the instance is in the fatal state; only fmi2FreeInstance is allowed"
-            ),
+            &format!("{func}: the instance is in the fatal state; only {free} is allowed"),
         );
-        return fmi2Fatal;
+        return STATUS_FATAL;
     }
     if inst.log_all() {
         inst.log(Status::Ok, LOG_ALL, func);
@@ -54,19 +72,17 @@ pub(crate) fn call(
     // SAFETY: as above; the closure has returned.
     let inst = unsafe { &mut *ptr };
     match result {
-        Ok(Ok(s)) => s as fmi2Status,
+        Ok(Ok(s)) => s as CStatus,
         Ok(Err(fail)) => {
             let cat = match fail.status {
                 Status::Discard => LOG_DISCARD,
                 Status::Fatal => LOG_FATAL,
                 _ => LOG_ERROR,
             };
-            // An FMI 3.0 instance's messages in FMI 3.0 words (FMI 2.0: unchanged).
-            let shown = message_in(inst.api, &fail.msg);
-            let msg = if shown.starts_with(func) {
-                shown
+            let msg = if fail.msg.starts_with(func) {
+                fail.msg
             } else {
-                format!("{func}: {shown}")
+                format!("{func}: {}", fail.msg)
             };
             inst.log(fail.status, cat, &msg);
             match fail.status {
@@ -74,7 +90,7 @@ pub(crate) fn call(
                 Status::Fatal => inst.phase = Phase::Fatal,
                 _ => {}
             }
-            fail.status as fmi2Status
+            fail.status as CStatus
         }
         Err(p) => {
             inst.phase = Phase::Fatal;
@@ -83,7 +99,7 @@ pub(crate) fn call(
                 LOG_FATAL,
                 &format!("{func}: internal error: {}", panic_message(&*p)),
             );
-            fmi2Fatal
+            STATUS_FATAL
         }
     }
 }
@@ -129,7 +145,7 @@ pub(crate) unsafe fn slice_mut<'a, T>(p: *mut T, n: size_t) -> Option<&'a mut [T
 ///
 /// # Safety
 /// `p` must be null or point to a NUL-terminated string valid for the call.
-pub(crate) unsafe fn string(p: fmi2String) -> Option<String> {
+pub(crate) unsafe fn string(p: CText) -> Option<String> {
     // SAFETY: non-null and NUL-terminated (the caller's contract).
     (!p.is_null()).then(|| unsafe { CStr::from_ptr(p) }.to_string_lossy().into_owned())
 }
@@ -181,7 +197,7 @@ pub(crate) unsafe fn set_args<'a, T>(
 }
 
 /// The string getter of either version: pointers to the instance's strings.
-pub(crate) fn get_strings(inst: &mut Instance, vrs: &[u32], out: &mut [fmi2String]) -> Res<Status> {
+pub(crate) fn get_strings(inst: &mut Instance, vrs: &[u32], out: &mut [CText]) -> Res<Status> {
     let strings = inst.get_string(vrs)?;
     for (o, s) in out.iter_mut().zip(strings) {
         *o = s.as_ptr();
@@ -193,11 +209,7 @@ pub(crate) fn get_strings(inst: &mut Instance, vrs: &[u32], out: &mut [fmi2Strin
 ///
 /// # Safety
 /// Each value is null or a NUL-terminated string valid for the call.
-pub(crate) unsafe fn set_strings(
-    inst: &mut Instance,
-    vrs: &[u32],
-    vals: &[fmi2String],
-) -> Res<Status> {
+pub(crate) unsafe fn set_strings(inst: &mut Instance, vrs: &[u32], vals: &[CText]) -> Res<Status> {
     // SAFETY: each value is null or a NUL-terminated string (FMI contract).
     let vals: Vec<Option<String>> = vals.iter().map(|&p| unsafe { string(p) }).collect();
     ok(inst.set_string(vrs, &vals))
@@ -213,7 +225,7 @@ pub(crate) unsafe fn debug_logging(
     inst: &mut Instance,
     func: &str,
     on: bool,
-    categories: *const fmi2String,
+    categories: *const CText,
     n: size_t,
 ) -> Res<Status> {
     // SAFETY: FMI passes `nCategories` category strings.
@@ -271,11 +283,11 @@ macro_rules! value_exports {
         ) -> $status {
             let $func = stringify!($name);
             $call(instance, $func, |$i| {
-                let n_values = $crate::ffi::value_exports!(@count nvr $($nv)?);
+                let n_values = $crate::shell::value_exports!(@count nvr $($nv)?);
                 // SAFETY: FMI passes `nvr` value references and an array of
                 // `n_values` values (null only when a count is 0, else refused).
                 let ($vrs, $vals) = unsafe {
-                    $crate::ffi::$args($func, $what, vr, nvr, values $(as $cast)?, n_values)
+                    $crate::shell::$args($func, $what, vr, nvr, values $(as $cast)?, n_values)
                 }?;
                 $body
             })
@@ -284,7 +296,7 @@ macro_rules! value_exports {
     ($call:ident($inst:ty) -> $status:ty, $what:literal, $nv:tt;
      $($name:ident($ptr:ty $(as $cast:ty)?, $args:ident)
        |$i:ident, $func:ident, $vrs:ident, $vals:ident| $body:expr;)*) => {$(
-        $crate::ffi::value_exports! { @one $call($inst) -> $status, $what, $nv;
+        $crate::shell::value_exports! { @one $call($inst) -> $status, $what, $nv;
             $name($ptr $(as $cast)?, $args) |$i, $func, $vrs, $vals| $body
         }
     )*};
@@ -300,8 +312,8 @@ pub(crate) use value_exports;
 /// `token` and `res` are null or NUL-terminated strings valid for the call.
 pub(crate) unsafe fn instantiate(
     name: Option<&str>,
-    token: fmi2String,
-    res: fmi2String,
+    token: CText,
+    res: CText,
     what: (&str, &str),
     checks: impl FnOnce() -> Result<(), String>,
     make: impl FnOnce(&str, &str, &str) -> Result<Box<Instance>, String>,
@@ -322,4 +334,22 @@ pub(crate) unsafe fn instantiate(
         make(name, &token, &res)
     }));
     result.unwrap_or_else(|p| Err(format!("internal error: {}", panic_message(&*p))))
+}
+
+/// `fmi2FreeInstance` / `fmi3FreeInstance`: frees the instance behind `c`
+/// (null or a foreign pointer: a no-op).
+///
+/// # Safety
+/// `c` is null or an instance this FMU handed out and the environment has
+/// not freed; the magic number rejects foreign pointers in most cases.
+pub(crate) unsafe fn free_instance(c: Component) {
+    // SAFETY: the caller's contract.
+    let Some(inst) = (unsafe { Instance::from_ptr(c) }) else {
+        return;
+    };
+    inst.invalidate();
+    // SAFETY: the instance was made by `Box::into_raw` at instantiation and
+    // is freed once (the magic is cleared above).
+    let b = unsafe { Box::from_raw(inst as *mut Instance) };
+    let _ = catch_unwind(AssertUnwindSafe(move || drop(b)));
 }

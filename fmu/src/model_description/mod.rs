@@ -3,8 +3,9 @@
 //! ([`COMMON_VARIABLES`]: `substeps` and the execution parameters, served by
 //! the instance), the scene file limits, the log categories, and the
 //! `modelDescription.xml` writer with the GUID hash ([`xml`]). Each model's
-//! own table is in its module ([`crate::yarn::variables`],
-//! [`crate::massspring`]); this module imports none of them.
+//! own table is in its folder ([`crate::models::yarn::variables`],
+//! [`crate::models::massspring::variables`](mod@crate::models::massspring::variables)); this module imports none of
+//! them.
 
 pub mod variables;
 pub mod xml;

@@ -8,7 +8,7 @@
 
 use yarnsim::scene::{Integrator, PinMotionKind, StepSize, TransferScheme, YarnScene};
 
-use crate::model::*;
+use crate::model_description::*;
 use Causality::{Input, Parameter};
 
 /// The FMI model identifier: the shared library's and the C symbols' name.
@@ -152,7 +152,7 @@ pub static YARN_VARIABLES: [VarSpec<YarnScene>; 21] = [
 ];
 
 /// The yarn's Real parameters that live in the scene, in table order (the
-/// order of [`crate::yarn::Config::reals`] and of the FMU state).
+/// order of [`crate::models::yarn::Config::reals`] and of the FMU state).
 pub fn yarn_real_parameters() -> impl Iterator<Item = (u32, SceneField<YarnScene>)> {
     YARN_VARIABLES.iter().filter_map(|v| match v.start {
         Start::Scene(f) => Some((v.vr, f)),

@@ -8,7 +8,7 @@ use yarnsim::mpm::YarnSim;
 use yarnsim::scene::YarnScene;
 
 use super::variables::fmu_pins;
-use crate::fmu_model::{refuse, ModelResult};
+use crate::models::model::{refuse, ModelResult};
 
 /// The inputs of one `motion = "input"` pin.
 #[derive(Clone, Copy, Debug, PartialEq)]
