@@ -7,7 +7,7 @@ mod common;
 use common::{straight, SceneBuilder};
 use yarnsim::massspring::{scenes, Integrator, IntegratorOptions, MassSpringError, Simulation};
 use yarnsim::math::{Mat2, Vec2};
-use yarnsim::mpm::constitutive::{frame_gradient, YarnEnergy};
+use yarnsim::mpm::laws::constitutive::{frame_gradient, YarnEnergy};
 use yarnsim::mpm::{Attractor, SimError};
 use yarnsim::scene::WallMode;
 use yarnsim::testing::reference_material;

@@ -8,7 +8,7 @@ mod common;
 
 use common::{capstan_threshold, momentum_scale, on_threads, straight, SceneBuilder};
 use yarnsim::math::Vec2;
-use yarnsim::mpm::sim::THETA;
+use yarnsim::mpm::driver::THETA;
 use yarnsim::scene::{Integrator, SceneError, StepSize, YarnScene};
 use yarnsim::testing::{
     cantilever_setup, cantilever_toml, capstan_toml, hanging_chain_period, hanging_chain_toml,

@@ -5,8 +5,10 @@ mod common;
 
 use common::{bundle, momentum_scale, pin_end, polyline, straight, Rng, SceneBuilder};
 use yarnsim::math::{perp, Mat2, Vec2};
-use yarnsim::mpm::grid::{self, Grid};
-use yarnsim::mpm::{grid_to_particle, particle_to_grid, simd, vertex_forces};
+use yarnsim::mpm::explicit::{grid_to_particle, particle_to_grid};
+use yarnsim::mpm::machinery::grid::{self, Grid};
+
+use yarnsim::mpm::machinery::simd;
 use yarnsim::scene::{TransferScheme, WallMode, YarnEnd, YarnScene, YarnSpec};
 use yarnsim::YarnSim;
 
@@ -74,7 +76,7 @@ fn grid_forces_are_minus_the_energy_gradient() {
         }
         let mut moved = p.vert.clone();
         moved.x = x;
-        e + vertex_forces::bending_energy(&moved, kb)
+        e + yarnsim::mpm::laws::bending::bending_energy(&moved, kb)
     };
 
     let mut max_f: f64 = 0.0;

@@ -1,10 +1,10 @@
-//! The yarn MPM's stable substep bound (`yarnsim::mpm::timestep`) and the
+//! The yarn MPM's stable substep bound (`yarnsim::mpm::driver::timestep`) and the
 //! divergence report of a substep that breaks it.
 
 mod common;
 
 use common::{straight, SceneBuilder};
-use yarnsim::mpm::timestep::{stable_dt, wave_speed};
+use yarnsim::mpm::driver::timestep::{stable_dt, wave_speed};
 use yarnsim::{SimError, YarnScene, YarnSim};
 
 /// The bare 64^2 scene with one straight yarn of 60 vertices.

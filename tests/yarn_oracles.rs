@@ -457,7 +457,7 @@ fn momenta_are_kept_under_flip() {
     let mut sim = spinning_bundle(4.0, Vec2::new(0.3, -0.2));
     assert_eq!(
         sim.transfer(),
-        yarnsim::mpm::transfer::Transfer::Flip { ratio: 1.0 }
+        yarnsim::mpm::machinery::transfer::Transfer::Flip { ratio: 1.0 }
     );
     let d0 = sim.diagnostics();
     let scale = common::momentum_scale(&sim);

@@ -5,7 +5,7 @@
 
 use std::ffi::c_void;
 
-use yarnsim::mpm::state::fnv1a;
+use yarnsim::mpm::driver::state::fnv1a;
 
 use crate::clock::Clock;
 use crate::fmu_model::{FmuModel, ModelState};
