@@ -15,6 +15,7 @@
 use rayon::prelude::*;
 
 use crate::math::Vec2;
+use crate::mpm::laws::attractor;
 use crate::mpm::laws::contact::{
     obstacle_friction, obstacle_normal, wall_velocity, ContactNode, WedgeTable,
 };
@@ -372,7 +373,7 @@ fn update_block<const FLIP: bool, const NEAR: bool>(
                 let xi = Vec2::new(i as f64, j as f64) * dx;
                 if let Some((pos, strength)) = ext.attractor {
                     let d = pos - xi;
-                    v += d * (dt * strength / (d.norm() + 0.01));
+                    v += attractor::pull(d, dt * strength);
                 }
                 if NEAR {
                     let touching = acc[MC] * inv_m;

@@ -9,6 +9,7 @@ use super::Problem;
 use crate::math::dual::jacobian;
 use crate::math::psd::{mul, project_psd, symmetrize};
 use crate::math::{Mat2, Vec2};
+use crate::mpm::laws::attractor;
 use crate::mpm::laws::bending::{bend_gradient_edges, project_bend};
 use crate::mpm::laws::constitutive::quad_gradient;
 
@@ -23,13 +24,6 @@ pub struct Blocks {
     /// Per contact term its weight `w` where it acts (`v . n < 0`), else 0:
     /// the block `w n n^T`.
     pub contact: Vec<f64>,
-}
-
-/// `phi(r) = s (r - 0.01 ln(r + 0.01))`: the attractor's potential per
-/// unit mass, `-grad phi = s (p - x) / (|p - x| + 0.01)`.
-#[inline]
-fn phi(r: f64, s: f64) -> f64 {
-    s * (r - 0.01 * (r + 0.01).ln())
 }
 
 /// The exact block of a pure fibre stretch (`gamma = normal = 0`: `psi =
@@ -124,7 +118,9 @@ impl Problem {
                 .map(|i| {
                     let x = a.x[i] - a.position;
                     let y = x + v[i] * self.dt;
-                    self.mass[i] * (phi(y.norm(), a.strength) - phi(x.norm(), a.strength))
+                    self.mass[i]
+                        * (attractor::potential(y.norm(), a.strength)
+                            - attractor::potential(x.norm(), a.strength))
                 })
                 .sum()
         });
@@ -162,7 +158,7 @@ impl Problem {
         if let Some(a) = &self.attractor {
             for (i, g) in g.iter_mut().enumerate() {
                 let y = a.x[i] + v[i] * self.dt - a.position;
-                *g += y * (self.mass[i] * self.dt * a.strength / (y.norm() + 0.01));
+                *g += attractor::pull(y, self.mass[i] * self.dt * a.strength);
             }
         }
         for c in &self.contacts {
@@ -211,20 +207,13 @@ impl Problem {
                 }
             })
             .collect();
-        // m dt^2 s [I / (r + 0.01) - y y^T / (r (r + 0.01)^2)]: positive
-        // definite (eigenvalues 1 / (r + 0.01) and 0.01 / (r + 0.01)^2)
+        // m dt^2 s [I / (r + e) - y y^T / (r (r + e)^2)]: positive
+        // definite
         let attr = self.attractor.as_ref().map_or(Vec::new(), |a| {
             (0..v.len())
                 .map(|i| {
                     let y = a.x[i] + v[i] * self.dt - a.position;
-                    let r = y.norm();
-                    let s = self.mass[i] * self.dt * self.dt * a.strength;
-                    let h = 1.0 / (r + 0.01);
-                    let t = if r > 0.0 { h * h / r } else { 0.0 };
-                    [
-                        [s * (h - t * y.x * y.x), -s * t * y.x * y.y],
-                        [-s * t * y.x * y.y, s * (h - t * y.y * y.y)],
-                    ]
+                    attractor::pull_jacobian(y, self.mass[i] * self.dt * self.dt * a.strength)
                 })
                 .collect()
         });

@@ -19,6 +19,7 @@
 use crate::math::dual::jacobian;
 use crate::math::psd::symmetrize;
 use crate::math::Vec2;
+use crate::mpm::laws::attractor;
 use crate::mpm::laws::bending::{bend_gradient_edges, curvature, project_bend, BendRest};
 
 /// A 2x2 block, row major.
@@ -51,17 +52,6 @@ pub struct Hessian {
     pub diag: Vec<Block>,
     pub off1: Vec<Block>,
     pub off2: Vec<Block>,
-}
-
-/// The attractor potential `phi(r) = s (r - 0.01 ln(r + 0.01))` and its
-/// first two derivatives.
-fn phi(r: f64, s: f64) -> (f64, f64, f64) {
-    let e = 0.01;
-    (
-        s * (r - e * (r + e).ln()),
-        s * (1.0 - e / (r + e)),
-        s * e / ((r + e) * (r + e)),
-    )
 }
 
 fn add(b: &mut Block, a: &Block, sign: f64) {
@@ -113,7 +103,7 @@ impl Rod {
         }
         if let Some((p, s)) = self.attractor {
             for (y, m) in y.iter().zip(&self.m) {
-                e += m * phi((y - p).norm(), s).0;
+                e += m * attractor::potential((y - p).norm(), s);
             }
         }
         e
@@ -163,7 +153,7 @@ impl Rod {
                 let r = y - p;
                 let d = r.norm();
                 if d > 0.0 {
-                    *g += r * (m * phi(d, s).1 / d);
+                    *g += r * (m * attractor::radial_derivatives(d, s).1 / d);
                 }
             }
         }
@@ -260,7 +250,7 @@ impl Rod {
                     continue;
                 }
                 let u = r / d;
-                let (_, d1, d2) = phi(d, s);
+                let (_, d1, d2) = attractor::radial_derivatives(d, s);
                 for a in 0..2 {
                     for c in 0..2 {
                         let uu = u[a] * u[c];
