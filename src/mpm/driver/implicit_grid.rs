@@ -17,13 +17,14 @@
 //! (unchanged: normal law, pooled Coulomb friction, walls) returns them
 //! and pools its friction over the normal impulse the solve delivered.
 
-use super::YarnSim;
+use super::{SimError, YarnSim};
 use crate::math::Vec2;
 use crate::mpm::explicit::grid_update::{self, GridForces};
 use crate::mpm::implicit_grid::{self, ContactTerm, Model, Problem};
 use crate::mpm::laws::contact::normal_share;
 use crate::mpm::laws::pins::PinEntry;
 use crate::mpm::machinery::grid::{Grid, BLOCK};
+use crate::scene::Obstacle;
 
 /// Cost of the implicit substeps (`[time] integrator = "implicit"`) since
 /// the start, the attempts that a cutback undid included
@@ -124,9 +125,82 @@ impl YarnSim {
     }
 }
 
+impl YarnSim {
+    /// The implicit grid update: `v*` without obstacles and walls (gravity
+    /// only), the fields' problems solved, then the obstacles and walls on
+    /// the solved velocities ([`implicit_solve`]); the pins are
+    /// constraints of the solve. `Err` (recorded in `failed`): a solve
+    /// failed.
+    pub(super) fn implicit_grid_velocities(
+        &mut self,
+        dt: f64,
+        flip: bool,
+        pin_entries: &[PinEntry],
+    ) -> Result<(), SimError> {
+        let passes = self.passes();
+        let obstacles: &[Obstacle] = if passes.obstacles {
+            &self.scene.obstacles
+        } else {
+            &[]
+        };
+        let bending = if passes.bending {
+            self.scene.material.bending
+        } else {
+            0.0
+        };
+        // the attractor is a term of the solve, not a force of the update
+        let ext = GridForces {
+            gravity: self.gravity,
+            attractor: None,
+            obstacles,
+            walls: self.scene.walls.mode,
+            wall_cells: self.scene.walls.cells as usize,
+        };
+        let model = Model {
+            energy: self.energy,
+            bending,
+            attractor: passes
+                .attractor
+                .then_some((self.attractor.position, self.attractor.strength)),
+        };
+        let mut problems = self.implicit_problems(&model, dt, pin_entries);
+        // v* without obstacles and walls; they act on the solved velocities
+        let (interior, mut masses, mut held_masses) =
+            (ext.without_boundaries(), Vec::new(), Vec::new());
+        if ext.has_boundaries() {
+            grid_update::record_masses(&self.grid, &mut masses);
+            if let Some(f) = &self.fields {
+                grid_update::record_masses(&f.grid, &mut held_masses);
+            }
+        }
+        if let Some(f) = &mut self.fields {
+            f.record_masses(&self.grid);
+            grid_update::grid_update(&mut f.grid, dt, &interior, flip);
+        }
+        grid_update::grid_update(&mut self.grid, dt, &interior, flip);
+        self.pin_reactions.resize(self.pins.len(), Vec2::zeros());
+        let out = ImplicitFields {
+            grid: &mut self.grid,
+            held: self.fields.as_mut().map(|f| &mut f.grid),
+            pin_reactions: &mut self.pin_reactions,
+            stats: &mut self.implicit_stats,
+        };
+        if let Err(what) = implicit_solve(&mut problems, out, [&masses, &held_masses], &ext, flip) {
+            let e = SimError::NonFinite {
+                step: self.steps + 1,
+                time: self.time + dt,
+                what,
+            };
+            self.failed = Some(e.clone());
+            return Err(e);
+        }
+        Ok(())
+    }
+}
+
 /// What [`implicit_solve`] writes: the (free) field's grid, the held
 /// field's with two fields, the pins' forces and the cost.
-pub(super) struct ImplicitFields<'a> {
+struct ImplicitFields<'a> {
     pub grid: &'a mut Grid,
     pub held: Option<&'a mut Grid>,
     pub pin_reactions: &'a mut Vec<Vec2>,
@@ -138,7 +212,7 @@ pub(super) struct ImplicitFields<'a> {
 /// laws act on its solved velocities (`masses`: each field's `(M, MC)`
 /// from before the grid update); the pins' forces from the multipliers.
 /// `Err`: why a solve failed.
-pub(super) fn implicit_solve(
+fn implicit_solve(
     problems: &mut [Problem],
     out: ImplicitFields,
     masses: [&[[f64; 2]]; 2],

@@ -1,42 +1,99 @@
-//! One substep of the yarn bundle: the passes in order (stress, scatter,
-//! grid update or implicit solve, boundaries, field contact, gather,
-//! pins), their timings, and the checks that turn a bad state into a
-//! [`SimError`].
+//! One substep of the yarn bundle: the one choice of integrator
+//! ([`YarnSim::substep_once`]), then, for the two grid integrators, the
+//! passes in order (stress, scatter, the integrator's grid velocities,
+//! field contact, gather, pins), their timings, and the checks that turn a
+//! bad state into a [`SimError`]. The explicit grid update is here
+//! ([`YarnSim::explicit_grid_velocities`]), the implicit one in
+//! `implicit_grid.rs`, the grid-free step in `implicit_vertex.rs`.
 
 use std::time::Instant;
 
-use super::implicit_grid::{implicit_solve, ImplicitFields};
 use super::{SimError, YarnSim};
-use crate::math::Vec2;
 use crate::mpm::explicit::grid_to_particle::{self, VertexGather};
 use crate::mpm::explicit::grid_update::{self, GridForces};
 use crate::mpm::explicit::particle_to_grid;
-use crate::mpm::laws::pins;
+use crate::mpm::laws::pins::{self, PinEntry};
 use crate::mpm::machinery::spin;
-use crate::scene::Obstacle;
+use crate::scene::{Integrator, Obstacle};
+
+/// The grid velocities of a grid integrator's substep, between the scatter
+/// and the field contact: `(sim, dt, flip, pin entries)`.
+type GridVelocities = fn(&mut YarnSim, f64, bool, &[PinEntry]) -> Result<(), SimError>;
 
 impl YarnSim {
-    /// One substep of `dt` (finite, > 0; not failed before): every pass
-    /// once. On a `SimError` the state is part-way through the substep
-    /// and the error is recorded in `failed`.
+    /// One substep of `dt` (finite, > 0; not failed before) by the scene's
+    /// integrator, chosen here and nowhere else. On a `SimError` the state
+    /// is part-way through the substep and the error is recorded in
+    /// `failed`.
     pub(super) fn substep_once(&mut self, dt: f64) -> Result<(), SimError> {
-        if self.is_gridless() {
-            return self.substep_gridless(dt);
+        match self.scene.time.integrator {
+            // the scatter carries the internal forces; the grid update
+            // adds gravity and the attractor and applies the boundaries
+            Integrator::Explicit => self.substep_grid(dt, true, Self::explicit_grid_velocities),
+            // the scatter carries momentum only: the internal forces (and
+            // the attractor) enter through the solve
+            Integrator::Implicit => self.substep_grid(dt, false, Self::implicit_grid_velocities),
+            Integrator::ImplicitVertices | Integrator::MidpointVertices => {
+                self.substep_gridless(dt)
+            }
         }
+    }
+
+    /// The explicit grid update of every field: velocities, gravity, the
+    /// attractor, obstacles and walls, then the pins' constraint.
+    fn explicit_grid_velocities(
+        &mut self,
+        dt: f64,
+        flip: bool,
+        pin_entries: &[PinEntry],
+    ) -> Result<(), SimError> {
+        let passes = self.passes();
+        let obstacles: &[Obstacle] = if passes.obstacles {
+            &self.scene.obstacles
+        } else {
+            &[]
+        };
+        let ext = GridForces {
+            gravity: self.gravity,
+            attractor: passes
+                .attractor
+                .then_some((self.attractor.position, self.attractor.strength)),
+            obstacles,
+            walls: self.scene.walls.mode,
+            wall_cells: self.scene.walls.cells as usize,
+        };
+        if let Some(f) = &mut self.fields {
+            f.record_masses(&self.grid);
+            grid_update::grid_update(&mut f.grid, dt, &ext, flip);
+        }
+        grid_update::grid_update(&mut self.grid, dt, &ext, flip);
+        if !self.pins.is_empty() {
+            pins::constrain_grid(
+                pin_entries,
+                self.pins.len(),
+                self.fields.as_mut().map_or(&mut self.grid, |f| &mut f.grid),
+                dt,
+                &mut self.pin_reactions,
+            );
+        }
+        Ok(())
+    }
+
+    /// A substep of a grid integrator: `scatter_forces` whether the
+    /// scatter carries the internal forces, `grid_velocities` the
+    /// integrator's update of the grid velocities.
+    fn substep_grid(
+        &mut self,
+        dt: f64,
+        scatter_forces: bool,
+        grid_velocities: GridVelocities,
+    ) -> Result<(), SimError> {
         let passes = self.passes();
         let bending = if passes.bending {
             self.scene.material.bending
         } else {
             0.0
         };
-        let empty: [Obstacle; 0] = [];
-        let obstacles: &[Obstacle] = if passes.obstacles {
-            &self.scene.obstacles
-        } else {
-            &empty
-        };
-
-        let implicit = self.is_implicit();
         let transfer = self.transfer;
         let flip = transfer.needs_delta();
         let t0 = Instant::now();
@@ -50,87 +107,27 @@ impl YarnSim {
             .fields
             .as_mut()
             .map(|f| (&mut f.grid, &f.vert_held[..], &f.quad_held[..]));
-        // implicit: the scatter carries momentum only, the internal forces
-        // (and the attractor) enter through the solve
         particle_to_grid::scatter_fields(
             &mut self.particles,
             &mut self.grid,
             held,
             dt,
             bending,
-            obstacles,
-            !implicit,
+            if passes.obstacles {
+                &self.scene.obstacles
+            } else {
+                &[]
+            },
+            scatter_forces,
         );
         let t2 = Instant::now();
-        let attractor = passes
-            .attractor
-            .then_some((self.attractor.position, self.attractor.strength));
-        let ext = GridForces {
-            gravity: self.gravity,
-            attractor: if implicit { None } else { attractor },
-            obstacles,
-            walls: self.scene.walls.mode,
-            wall_cells: self.scene.walls.cells as usize,
-        };
         let pin_entries = if self.pins.is_empty() {
             Vec::new()
         } else {
             let held = self.fields.as_ref().map_or(&self.grid, |f| &f.grid);
             pins::stencil_masses(&self.pins, &self.particles.vert, held, self.time + dt)
         };
-        let mut problems = if implicit {
-            let model = crate::mpm::implicit_grid::Model {
-                energy: self.energy,
-                bending,
-                attractor,
-            };
-            self.implicit_problems(&model, dt, &pin_entries)
-        } else {
-            Vec::new()
-        };
-        // implicit: v* without obstacles and walls; they act on the solved velocities
-        let (interior, mut masses, mut held_masses) =
-            (ext.without_boundaries(), Vec::new(), Vec::new());
-        let ext_update = if implicit { &interior } else { &ext };
-        if implicit && ext.has_boundaries() {
-            grid_update::record_masses(&self.grid, &mut masses);
-            if let Some(f) = &self.fields {
-                grid_update::record_masses(&f.grid, &mut held_masses);
-            }
-        }
-        if let Some(f) = &mut self.fields {
-            f.record_masses(&self.grid);
-            grid_update::grid_update(&mut f.grid, dt, ext_update, flip);
-        }
-        grid_update::grid_update(&mut self.grid, dt, ext_update, flip);
-        if implicit {
-            self.pin_reactions.resize(self.pins.len(), Vec2::zeros());
-            let out = ImplicitFields {
-                grid: &mut self.grid,
-                held: self.fields.as_mut().map(|f| &mut f.grid),
-                pin_reactions: &mut self.pin_reactions,
-                stats: &mut self.implicit_stats,
-            };
-            if let Err(what) =
-                implicit_solve(&mut problems, out, [&masses, &held_masses], &ext, flip)
-            {
-                let e = SimError::NonFinite {
-                    step: self.steps + 1,
-                    time: self.time + dt,
-                    what,
-                };
-                self.failed = Some(e.clone());
-                return Err(e);
-            }
-        } else if !self.pins.is_empty() {
-            pins::constrain_grid(
-                &pin_entries,
-                self.pins.len(),
-                self.fields.as_mut().map_or(&mut self.grid, |f| &mut f.grid),
-                dt,
-                &mut self.pin_reactions,
-            );
-        }
+        grid_velocities(self, dt, flip, &pin_entries)?;
         if let Some(f) = &mut self.fields {
             let mu = self.scene.material.friction;
             f.contact(
@@ -141,6 +138,11 @@ impl YarnSim {
                 &mut self.pin_reactions,
             );
         }
+        let obstacles: &[Obstacle] = if passes.obstacles {
+            &self.scene.obstacles
+        } else {
+            &[]
+        };
         let held = self
             .fields
             .as_ref()
