@@ -188,7 +188,7 @@ fn momentum_is_kept_and_threads_do_not_change_bits() {
             on_threads(threads, || {
                 let mut sim = YarnSim::new(&with(free_yarn(1e-3), integ, 2e-3)).unwrap();
                 {
-                    let p = sim.particles_mut();
+                    let p = yarnsim::testing::particles_mut(&mut sim);
                     for (i, (x, v)) in p.vert.x.iter().zip(p.vert.v.iter_mut()).enumerate() {
                         let r = x - Vec2::new(0.5, 0.61);
                         *v = Vec2::new(-r.y, r.x) * 3.0

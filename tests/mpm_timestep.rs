@@ -56,7 +56,7 @@ fn a_substep_beyond_the_bound_diverges() {
         s.time.dt = dt.into();
         let mut sim = YarnSim::new(&s).unwrap();
         {
-            let p = sim.particles_mut();
+            let p = yarnsim::testing::particles_mut(&mut sim);
             for (k, x) in p.vert.x.iter_mut().enumerate() {
                 x.y += if k % 2 == 0 { 0.002 } else { -0.002 };
             }

@@ -19,7 +19,7 @@
 //! * [`driver`]: [`YarnSim`], which runs the integrator a scene names
 //!   (one `match` per substep), cutback, the stable time step, the
 //!   dynamic state, diagnostics and statistics.
-//! * [`error`]: [`SimError`].
+//! * [`error`]: the error of a failed step or input, [`SimError`].
 //!
 //! A layer uses only the layers below it (`tools/check_modules.py` checks
 //! it): laws use the machinery, integrators the laws and the machinery,
@@ -27,9 +27,9 @@
 
 pub mod driver;
 pub mod error;
-pub mod explicit;
-pub mod implicit_grid;
-pub mod implicit_vertex;
+pub(crate) mod explicit;
+pub(crate) mod implicit_grid;
+pub(crate) mod implicit_vertex;
 pub mod laws;
 pub mod machinery;
 
@@ -37,4 +37,5 @@ pub use driver::{
     Attractor, Diagnostics, DtStats, ImplicitStats, PassTimes, Passes, SimError, Stepping, YarnSim,
 };
 pub use laws::pins::{Pin, PinMotion};
+pub use machinery::grid::GridGeom;
 pub use machinery::transfer::Transfer;

@@ -164,9 +164,11 @@ impl YarnSim {
     pub fn particles(&self) -> &Particles {
         &self.particles
     }
-    /// Mutable particles, to set up initial conditions in tests and tools.
-    /// The cached frame factorisations are recomputed at the next step.
-    pub fn particles_mut(&mut self) -> &mut Particles {
+    /// Mutable particles, to set up initial conditions in tests and tools
+    /// (`crate::testing::particles_mut`). The cached frame factorisations
+    /// are recomputed at the next step.
+    #[cfg_attr(not(feature = "testing"), allow(dead_code))]
+    pub(crate) fn particles_mut(&mut self) -> &mut Particles {
         self.frames_stale = true;
         &mut self.particles
     }

@@ -132,6 +132,7 @@ fn split_chunks<T>(v: &mut [T], n: usize) -> Vec<&mut [T]> {
 /// [`crate::mpm::explicit::grid_to_particle::quad_stress`]). `flip` keeps the impulse
 /// alone too (in lanes that only FLIP reads); `obstacles` are the ones
 /// whose contact mass is marked.
+#[cfg_attr(not(feature = "testing"), allow(dead_code))]
 pub fn scatter(p: &mut Particles, grid: &mut Grid, dt: f64, bending: f64, obstacles: &[Obstacle]) {
     scatter_fields(p, grid, None, dt, bending, obstacles, true)
 }

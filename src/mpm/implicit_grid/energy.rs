@@ -84,6 +84,7 @@ impl Problem {
     }
 
     /// The frames `(d1, d2)` of the quadrature particles at `v`.
+    #[cfg(test)]
     pub fn frames(&self, v: &[Vec2]) -> Vec<[f64; 4]> {
         self.quads.iter().map(|q| self.quad_d(q, v)).collect()
     }
@@ -235,6 +236,7 @@ impl Problem {
     }
 
     /// `H d = M d + sum_e J_e^T K_e J_e d` from the blocks.
+    #[cfg(test)]
     pub fn hess_vec_blocks(&self, k: &Blocks, d: &[Vec2]) -> Vec<Vec2> {
         let mut y = vec![Vec2::zeros(); d.len()];
         self.hess_vec_into(k, d, &mut y);
@@ -284,6 +286,7 @@ impl Problem {
     }
 
     /// The exact `H d` at `v` (unprojected blocks).
+    #[cfg(test)]
     pub fn hess_vec(&self, v: &[Vec2], d: &[Vec2]) -> Vec<Vec2> {
         self.hess_vec_blocks(&self.blocks(v, false), d)
     }

@@ -49,7 +49,9 @@ use crate::math::Vec2;
 use crate::mpm::laws::constitutive::YarnEnergy;
 
 pub use energy::Blocks;
-pub use newton::{solve, Precond, Settings, Solution, SolveStats};
+#[cfg(test)]
+use newton::Precond;
+pub use newton::{solve, Settings};
 pub use problem::Model;
 
 /// The minimisation of one implicit substep on the active grid nodes.

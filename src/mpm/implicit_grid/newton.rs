@@ -40,6 +40,7 @@ pub struct Settings {
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Precond {
     /// `diag H`.
+    #[cfg_attr(not(test), allow(dead_code))]
     Jacobi,
     /// The fibre stretch exactly, the rest by its diagonal
     /// ([`super::precond`]), built at the solve's first Newton iterate and

@@ -144,6 +144,7 @@ impl StiffPrecond {
     }
 
     /// Band half-width of the factored `S_a`.
+    #[cfg(test)]
     pub fn band(&self) -> usize {
         self.bw
     }

@@ -344,12 +344,9 @@ impl Problem {
     }
 
     /// Number of unknown nodes.
+    #[cfg(test)]
     pub fn len(&self) -> usize {
         self.nodes.len()
-    }
-    /// Whether there are no unknowns.
-    pub fn is_empty(&self) -> bool {
-        self.nodes.is_empty()
     }
     /// Whether an external potential (the attractor, an obstacle's
     /// contact) acts: the elastic energy alone keeps the momentum.

@@ -36,17 +36,8 @@ impl Banded {
         self.band[i * (self.w + 1) + (i - j)] += a;
     }
 
-    /// `A[i][j]`, zero outside the band.
-    pub fn get(&self, i: usize, j: usize) -> f64 {
-        let (i, j) = if i >= j { (i, j) } else { (j, i) };
-        if i - j > self.w {
-            0.0
-        } else {
-            self.band[i * (self.w + 1) + (i - j)]
-        }
-    }
-
     /// `A x`.
+    #[cfg(test)]
     pub fn mul(&self, x: &[f64]) -> Vec<f64> {
         let mut y = vec![0.0; self.n];
         for i in 0..self.n {

@@ -49,7 +49,6 @@ pub struct Stepped {
     /// The vertices in contact.
     pub contacts: Vec<Contact>,
     pub newton: usize,
-    pub rounds: usize,
 }
 
 /// The positions `x + reach v`.
@@ -191,7 +190,6 @@ pub fn step(
                 gradient: sol.gradient,
                 contacts,
                 newton,
-                rounds: round,
             });
         }
     }

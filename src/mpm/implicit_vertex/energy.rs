@@ -73,9 +73,6 @@ impl Rod {
     pub fn len(&self) -> usize {
         self.x.len()
     }
-    pub fn is_empty(&self) -> bool {
-        self.x.is_empty()
-    }
 
     /// End-of-step positions `x + dt v`.
     pub fn positions(&self, v: &[Vec2]) -> Vec<Vec2> {
@@ -270,6 +267,7 @@ impl Rod {
 
 impl Hessian {
     /// `H d`.
+    #[cfg(test)]
     pub fn mul(&self, d: &[Vec2]) -> Vec<Vec2> {
         let n = d.len();
         let m = |b: &Block, x: &Vec2| {

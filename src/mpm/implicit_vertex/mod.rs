@@ -36,6 +36,6 @@ pub mod contacts;
 pub mod energy;
 pub mod newton;
 
-pub use contacts::{step, Contact, Stepped, LAMBDA_RTOL, MAX_ROUNDS};
+pub use contacts::step;
 pub use energy::Rod;
 pub use newton::Settings;

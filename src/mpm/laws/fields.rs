@@ -54,13 +54,6 @@ pub struct Fields {
     pinned_node: Vec<u32>,
 }
 
-/// The held field's grid and membership, as the scatter and gathers read it.
-pub struct HeldField<'a> {
-    pub grid: &'a Grid,
-    pub vert: &'a [bool],
-    pub quad: &'a [bool],
-}
-
 impl Fields {
     /// Two fields when some yarns are held (`held_yarn[y]`: yarn `y` has a
     /// pinned vertex) and some are not; `None` otherwise (one field, the
@@ -88,15 +81,6 @@ impl Fields {
             mass_held: Vec::new(),
             pinned_node: Vec::new(),
         })
-    }
-
-    /// The held field as the gathers read it.
-    pub fn held(&self) -> HeldField<'_> {
-        HeldField {
-            grid: &self.grid,
-            vert: &self.vert_held,
-            quad: &self.quad_held,
-        }
     }
 
     /// Keeps the node masses of both fields (call after the scatter, before

@@ -18,7 +18,7 @@
 pub mod attractor;
 pub mod bending;
 pub mod constitutive;
-pub mod contact;
-pub mod fields;
+pub(crate) mod contact;
+pub(crate) mod fields;
 pub mod pins;
-pub mod vertex_forces;
+pub(crate) mod vertex_forces;

@@ -9,9 +9,9 @@
 //! * [`spin`]: the per-yarn angular momentum balance of the FLIP transfer.
 //! * [`simd`]: AVX2 + FMA / portable kernel dispatch and the fixed chunking.
 
-pub mod grid;
-pub mod line_pool;
+pub(crate) mod grid;
+pub(crate) mod line_pool;
 pub mod particles;
-pub mod simd;
-pub mod spin;
-pub mod transfer;
+pub(crate) mod simd;
+pub(crate) mod spin;
+pub(crate) mod transfer;

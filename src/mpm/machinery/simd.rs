@@ -40,6 +40,7 @@ fn widest_from_env() -> u8 {
 /// Limits every simulation in the process to kernels no wider than `k`
 /// (default: [`Kernels::Avx512`], i.e. the widest the CPU has). Results are
 /// bitwise the same for every choice; this exists to test exactly that.
+#[cfg_attr(not(feature = "testing"), allow(dead_code))]
 pub fn set_widest_kernels(k: Kernels) {
     WIDEST.store(k as u8, Ordering::Relaxed);
 }
@@ -117,8 +118,8 @@ pub(crate) fn chunk_range(n: usize, k: usize) -> std::ops::Range<usize> {
     (n * k / CHUNKS)..(n * (k + 1) / CHUNKS)
 }
 
-/// The scatter's chunks of `n` items (for tests).
-#[doc(hidden)]
+/// The scatter's chunks of `n` items (for tests and the roofline counts).
+#[cfg_attr(not(feature = "testing"), allow(dead_code))]
 pub fn chunk_bounds(n: usize) -> Vec<std::ops::Range<usize>> {
     (0..CHUNKS).map(|k| chunk_range(n, k)).collect()
 }
