@@ -22,7 +22,9 @@ pub trait Real:
     fn cst(v: f64) -> Self;
     /// The value (branches and clamps test it).
     fn val(self) -> f64;
+    /// The square root.
     fn sqrt(self) -> Self;
+    /// The natural logarithm.
     fn ln(self) -> Self;
 }
 
@@ -48,7 +50,9 @@ impl Real for f64 {
 /// `v + d eps` with `eps^2 = 0`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Dual {
+    /// The value.
     pub v: f64,
+    /// The derivative along the seed.
     pub d: f64,
 }
 

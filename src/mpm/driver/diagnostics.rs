@@ -8,19 +8,29 @@ use crate::mpm::laws::bending;
 /// Summary quantities of the current state.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Diagnostics {
+    /// Simulated time, s.
     pub time: f64,
+    /// Substeps taken.
     pub steps: u64,
+    /// Kinetic energy `sum m v^2 / 2` of the particles, J (per m of depth).
     pub kinetic_energy: f64,
+    /// Elastic energy of the yarn material and of bending, J (per m of depth).
     pub elastic_energy: f64,
     /// Gravitational potential energy `-sum m g.x`.
     pub potential_energy: f64,
+    /// Linear momentum.
     pub momentum: Vec2,
     /// Angular momentum about the origin, including the APIC affine part.
     pub angular_momentum: f64,
+    /// Smallest segment stretch `|x_r - x_l| / l0`.
     pub min_stretch: f64,
+    /// Largest segment stretch `|x_r - x_l| / l0`.
     pub max_stretch: f64,
+    /// Mean segment stretch `|x_r - x_l| / l0`.
     pub mean_stretch: f64,
+    /// Centre of mass, m.
     pub center_of_mass: Vec2,
+    /// Total mass (per m of depth).
     pub total_mass: f64,
 }
 

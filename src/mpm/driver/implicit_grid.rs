@@ -33,7 +33,9 @@ use crate::scene::Obstacle;
 pub struct ImplicitStats {
     /// Solves that converged.
     pub substeps: u64,
+    /// Newton iterations, summed.
     pub newton: u64,
+    /// CG iterations, summed.
     pub cg: u64,
     /// Most Newton iterations of one substep.
     pub max_newton: u64,
@@ -52,6 +54,7 @@ pub struct ImplicitStats {
     /// energy by more than [`super::ENERGY_TOL`], and the largest such
     /// rise, J.
     pub energy_kept: u64,
+    /// The largest energy rise so kept, J.
     pub max_energy_kept: f64,
 }
 

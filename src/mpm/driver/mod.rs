@@ -37,7 +37,12 @@ pub enum Stepping {
     Fixed(f64),
     /// `dt = "auto"`: each substep is `min(safety * stable_dt, dt_max)` of
     /// the state it starts from ([`timestep::stable_dt`]).
-    Auto { safety: f64, dt_max: f64 },
+    Auto {
+        /// Factor on the stability bound, in (0, 2].
+        safety: f64,
+        /// Largest substep, s.
+        dt_max: f64,
+    },
 }
 
 /// A running yarn-bundle simulation.
@@ -158,9 +163,11 @@ impl YarnSim {
         Ok(sim)
     }
 
+    /// The scene it was built from.
     pub fn scene(&self) -> &YarnScene {
         &self.scene
     }
+    /// The particles (vertices and quadrature particles) as they are now.
     pub fn particles(&self) -> &Particles {
         &self.particles
     }
@@ -172,9 +179,11 @@ impl YarnSim {
         self.frames_stale = true;
         &mut self.particles
     }
+    /// Simulated time, s.
     pub fn time(&self) -> f64 {
         self.time
     }
+    /// Substeps taken.
     pub fn steps(&self) -> u64 {
         self.steps
     }
@@ -239,18 +248,23 @@ impl YarnSim {
     pub fn dt_stats(&self) -> DtStats {
         self.dt_stats
     }
+    /// Starts the substep statistics ([`DtStats`]) afresh.
     pub fn reset_dt_stats(&mut self) {
         self.dt_stats = DtStats::default();
     }
+    /// The grid's geometry and its current window.
     pub fn grid_geom(&self) -> GridGeom {
         self.grid.geom
     }
+    /// The yarn material's energy (from the scene's material).
     pub fn energy_model(&self) -> &YarnEnergy {
         &self.energy
     }
+    /// Gravity, m/s^2.
     pub fn gravity(&self) -> Vec2 {
         self.gravity
     }
+    /// The attractor as it is set now.
     pub fn attractor(&self) -> Attractor {
         self.attractor
     }
@@ -287,6 +301,7 @@ impl YarnSim {
     pub fn failure(&self) -> Option<&SimError> {
         self.failed.as_ref()
     }
+    /// Number of yarns.
     pub fn num_yarns(&self) -> usize {
         self.particles.num_yarns()
     }
@@ -429,6 +444,7 @@ impl YarnSim {
     pub fn timings(&self) -> PassTimes {
         self.timings
     }
+    /// Starts the pass timings afresh.
     pub fn reset_timings(&mut self) {
         self.timings = PassTimes::default();
     }

@@ -23,22 +23,36 @@ const HEADER: usize = 8 + 4 + 8 * 5;
 /// Why a byte string is not a state of this simulation.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub enum StateError {
+    /// Fewer bytes than the header or the counts need.
     TooShort {
+        /// Bytes given.
         len: usize,
+        /// Bytes needed.
         need: usize,
     },
+    /// Not a yarn state (wrong magic number).
     BadMagic,
+    /// A state of another format version.
     BadVersion(u32),
+    /// A state of another scene (its fingerprint differs).
     OtherScene,
+    /// Particle counts other than the scene's.
     CountMismatch {
+        /// Vertices stored.
         vertices: u64,
+        /// Quadrature particles stored.
         quads: u64,
     },
+    /// The stored length disagrees with the bytes given.
     LengthMismatch {
+        /// Payload length the header declares.
         declared: u64,
+        /// Payload length given.
         actual: u64,
     },
+    /// The checksum does not match the bytes.
     Checksum,
+    /// A stored value is NaN or infinite.
     NonFinite,
     /// A stored input (gravity, attractor) outside the limits the
     /// simulation accepts from its setters.

@@ -4,10 +4,15 @@
 /// Which optional passes a scene needs; the stepper skips the others.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Passes {
+    /// Bending forces (bending stiffness > 0).
     pub bending: bool,
+    /// The plastic return mapping.
     pub plasticity: bool,
+    /// Obstacle contact.
     pub obstacles: bool,
+    /// The attractor (active, nonzero strength).
     pub attractor: bool,
+    /// Domain walls.
     pub walls: bool,
 }
 
@@ -26,10 +31,12 @@ pub struct PassTimes {
     pub gather_vertices: f64,
     /// Grid-to-particle of the quadrature particles, return mapping, stress.
     pub gather_quads: f64,
+    /// Substeps counted.
     pub substeps: u64,
 }
 
 impl PassTimes {
+    /// All passes together, s.
     pub fn total(&self) -> f64 {
         self.forces + self.scatter + self.grid + self.gather_vertices + self.gather_quads
     }
@@ -61,8 +68,11 @@ impl PassTimes {
 /// The substeps taken since the last reset: count and sizes.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct DtStats {
+    /// Substeps counted.
     pub substeps: u64,
+    /// Smallest substep, s.
     pub min: f64,
+    /// Largest substep, s.
     pub max: f64,
     /// Sum of the substeps (simulated time), s.
     pub sum: f64,

@@ -26,17 +26,28 @@ pub enum PinMotion {
     /// Held where they start.
     Fixed,
     /// `x(t) = x(0) + velocity t`.
-    Line { velocity: Vec2 },
+    Line {
+        /// m/s.
+        velocity: Vec2,
+    },
     /// Turned rigidly about `center`: `x(t) = center + Rot(omega t) (x(0) - center)`.
-    Circle { center: Vec2, omega: f64 },
+    Circle {
+        /// Centre of the turn, m.
+        center: Vec2,
+        /// Angular velocity, rad/s (counter-clockwise).
+        omega: f64,
+    },
     /// Driven from outside: the first vertex at
     /// `x(t) = position + velocity (t - since)` with velocity `velocity`, the
     /// others translated rigidly with it (their offsets from the first
     /// vertex stay those of t = 0). Until a target is set: `position` is the
     /// first vertex's start, `velocity` zero (a fixed pin).
     Input {
+        /// The first vertex's target position at `since`, m.
         position: Vec2,
+        /// Its target velocity, m/s.
         velocity: Vec2,
+        /// Time the target was set, s.
         since: f64,
     },
 }
@@ -50,6 +61,7 @@ pub struct Pin {
     pub vertices: Vec<usize>,
     /// Their positions at t = 0.
     pub origin: Vec<Vec2>,
+    /// How the pinned vertices move.
     pub motion: PinMotion,
 }
 

@@ -65,16 +65,21 @@ pub const DVY: usize = 3;
 /// Blocks are numbered inside the window.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct GridGeom {
+    /// Nodes per side.
     pub n: usize,
+    /// Node spacing, m.
     pub dx: f64,
+    /// `1 / dx`.
     pub inv_dx: f64,
     /// Blocks per side of the whole grid.
     pub nb: usize,
     /// First node of the window (multiples of [`BLOCK`]).
     pub i0: usize,
+    /// (`i0`: first row, `j0`: first column.)
     pub j0: usize,
     /// Window size in blocks.
     pub nbi: usize,
+    /// (`nbi` rows, `nbj` columns.)
     pub nbj: usize,
     /// Row stride of the window, `nbj * BLOCK`.
     pub stride: usize,
@@ -257,12 +262,15 @@ impl ScatterBuffer {
 /// active blocks), and the chunks' scatter buffers.
 #[derive(Clone, Debug)]
 pub struct Grid {
+    /// Geometry and window.
     pub geom: GridGeom,
+    /// The summed nodes of the window.
     pub node: LinePool<Node>,
     /// Blocks touched this substep, sorted.
     pub active: Vec<u32>,
     /// `is_active[b]` for every block.
     pub is_active: Vec<bool>,
+    /// The chunks' scatter buffers.
     pub buffers: Vec<ScatterBuffer>,
     /// The grid update's obstacle contact nodes, one list per block row
     /// (kept between substeps so their storage is reused).

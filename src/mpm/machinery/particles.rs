@@ -29,10 +29,13 @@ pub struct BendRest {
 /// Type-2 particles: the yarn vertices.
 #[derive(Clone, Debug, Default)]
 pub struct Vertices {
+    /// Positions, m.
     pub x: Vec<Vec2>,
+    /// Velocities, m/s.
     pub v: Vec<Vec2>,
     /// Affine velocity matrix (APIC `C`).
     pub c: Vec<Mat2>,
+    /// Masses (per m of depth).
     pub m: Vec<f64>,
     /// Quadrature particle of the segment to the left (this vertex is its right end), or [`NONE`].
     pub q_left: Vec<u32>,
@@ -53,9 +56,13 @@ pub struct Vertices {
 /// Type-3 particles: one quadrature point per segment.
 #[derive(Clone, Debug, Default)]
 pub struct Quads {
+    /// Positions, m.
     pub x: Vec<Vec2>,
+    /// Velocities, m/s.
     pub v: Vec<Vec2>,
+    /// Affine velocity matrix (APIC `C`).
     pub c: Vec<Mat2>,
+    /// Masses (per m of depth).
     pub m: Vec<f64>,
     /// Current material frame `d = [d1 | d2]`.
     pub d: Vec<Mat2>,
@@ -69,6 +76,7 @@ pub struct Quads {
     pub vol: Vec<f64>,
     /// Index of the left vertex; the right one is `left + 1`.
     pub left: Vec<u32>,
+    /// Stencils at the start-of-step positions (scratch).
     pub stencil: Vec<Stencil>,
     /// QR factorisation of `G = d / l0` for the current `d` (kept by the
     /// quadrature gather for the next step's stress; see [`Quads::refresh_frames`]).
@@ -101,7 +109,9 @@ impl Quads {
 /// All particles and the yarn topology.
 #[derive(Clone, Debug, Default)]
 pub struct Particles {
+    /// The vertices.
     pub vert: Vertices,
+    /// The quadrature particles.
     pub quad: Quads,
     /// `yarn_vertices[y]..yarn_vertices[y + 1]` are yarn `y`'s vertices.
     pub yarn_vertices: Vec<usize>,

@@ -25,7 +25,10 @@ pub enum Transfer {
     /// APIC: `v`, `C` from the grid.
     Apic,
     /// FLIP / APIC blend with FLIP ratio in `[0, 1]`.
-    Flip { ratio: f64 },
+    Flip {
+        /// Share of FLIP in the blend, in `[0, 1]`.
+        ratio: f64,
+    },
 }
 
 impl Transfer {

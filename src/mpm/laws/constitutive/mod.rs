@@ -15,7 +15,7 @@
 //! is mirrored: `A00 = f' r11 + g' r12`, `A01 = A10 = g' r22`, `A11 = h' r22`.
 //! In world terms, with `F = d D^-1` and `D = Q_D l0`, `dpsi/dF D^-T = P / l0`.
 
-pub mod frames;
+pub(crate) mod frames;
 
 use crate::math::dual::Real;
 use crate::math::qr::{qr, Qr2};
@@ -43,6 +43,7 @@ pub struct YarnEnergy {
 }
 
 impl YarnEnergy {
+    /// The energy of a scene's material.
     pub fn from_material(m: &Material) -> Self {
         YarnEnergy {
             k: m.k,
