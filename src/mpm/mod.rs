@@ -10,10 +10,10 @@
 //!   form written once: the constitutive model and its return mapping,
 //!   bending, the vertex forces, the attractor, obstacle and wall contact,
 //!   the two velocity fields' contact, pins.
-//! * the integrators, one folder each: [`explicit`] (the explicit passes:
+//! * the integrators, one folder each: `explicit` (the explicit passes:
 //!   P2G, grid update, G2P; the implicit grid integrator scatters and
-//!   gathers with the same passes), [`implicit_grid`] (backward Euler on
-//!   the grid velocities: Newton, PCG) and [`implicit_vertex`] (backward
+//!   gathers with the same passes), `implicit_grid` (backward Euler on
+//!   the grid velocities: Newton, PCG) and `implicit_vertex` (backward
 //!   Euler and the generalized midpoint rule on a single yarn's vertices,
 //!   without the grid).
 //! * [`driver`]: [`YarnSim`], which runs the integrator a scene names

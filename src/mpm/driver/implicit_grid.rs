@@ -28,7 +28,7 @@ use crate::scene::Obstacle;
 
 /// Cost of the implicit substeps (`[time] integrator = "implicit"`) since
 /// the start, the attempts that a cutback undid included
-/// ([`super::cutback`]).
+/// (`super::cutback`).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct ImplicitStats {
     /// Solves that converged.
@@ -39,7 +39,7 @@ pub struct ImplicitStats {
     pub cg: u64,
     /// Most Newton iterations of one substep.
     pub max_newton: u64,
-    /// Substeps run as two halves ([`super::cutback`]).
+    /// Substeps run as two halves (`super::cutback`).
     pub cutbacks: u64,
     /// Of those, the ones tried first and undone (a failed solve or a
     /// vertex past a cell); the others were past the advection limit of

@@ -1,4 +1,11 @@
-//! [`YarnSim`]: a yarn-bundle scene turned into a running MPM simulation.
+//! The driver: [`YarnSim`], a yarn-bundle scene turned into a running MPM
+//! simulation, and everything it does itself: stepping and the substep
+//! (`substep.rs`, where the integrator is chosen), the grid integrators'
+//! grid velocities as the substep calls them (`substep.rs`,
+//! `implicit_grid.rs`), the grid-free substep (`implicit_vertex.rs`),
+//! cutback (`cutback.rs`), the stable time step ([`timestep`]), the dynamic
+//! state ([`state`]), diagnostics (`diagnostics.rs`) and statistics
+//! (`stats.rs`).
 
 use crate::math::Vec2;
 pub use crate::mpm::error::SimError;
@@ -274,7 +281,7 @@ impl YarnSim {
         self.grid.memory_bytes() + self.fields.as_ref().map_or(0, |f| f.grid.memory_bytes())
     }
     /// Whether held and free yarns move in velocity fields of their own
-    /// ([`crate::mpm::laws::fields`]): the scene has both.
+    /// (`crate::mpm::laws::fields`): the scene has both.
     pub fn has_two_fields(&self) -> bool {
         self.fields.is_some()
     }
@@ -293,7 +300,7 @@ impl YarnSim {
     }
     /// Whether the substeps are backward Euler on the vertices without the
     /// grid (`integrator = "implicit-vertices"` or `"midpoint-vertices"`,
-    /// [`crate::mpm::implicit_vertex`]).
+    /// `crate::mpm::implicit_vertex`).
     pub fn is_gridless(&self) -> bool {
         self.scene.time.integrator.is_gridless()
     }

@@ -25,7 +25,7 @@
 //! lowers the real limit (the return mapping caps the shear stress), so
 //! there the bound is pessimistic (up to 10x).
 //! * **Bending.** The bending energy `B/2 kappa^2` (discrete elastic rods,
-//!   [`crate::mpm::laws::vertex_forces`]) gives flexural waves with `omega = sqrt(B / rho) q^2`;
+//!   `crate::mpm::laws::vertex_forces`) gives flexural waves with `omega = sqrt(B / rho) q^2`;
 //!   at the grid's shortest wavelength (`q = 2 / dx`) an explicit step needs
 //!   `dt <= 2 / omega = dx^2 sqrt(rho / B) / 2`. It is far above the
 //!   elastic bound at the built-in values (B = 1e-3 N m on 256^2: 7.6e-3 s
@@ -37,7 +37,7 @@
 //! bound of a scene at rest, a necessary condition, not a guarantee.
 //!
 //! **Implicit integrator** (`[time] integrator = "implicit"`, backward
-//! Euler on the grid velocities, [`crate::mpm::implicit_grid`]): the elastic
+//! Euler on the grid velocities, `crate::mpm::implicit_grid`): the elastic
 //! forces enter the solve, so neither the elastic-wave nor the bending
 //! bound applies. What remains is advection: a particle must not cross
 //! more than one cell per substep (the gather's check), so

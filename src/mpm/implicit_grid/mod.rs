@@ -23,12 +23,13 @@
 //! ordinary gather recomputes the frames from the grid and applies the
 //! plastic return mapping.
 //!
-//! The gradient is the explicit force law ([`dual`]); the Hessian is
+//! The gradient is the explicit force law (written over
+//! [`crate::math::dual`] in the laws); the Hessian is
 //! assembled once per Newton iteration as small element blocks (4x4 per
 //! quadrature particle in `(d1, d2)`, 4x4 per bending vertex in its edges
 //! `(e1, e2)`, 2x2 per node for the attractor), exact by forward-mode dual
 //! numbers (a pure fibre stretch in closed form), and each block projected
-//! onto the PSD cone ([`blocks`]: projected Newton, Teran, Sifakis, Irving,
+//! onto the PSD cone ([`crate::math::psd`]: projected Newton, Teran, Sifakis, Irving,
 //! Fedkiw 2005; the bending blocks in closed form) so the CG systems are
 //! positive definite.
 //! Fixed pins are linear constraints held by the mass-weighted projection

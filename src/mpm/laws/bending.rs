@@ -1,8 +1,17 @@
-//! Rest state of the bending energy: the discrete curvature of a turning
-//! angle and the rest curvature and Voronoi length of every vertex, after
-//! discrete elastic rods (Bergou et al. 2008) in 2D (the energy and its
-//! forces are in [`crate::mpm::laws::vertex_forces`]). The particle store keeps one
-//! [`BendRest`] per vertex; it depends on this module, not on the forces.
+//! The bending law: discrete elastic rods (Bergou et al. 2008) in 2D. At an
+//! interior vertex with edges `e1`, `e2` the curvature is `kappa = 2 tan(theta
+//! / 2) = 2 (e1 x e2) / (|e1| |e2| + e1 . e2)` and the energy `B / 2 (kappa -
+//! kappa0)^2 / l` (`kappa0` the rest curvature, `l` the rest Voronoi length).
+//!
+//! Here, once each: the rest state ([`curvature`], [`rest_of_curve`],
+//! `BendRest::new`; the particle store keeps one [`BendRest`] per vertex),
+//! the energy ([`bending_energy`]), its gradient in the edges over plain
+//! `f64`s, branch-free so that it vectorizes across vertices (`bend_gradients`,
+//! which `super::vertex_forces` turns into forces), the same gradient over
+//! the dual-number scalar ([`bend_gradient_edges`], [`bend_gradient`]) whose
+//! Jacobian is the exact Hessian block of the implicit integrators, and
+//! that block's projection onto the PSD cone in closed form
+//! ([`project_bend`]).
 
 use crate::math::dual::Real;
 use crate::math::psd::{mul, symmetrize};

@@ -4,15 +4,15 @@
 //!
 //! * [`constitutive`]: the anisotropic yarn energy of Jiang, Gast, Teran
 //!   2017, its stress and Mohr-Coulomb return mapping (with its dual-number
-//!   form), and [`constitutive::frames`], the same over batches of frames.
+//!   form), and `constitutive::frames`, the same over batches of frames.
 //! * [`bending`]: discrete-elastic-rod bending (Bergou et al. 2008): rest
 //!   state, energy, gradient, dual-number form and the PSD projection of
 //!   its Hessian blocks.
-//! * [`vertex_forces`]: fibre and bending forces on the yarn vertices.
+//! * `vertex_forces`: fibre and bending forces on the yarn vertices.
 //! * [`attractor`]: the attractor's potential, pull and Hessian, and its
 //!   input check.
-//! * [`contact`]: obstacles with Coulomb friction, walls, the grid's edge.
-//! * [`fields`]: the held and free velocity fields and their Coulomb contact.
+//! * `contact`: obstacles with Coulomb friction, walls, the grid's edge.
+//! * `fields`: the held and free velocity fields and their Coulomb contact.
 //! * [`pins`]: pinned and driven vertices and their reaction forces.
 
 pub mod attractor;

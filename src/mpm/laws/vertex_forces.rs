@@ -16,6 +16,7 @@
 //! yarn bends alike at any number of vertices. `B` (`material.bending`) is
 //! the bending stiffness of the rod in N m^2 per m of depth (N m).
 //!
+//! The bending gradient is the bending law's ([`super::bending`]).
 //! [`vertex_forces`] is a plain function of the positions (and the quadrature
 //! stress), callable without a grid: the scatter calls it per chunk, and an
 //! implicit solver or a test can call it directly.

@@ -73,7 +73,7 @@ pub struct GridGeom {
     pub inv_dx: f64,
     /// Blocks per side of the whole grid.
     pub nb: usize,
-    /// First node of the window (multiples of [`BLOCK`]).
+    /// First node of the window (multiples of `BLOCK`).
     pub i0: usize,
     /// (`i0`: first row, `j0`: first column.)
     pub j0: usize,

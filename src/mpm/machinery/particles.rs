@@ -42,14 +42,14 @@ pub struct Vertices {
     /// Quadrature particle of the segment to the right, or [`NONE`].
     pub q_right: Vec<u32>,
     /// Rest curvature and Voronoi length of the bending energy (see
-    /// [`crate::mpm::laws::vertex_forces`]); none at yarn ends.
+    /// `crate::mpm::laws::vertex_forces`); none at yarn ends.
     pub bend: Vec<BendRest>,
     /// Stencils at the start-of-step positions (scratch).
     pub stencil: Vec<Stencil>,
     /// Internal force of the current substep (scratch).
     pub f: Vec<Vec2>,
     /// `(x_new - x_old) x v_new` of the current substep without the mass
-    /// (scratch of the FLIP angular momentum balance, [`crate::mpm::machinery::spin`]).
+    /// (scratch of the FLIP angular momentum balance, `crate::mpm::machinery::spin`).
     pub spin: Vec<f64>,
 }
 

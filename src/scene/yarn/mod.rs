@@ -47,7 +47,7 @@ pub struct YarnScene {
 }
 
 /// The grid-to-particle velocity update (`[transfer]`); see
-/// [`crate::mpm::machinery::transfer`].
+/// `crate::mpm::machinery::transfer`.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct TransferSpec {
@@ -207,20 +207,20 @@ pub enum Integrator {
     Explicit,
     /// Backward Euler on the grid velocities as a minimisation (Gast,
     /// Schroeder, Stomakhin, Jiang, Teran 2015, "Optimization integrator for
-    /// large time steps", IEEE TVCG 21(10)), [`crate::mpm::implicit_grid`]: the
+    /// large time steps", IEEE TVCG 21(10)), `crate::mpm::implicit_grid`: the
     /// whole yarn energy in one velocity field (pins, obstacles and walls
     /// act as in the explicit step, after the solve); a
     /// scene outside that scope is refused at load naming the field, never
     /// run with the explicit step instead.
     Implicit,
     /// Backward Euler on the vertex velocities of a single yarn without the
-    /// grid ([`crate::mpm::implicit_vertex`]): for one yarn whose material has no
+    /// grid (`crate::mpm::implicit_vertex`): for one yarn whose material has no
     /// cross-section energy (`gamma = youngs_modulus = 0`), no walls; a
     /// scene outside that scope is refused at load naming the field.
     #[serde(rename = "implicit-vertices")]
     ImplicitVertices,
     /// The generalized midpoint rule (theta 0.55) on the same vertices, in
-    /// the same scope ([`crate::mpm::implicit_vertex`]): the implicit midpoint
+    /// the same scope (`crate::mpm::implicit_vertex`): the implicit midpoint
     /// rule's period error on slow modes with light damping (1.3 % per
     /// period at `omega dt = 0.042`) and strong damping of modes far above
     /// `1 / dt`; a contact's normal velocity stays inelastic.
@@ -373,7 +373,7 @@ pub struct Material {
     pub friction: f64,
     /// Bending stiffness `B` of the rod in N m^2 per m of depth (N m): the
     /// energy is `int B / 2 kappa^2 ds` (discrete elastic rods, see
-    /// [`crate::mpm::laws::vertex_forces`]). 0 disables bending.
+    /// `crate::mpm::laws::vertex_forces`). 0 disables bending.
     #[serde(default, deserialize_with = "nonnegative")]
     pub bending: f64,
     /// Density in kg/m^2: mass per metre of yarn per metre of depth.

@@ -14,6 +14,10 @@
 //! and `P = dpsi/dG = Q A R^-T` with `A = (dpsi/dR) R^T` whose upper triangle
 //! is mirrored: `A00 = f' r11 + g' r12`, `A01 = A10 = g' r22`, `A11 = h' r22`.
 //! In world terms, with `F = d D^-1` and `D = Q_D l0`, `dpsi/dF D^-T = P / l0`.
+//!
+//! The same stress over the dual-number scalar ([`stress`], [`quad_gradient`])
+//! gives the implicit integrators' exact Hessian blocks; `frames.rs` evaluates
+//! the law over batches of quadrature particles (vectorized).
 
 pub(crate) mod frames;
 
@@ -84,7 +88,7 @@ impl YarnEnergy {
     /// [`YarnEnergy::stress_qr`] from the rotation `(c, s)`, the clamped
     /// `r11 >= R11_MIN`, `r22 >= R22_MIN`, `r12`, and `ln22 = ln r22` (read
     /// only where `r22 < 1`): the arithmetic after the `ln`, shared with the
-    /// batched frame update ([`crate::mpm::laws::constitutive::frames`]).
+    /// batched frame update (`crate::mpm::laws::constitutive::frames`).
     #[inline(always)]
     pub fn stress_clamped(&self, c: f64, s: f64, r11: f64, r12: f64, r22: f64, ln22: f64) -> Mat2 {
         let fp = self.k * (r11 - 1.0);
