@@ -53,7 +53,7 @@ fn run(base: &YarnScene, implicit: Option<f64>, duration: f64, press: bool) -> (
     let mut sim = YarnSim::new(&s).unwrap();
     if press {
         let c = sim.diagnostics().center_of_mass;
-        let p = sim.particles_mut();
+        let p = yarnsim::testing::particles_mut(&mut sim);
         for (x, v) in p.vert.x.iter().zip(p.vert.v.iter_mut()) {
             let toward = if x.y > c.y { -3.0 } else { 3.0 };
             *v = perp(x - c) * 2.0 + Vec2::new(0.0, toward);

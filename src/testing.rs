@@ -457,3 +457,21 @@ mod tests {
         small_yarn_scene(2, 40, 64).validate().unwrap();
     }
 }
+
+/// Mutable particles of `sim`, to set up initial conditions in tests and
+/// studies (not part of the simulator's API); the cached frame
+/// factorisations are recomputed at the next step.
+pub fn particles_mut(sim: &mut crate::YarnSim) -> &mut crate::mpm::machinery::particles::Particles {
+    sim.particles_mut()
+}
+
+/// The solver's grid machinery and passes that the physics tests and the
+/// roofline counts drive directly (not part of the simulator's API): the
+/// grid, its node layouts and buffers, the kernel dispatch, the scatter and
+/// the quadrature particles' stress pass.
+pub mod internals {
+    pub use crate::mpm::explicit::grid_to_particle::quad_stress;
+    pub use crate::mpm::explicit::particle_to_grid::scatter;
+    pub use crate::mpm::machinery::grid::{Grid, Node, P2gNode, BLOCK, M, P2G_LANES, PX, PY};
+    pub use crate::mpm::machinery::simd::{chunk_bounds, kernels, set_widest_kernels, Kernels};
+}

@@ -164,7 +164,7 @@ fn kick(sim: &mut YarnSim, centre: Vec2, speed: f64) {
             Vec2::new(0.0, -speed)
         }
     };
-    let p = sim.particles_mut();
+    let p = yarnsim::testing::particles_mut(sim);
     for k in 0..p.vert.x.len() {
         p.vert.v[k] = along(p.vert.x[k]);
     }

@@ -7,7 +7,7 @@ mod common;
 
 use common::{bundle, pin_end, SceneBuilder};
 use yarnsim::math::Vec2;
-use yarnsim::mpm::state::StateError;
+use yarnsim::mpm::driver::state::StateError;
 use yarnsim::scene::{PinMotionKind, PinSpec, TransferScheme, WallMode, YarnEnd, YarnScene};
 use yarnsim::YarnSim;
 

@@ -8,7 +8,7 @@ mod common;
 
 use common::{capstan_threshold, momentum_scale, on_threads, straight, SceneBuilder};
 use yarnsim::math::Vec2;
-use yarnsim::mpm::sim::THETA;
+use yarnsim::mpm::driver::THETA;
 use yarnsim::scene::{Integrator, SceneError, StepSize, YarnScene};
 use yarnsim::testing::{
     cantilever_setup, cantilever_toml, capstan_toml, hanging_chain_period, hanging_chain_toml,
@@ -188,7 +188,7 @@ fn momentum_is_kept_and_threads_do_not_change_bits() {
             on_threads(threads, || {
                 let mut sim = YarnSim::new(&with(free_yarn(1e-3), integ, 2e-3)).unwrap();
                 {
-                    let p = sim.particles_mut();
+                    let p = yarnsim::testing::particles_mut(&mut sim);
                     for (i, (x, v)) in p.vert.x.iter().zip(p.vert.v.iter_mut()).enumerate() {
                         let r = x - Vec2::new(0.5, 0.61);
                         *v = Vec2::new(-r.y, r.x) * 3.0

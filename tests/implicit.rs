@@ -67,7 +67,7 @@ fn linear_momentum_is_kept_to_round_off() {
     // different speeds stretch the segments, so the solve has work to do
     let c = sim.diagnostics().center_of_mass;
     {
-        let p = sim.particles_mut();
+        let p = yarnsim::testing::particles_mut(&mut sim);
         for (x, v) in p.vert.x.iter().zip(p.vert.v.iter_mut()) {
             *v = perp(x - c) * 4.0 + Vec2::new(0.3, -0.2) + Vec2::new(0.0, 2.0 * (x.x - c.x));
         }

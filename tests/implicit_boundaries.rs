@@ -305,7 +305,7 @@ fn drop_on_floor(
         .yarn(straight([0.3, 0.3], [0.6, 0.3], 40))
         .build();
     let mut sim = YarnSim::new(&with_integrator(s, integrator, dt)).unwrap();
-    for v in sim.particles_mut().vert.v.iter_mut() {
+    for v in yarnsim::testing::particles_mut(&mut sim).vert.v.iter_mut() {
         *v = Vec2::new(vx, 0.0);
     }
     sim

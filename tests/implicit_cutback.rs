@@ -8,7 +8,7 @@
 mod common;
 
 use common::same_bits_on_one_and_two_threads;
-use yarnsim::mpm::sim::MAX_CUTBACKS;
+use yarnsim::mpm::driver::MAX_CUTBACKS;
 use yarnsim::scene::builtin::yarn_reference;
 use yarnsim::scene::{Integrator, StepSize, YarnScene};
 use yarnsim::testing::hanging_chain_toml;

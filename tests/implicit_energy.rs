@@ -36,7 +36,7 @@ fn two_yarns() -> YarnScene {
 /// and the two yarns pressed together (y above the centre moves down).
 fn press(sim: &mut YarnSim) {
     let c = sim.diagnostics().center_of_mass;
-    let p = sim.particles_mut();
+    let p = yarnsim::testing::particles_mut(sim);
     for (x, v) in p.vert.x.iter().zip(p.vert.v.iter_mut()) {
         let toward = if x.y > c.y { -1.0 } else { 1.0 };
         *v = perp(x - c) * 2.0 + Vec2::new(0.3, -0.2) + Vec2::new(0.0, 3.0 * toward);

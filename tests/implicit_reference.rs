@@ -282,7 +282,7 @@ fn reference_bundle_drapes_under_backward_euler_at_a_fixed_25x_the_explicit_dt()
 /// speed (to round-off), and without gravity it is `safety dx / |v|`.
 #[test]
 fn implicit_auto_dt_counts_the_speed_gravity_adds() {
-    use yarnsim::mpm::timestep::{implicit_auto_dt, implicit_stable_dt};
+    use yarnsim::mpm::driver::timestep::{implicit_auto_dt, implicit_stable_dt};
     let (dx, s) = (1.0 / 256.0, 0.8);
     for v in [0.0, 0.294, 2.0, 40.0] {
         let dt = implicit_auto_dt(dx, v, 9.8, s);

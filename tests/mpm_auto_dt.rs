@@ -1,6 +1,6 @@
 //! Adaptive substeps, `[time] dt = "auto"`: each substep is the safety
 //! factor times the stability bound of the state it starts from
-//! ([`yarnsim::mpm::timestep`]), the last one before a frame or
+//! ([`yarnsim::mpm::driver::timestep`]), the last one before a frame or
 //! communication point shortened to land on it.
 
 mod common;

@@ -7,7 +7,7 @@ use common::Rng;
 use std::f64::consts::{FRAC_PI_2, PI};
 use yarnsim::math::qr::qr;
 use yarnsim::math::{Mat2, Vec2};
-use yarnsim::mpm::constitutive::{frame_gradient, YarnEnergy, R22_MIN};
+use yarnsim::mpm::laws::constitutive::{frame_gradient, YarnEnergy, R22_MIN};
 
 fn energy() -> YarnEnergy {
     YarnEnergy {

@@ -5,9 +5,10 @@ mod common;
 
 use common::{bundle, momentum_scale, pin_end, polyline, straight, Rng, SceneBuilder};
 use yarnsim::math::{perp, Mat2, Vec2};
-use yarnsim::mpm::grid::{self, Grid};
-use yarnsim::mpm::{grid_to_particle, particle_to_grid, simd, vertex_forces};
+use yarnsim::testing::internals::{self as grid, quad_stress, scatter, Grid};
+
 use yarnsim::scene::{TransferScheme, WallMode, YarnEnd, YarnScene, YarnSpec};
+use yarnsim::testing::internals as simd;
 use yarnsim::YarnSim;
 
 /// Weight of grid node `(i, j)` in a stencil (0 outside it).
@@ -32,7 +33,7 @@ fn grid_forces_are_minus_the_energy_gradient() {
     let kb = scene.material.bending;
     let mut rng = Rng::new(7);
     {
-        let p = sim.particles_mut();
+        let p = yarnsim::testing::particles_mut(&mut sim);
         let l0 = p.quad.l0[0];
         for x in p.vert.x.iter_mut() {
             *x += Vec2::new(rng.uniform(-0.15, 0.15), rng.uniform(-0.15, 0.15)) * l0;
@@ -46,11 +47,11 @@ fn grid_forces_are_minus_the_energy_gradient() {
             p.quad.x[q] = (p.vert.x[l] + p.vert.x[l + 1]) * 0.5;
         }
     }
-    let p = sim.particles_mut();
+    let p = yarnsim::testing::particles_mut(&mut sim);
     p.quad.refresh_frames(); // d was set by hand
-    grid_to_particle::quad_stress(&mut p.quad, &geom, &energy);
+    quad_stress(&mut p.quad, &geom, &energy);
     let mut grid = Grid::new(geom);
-    particle_to_grid::scatter(p, &mut grid, 1.0, kb, &[]); // v = 0, C = 0: momentum = 1 * force
+    scatter(p, &mut grid, 1.0, kb, &[]); // v = 0, C = 0: momentum = 1 * force
     let p = sim.particles();
 
     let total_energy = |node: (usize, usize), axis: usize, eps: f64| -> f64 {
@@ -74,7 +75,7 @@ fn grid_forces_are_minus_the_energy_gradient() {
         }
         let mut moved = p.vert.clone();
         moved.x = x;
-        e + vertex_forces::bending_energy(&moved, kb)
+        e + yarnsim::mpm::laws::bending::bending_energy(&moved, kb)
     };
 
     let mut max_f: f64 = 0.0;
@@ -154,7 +155,7 @@ fn linear_momentum_is_conserved_and_angular_drift_is_small() {
     let omega = 4.0;
     let spin = Mat2::new(0.0, -omega, omega, 0.0);
     {
-        let p = sim.particles_mut();
+        let p = yarnsim::testing::particles_mut(&mut sim);
         for ((x, v), cm) in p
             .vert
             .x
@@ -349,7 +350,7 @@ fn divergence_is_reported_with_its_step_and_blocks_further_steps() {
         .build();
     let mut sim = YarnSim::new(&scene).unwrap();
     {
-        let p = sim.particles_mut();
+        let p = yarnsim::testing::particles_mut(&mut sim);
         for (k, x) in p.vert.x.iter_mut().enumerate() {
             x.y += if k % 2 == 0 { 0.002 } else { -0.002 };
         }

@@ -1,10 +1,10 @@
-//! The yarn MPM's stable substep bound (`yarnsim::mpm::timestep`) and the
+//! The yarn MPM's stable substep bound (`yarnsim::mpm::driver::timestep`) and the
 //! divergence report of a substep that breaks it.
 
 mod common;
 
 use common::{straight, SceneBuilder};
-use yarnsim::mpm::timestep::{stable_dt, wave_speed};
+use yarnsim::mpm::driver::timestep::{stable_dt, wave_speed};
 use yarnsim::{SimError, YarnScene, YarnSim};
 
 /// The bare 64^2 scene with one straight yarn of 60 vertices.
@@ -56,7 +56,7 @@ fn a_substep_beyond_the_bound_diverges() {
         s.time.dt = dt.into();
         let mut sim = YarnSim::new(&s).unwrap();
         {
-            let p = sim.particles_mut();
+            let p = yarnsim::testing::particles_mut(&mut sim);
             for (k, x) in p.vert.x.iter_mut().enumerate() {
                 x.y += if k % 2 == 0 { 0.002 } else { -0.002 };
             }

@@ -6,7 +6,7 @@
 use proptest::prelude::*;
 use yarnsim::massspring::{scenes, Integrator, IntegratorOptions, Simulation};
 use yarnsim::math::Mat2;
-use yarnsim::mpm::constitutive::YarnEnergy;
+use yarnsim::mpm::laws::constitutive::YarnEnergy;
 use yarnsim::mpm::SimError;
 use yarnsim::scene::{Obstacle, WallMode, YarnScene};
 use yarnsim::testing::reference_material;

@@ -435,7 +435,7 @@ vertices = 80
     let mut sim = YarnSim::new(&s).unwrap();
     let c = sim.diagnostics().center_of_mass;
     let spin = Mat2::new(0.0, -omega, omega, 0.0);
-    let p = sim.particles_mut();
+    let p = yarnsim::testing::particles_mut(&mut sim);
     for k in 0..p.vert.x.len() {
         p.vert.v[k] = perp(p.vert.x[k] - c) * omega + drift;
         p.vert.c[k] = spin;
@@ -455,10 +455,7 @@ fn momenta_are_kept_under_flip() {
     // of a deforming bundle with internal forces only, and the angular
     // momentum of a rigidly spinning one, under the default FLIP (ratio 1).
     let mut sim = spinning_bundle(4.0, Vec2::new(0.3, -0.2));
-    assert_eq!(
-        sim.transfer(),
-        yarnsim::mpm::transfer::Transfer::Flip { ratio: 1.0 }
-    );
+    assert_eq!(sim.transfer(), yarnsim::mpm::Transfer::Flip { ratio: 1.0 });
     let d0 = sim.diagnostics();
     let scale = common::momentum_scale(&sim);
     let t = 0.5;

@@ -17,10 +17,17 @@ Second rule, the FMU's sibling front ends (`SIBLINGS`): no file under
 `fmi3Functions.c` build on one `model.h`. Comments and strings do not count
 (a message may name the other version's function).
 
+Third rule, layers (LAYERS, `layer_violations`): in a folder listed there, each child
+module has a rank, and a child may name only children of a lower rank
+(children of one rank are peers that must not name each other); a child
+missing from the table is an error too. `src/mpm`: the machinery below the
+laws, the laws below the integrators, the integrators below the driver.
+
 Usage: tools/check_modules.py [CRATE_SRC ...]   (default: every crate's src/)
        tools/check_modules.py --self-test
 Prints each circle as `crate folder: a -> b -> a`, each sibling import as
-`file: names ...`, and exits 1 if any.
+`file: names ...`, each import against the layers as `folder: a -> b (layer
+...)`, and exits 1 if any.
 """
 import re
 import sys
@@ -134,6 +141,72 @@ def check(src):
     return found
 
 
+# ---- layers: (crate src, folder) -> {child: rank}; a child names only lower ranks
+LAYERS = {
+    ("src", "mpm"): {
+        "error": 0,
+        "machinery": 1,  # grid, node pools, particles, transfer, spin, SIMD
+        "laws": 2,  # the physical laws
+        "explicit": 3,  # the integrators: peers, none names another
+        "implicit_grid": 3,
+        "implicit_vertex": 3,
+        "driver": 4,  # YarnSim
+    },
+}
+
+
+def layer_violations(src, crate):
+    """Imports against LAYERS in the crate at `src` (`crate`: its key)."""
+    found = []
+    for (c, rel), ranks in LAYERS.items():
+        folder = src / rel
+        if c != crate or not folder.is_dir():
+            continue
+        graph = edges(src, folder, list(Path(rel).parts))
+        name = f"{crate}/{rel}"
+        for a in sorted(graph):
+            if a not in ranks:
+                found.append(f"{name}: {a} has no layer (add it to LAYERS)")
+                continue
+            for b in sorted(graph[a]):
+                rb = ranks.get(b)
+                if rb is None:
+                    continue
+                if rb > ranks[a]:
+                    found.append(f"{name}: {a} -> {b} (layer {ranks[a]} names layer {rb} above it)")
+                elif rb == ranks[a]:
+                    found.append(f"{name}: {a} -> {b} (peers of layer {rb} name each other)")
+    return found
+
+
+def layer_self_test():
+    import tempfile
+    with tempfile.TemporaryDirectory() as t:
+        src = Path(t) / "src"
+        m = src / "mpm"
+        for d in ("machinery", "laws", "explicit", "implicit_grid", "driver"):
+            (m / d).mkdir(parents=True)
+            (m / d / "mod.rs").write_text("pub mod x;\n")
+        (m / "mod.rs").write_text("pub mod error;\n")
+        (m / "error.rs").write_text("pub struct E;\n")
+        (m / "machinery" / "x.rs").write_text("use crate::mpm::error::E;\n")
+        (m / "laws" / "x.rs").write_text("use crate::mpm::machinery::x;\n// crate::mpm::driver\n")
+        (m / "explicit" / "x.rs").write_text("use crate::mpm::laws::x;\n")
+        (m / "implicit_grid" / "x.rs").write_text(
+            "use crate::mpm::laws::x;\n#[cfg(test)]\nmod t { use crate::mpm::explicit; }\n")
+        (m / "driver" / "x.rs").write_text("use crate::mpm::{explicit, implicit_grid};\n")
+        assert layer_violations(src, "src") == [], layer_violations(src, "src")
+        (m / "machinery" / "x.rs").write_text("use crate::mpm::laws::x;\n")
+        (m / "implicit_grid" / "x.rs").write_text("use crate::mpm::explicit::x;\n")
+        (m / "laws" / "x.rs").write_text("fn f() { crate::mpm::driver::x::g() }\n")
+        (m / "extra.rs").write_text("\n")
+        got = layer_violations(src, "src")
+        want = ["machinery -> laws", "implicit_grid -> explicit", "laws -> driver",
+                "extra has no layer"]
+        assert len(got) == 4 and all(any(w in g for g in got) for w in want), got
+    print("check_modules layer self-test: ok")
+
+
 def self_test():
     import tempfile
     with tempfile.TemporaryDirectory() as t:
@@ -152,6 +225,7 @@ def self_test():
         assert len(got) == 2 and any("a -> b -> a" in g for g in got) \
             and any("p -> q -> p" in g for g in got), got
     print("check_modules self-test: ok")
+    layer_self_test()
 
 
 # The FMU's FMI front ends: (folder, what no file in it may name).
@@ -209,9 +283,15 @@ def main(argv):
     siblings = [] if argv[1:] else sibling_imports()
     for b in siblings:
         print(f"FMI front end names its sibling: {b}")
-    if bad or siblings:
+    layered = []
+    for src in srcs:
+        if src.is_dir() and src.is_relative_to(ROOT):
+            layered += layer_violations(src, str(src.relative_to(ROOT)))
+    for v in layered:
+        print(f"import against the layers: {v}")
+    if bad or siblings or layered:
         return 1
-    print(f"module graphs of {len(srcs)} crates have no circle"
+    print(f"module graphs of {len(srcs)} crates have no circle and keep their layers"
           + ("" if argv[1:] else "; the FMU's fmi2/ and fmi3/ do not name each other"))
     return 0
 

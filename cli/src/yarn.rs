@@ -6,7 +6,7 @@
 //! The bound is the library's, [`YarnSim::stable_dt`] (the one the FMU
 //! warns with at initialization): `dx / (c + |v|max)` with the fastest
 //! elastic wave `c` and, with bending, the flexural bound, see
-//! [`yarnsim::mpm::timestep`]. Measured on `yarn-small`, the largest stable
+//! [`yarnsim::mpm::driver::timestep`]. Measured on `yarn-small`, the largest stable
 //! substep lies at 1.3 to 1.8 times it when `k`, `E`, friction, gravity or
 //! the attractor change (docs/performance.md, "Stability stress"), so a
 //! step above the bound is warned about and one above [`REFUSE_FACTOR`]
@@ -14,7 +14,7 @@
 //! exception: there the bound is pessimistic, up to 10x, and
 //! `--allow-unstable` runs such a step.)
 
-use yarnsim::mpm::timestep;
+use yarnsim::mpm::driver::timestep;
 use yarnsim::scene::{Integrator, YarnScene};
 use yarnsim::{SimError, YarnSim};
 

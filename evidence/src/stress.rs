@@ -231,7 +231,7 @@ pub fn yarn_stable(scene: &YarnScene, dt: f64) -> bool {
 
 /// The yarn's theoretical step bound (Courant number 1), see the module docs.
 /// The wave speed and the formula are the solver's
-/// ([`crate::mpm::timestep::stable_dt`]); the speed is the one gravity and
+/// ([`crate::mpm::driver::timestep::stable_dt`]); the speed is the one gravity and
 /// attractor can give over the probe time.
 pub fn yarn_bound(scene: &YarnScene) -> f64 {
     let g = Vec2::from(scene.gravity).norm();
@@ -241,7 +241,7 @@ pub fn yarn_bound(scene: &YarnScene) -> f64 {
         0.0
     };
     let v = (g + a) * YARN_PROBE_TIME;
-    yarnsim::mpm::timestep::stable_dt(&scene.material, scene.dx(), v)
+    yarnsim::mpm::driver::timestep::stable_dt(&scene.material, scene.dx(), v)
 }
 
 /// The yarn parameter sweep: (label, value, scene).

@@ -2,6 +2,8 @@
 //! quadratic B-spline weights of the MPM transfer.
 
 pub mod bspline;
+pub mod dual;
+pub mod psd;
 pub mod qr;
 
 /// A 2-vector of `f64` (nalgebra).

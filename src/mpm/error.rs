@@ -6,7 +6,14 @@ pub enum SimError {
     /// A particle's state became NaN or infinite, or a particle moved more
     /// than one grid cell in one substep, during this step; the simulation
     /// refuses further steps until its state is restored.
-    NonFinite { step: u64, time: f64, what: String },
+    NonFinite {
+        /// The substep that failed.
+        step: u64,
+        /// Simulated time at its end, s.
+        time: f64,
+        /// What went wrong, and where.
+        what: String,
+    },
     /// An input given to the simulation is unusable.
     BadInput(String),
 }

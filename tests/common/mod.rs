@@ -69,7 +69,7 @@ pub fn same_on_one_and_two_threads<S: PartialEq + Send, T: PartialEq + std::fmt:
 pub fn same_bits_on_one_and_two_threads(
     scene: &YarnScene,
     steps: u64,
-) -> yarnsim::mpm::sim::ImplicitStats {
+) -> yarnsim::mpm::driver::ImplicitStats {
     same_on_one_and_two_threads(|| {
         let mut sim = YarnSim::new(scene).unwrap();
         sim.steps_n(steps).unwrap();

@@ -50,8 +50,8 @@ pub use style::{
 };
 pub use yarn::{record_yarn, vertex_stretches};
 /// Plastic state of a quadrature particle, see [`values::PLASTIC`]; the
-/// library classifies it ([`yarnsim::mpm::constitutive::YarnEnergy::plastic_state`]).
-pub use yarnsim::mpm::constitutive::PlasticState;
+/// library classifies it ([`yarnsim::mpm::laws::constitutive::YarnEnergy::plastic_state`]).
+pub use yarnsim::mpm::laws::constitutive::PlasticState;
 
 /// Rerun application id of the recordings.
 pub const APP_ID: &str = "yarnsim";

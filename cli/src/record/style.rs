@@ -1,7 +1,7 @@
 //! How things look: the 2D view transform, colours, radii and the legend.
 
 use rerun::components::Color;
-use yarnsim::mpm::constitutive::PlasticState;
+use yarnsim::mpm::laws::constitutive::PlasticState;
 
 /// Where a library point `v` is drawn in a domain of side `size`: Rerun's 2D
 /// views draw +y downwards, so y is stored as `size - y` (+y shows up). The

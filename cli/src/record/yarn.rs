@@ -45,7 +45,7 @@ pub fn record_yarn(
 /// Mean stretch of the segments around every vertex.
 pub fn vertex_stretches(sim: &YarnSim, seg: &[f64]) -> Vec<f64> {
     let p = sim.particles();
-    let none = yarnsim::mpm::particles::NONE;
+    let none = yarnsim::mpm::machinery::particles::NONE;
     (0..p.vert.x.len())
         .map(|i| {
             let (l, r) = (p.vert.q_left[i], p.vert.q_right[i]);

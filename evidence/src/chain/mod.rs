@@ -39,7 +39,7 @@ use std::time::Instant;
 
 use crate::plot::{LinePlot, Marker, Series};
 use crate::{num, Table};
-use yarnsim::mpm::timestep::wave_speed;
+use yarnsim::mpm::driver::timestep::wave_speed;
 use yarnsim::mpm::YarnSim;
 use yarnsim::scene::{
     GridSpec, Integrator, Material, PinSpec, StepSize, TimeSpec, TransferScheme, TransferSpec,

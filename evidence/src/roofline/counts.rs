@@ -4,9 +4,8 @@
 use std::collections::{HashMap, HashSet};
 
 use yarnsim::math::bspline::Stencil;
-use yarnsim::mpm::grid::BLOCK;
-use yarnsim::mpm::simd::chunk_bounds;
 use yarnsim::mpm::YarnSim;
+use yarnsim::testing::internals::{chunk_bounds, BLOCK};
 
 /// One term of a kernel's count, per particle (or per grid node).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -44,7 +43,7 @@ const fn per_obstacle(what: &'static str, source: &'static str, flops: u64) -> T
 }
 
 /// Lanes of a scatter node `[px, py, m, mc, fx, fy]`.
-pub const P2G_LANES: u64 = yarnsim::mpm::grid::P2G_LANES as u64;
+pub const P2G_LANES: u64 = yarnsim::testing::internals::P2G_LANES as u64;
 /// Bytes of a scatter node.
 pub const P2G_NODE_BYTES: u64 = 8 * P2G_LANES;
 /// Bytes of a grid node `[vx, vy, dvx, dvy]`.
@@ -405,11 +404,11 @@ mod tests {
         assert_eq!(STENCIL_BYTES as usize, std::mem::size_of::<Stencil>());
         assert_eq!(
             P2G_NODE_BYTES as usize,
-            std::mem::size_of::<yarnsim::mpm::grid::P2gNode>()
+            std::mem::size_of::<yarnsim::testing::internals::P2gNode>()
         );
         assert_eq!(
             GRID_NODE_BYTES as usize,
-            std::mem::size_of::<yarnsim::mpm::grid::Node>()
+            std::mem::size_of::<yarnsim::testing::internals::Node>()
         );
         let st = Stencil::new(yarnsim::math::Vec2::new(0.3, 0.4), 32.0);
         assert_eq!(STENCIL_NODES as usize, st.w[0].len() * st.w[1].len());

@@ -5,7 +5,7 @@
 
 use std::ffi::c_void;
 
-use yarnsim::mpm::state::fnv1a;
+use yarnsim::mpm::driver::state::fnv1a;
 
 use super::phase::Phase;
 use crate::instance::clock::Clock;

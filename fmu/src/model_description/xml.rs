@@ -3,7 +3,7 @@
 
 use std::fmt::Write as _;
 
-use yarnsim::mpm::state::fnv1a;
+use yarnsim::mpm::driver::state::fnv1a;
 
 use super::{real, ArrayVariable, VarType, Variable, LOG_CATEGORIES};
 

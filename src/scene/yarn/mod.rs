@@ -54,7 +54,7 @@ pub struct YarnScene {
 }
 
 /// The grid-to-particle velocity update (`[transfer]`); see
-/// [`crate::mpm::transfer`].
+/// `crate::mpm::machinery::transfer`.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct TransferSpec {
@@ -173,7 +173,7 @@ pub struct GridSpec {
 #[serde(deny_unknown_fields)]
 pub struct TimeSpec {
     /// Substep size: a number in s, or `"auto"` (each substep from the
-    /// stability bound of the current state, see [`crate::mpm::timestep`]).
+    /// stability bound of the current state, see [`crate::mpm::driver::timestep`]).
     pub dt: StepSize,
     /// Safety factor of `dt = "auto"`: the substep is `safety` times the
     /// stability bound (default [`DEFAULT_SAFETY`]; 0 < safety <= 2). Only
@@ -214,20 +214,20 @@ pub enum Integrator {
     Explicit,
     /// Backward Euler on the grid velocities as a minimisation (Gast,
     /// Schroeder, Stomakhin, Jiang, Teran 2015, "Optimization integrator for
-    /// large time steps", IEEE TVCG 21(10)), [`crate::mpm::implicit`]: the
+    /// large time steps", IEEE TVCG 21(10)), `crate::mpm::implicit_grid`: the
     /// whole yarn energy in one velocity field (pins, obstacles and walls
     /// act as in the explicit step, after the solve); a
     /// scene outside that scope is refused at load naming the field, never
     /// run with the explicit step instead.
     Implicit,
     /// Backward Euler on the vertex velocities of a single yarn without the
-    /// grid ([`crate::mpm::gridless`]): for one yarn whose material has no
+    /// grid (`crate::mpm::implicit_vertex`): for one yarn whose material has no
     /// cross-section energy (`gamma = youngs_modulus = 0`), no walls; a
     /// scene outside that scope is refused at load naming the field.
     #[serde(rename = "implicit-vertices")]
     ImplicitVertices,
     /// The generalized midpoint rule (theta 0.55) on the same vertices, in
-    /// the same scope ([`crate::mpm::gridless`]): the implicit midpoint
+    /// the same scope (`crate::mpm::implicit_vertex`): the implicit midpoint
     /// rule's period error on slow modes with light damping (1.3 % per
     /// period at `omega dt = 0.042`) and strong damping of modes far above
     /// `1 / dt`; a contact's normal velocity stays inelastic.
@@ -380,7 +380,7 @@ pub struct Material {
     pub friction: f64,
     /// Bending stiffness `B` of the rod in N m^2 per m of depth (N m): the
     /// energy is `int B / 2 kappa^2 ds` (discrete elastic rods, see
-    /// [`crate::mpm::vertex_forces`]). 0 disables bending.
+    /// `crate::mpm::laws::vertex_forces`). 0 disables bending.
     #[serde(default, deserialize_with = "nonnegative")]
     pub bending: f64,
     /// Density in kg/m^2: mass per metre of yarn per metre of depth.

@@ -5,7 +5,7 @@
 
 use std::path::Path;
 
-use yarnsim::mpm::state::DynamicState;
+use yarnsim::mpm::driver::state::DynamicState;
 use yarnsim::mpm::{Diagnostics, SimError, YarnSim};
 use yarnsim::scene::{Integrator, TransferScheme, YarnScene};
 
