@@ -41,8 +41,9 @@
 //!   instance with [`state_machine::Api::Fmi3`]: the table's fmi3 rows, FMI
 //!   3.0 words in the log, the non-variadic logger).
 //!
-//! See `docs/fmu.md` for the FMI 2.0 FMUs (variables, build command) and
-//! `docs/fmu3.md` for the FMI 3.0 ones (arrays, fmpy, what differs).
+//! See `docs/fmu.md` for the FMI 2.0 FMUs (variables, build command),
+//! `docs/fmu-masters.md` for fmpy and other masters, and `docs/fmu3.md` for
+//! the FMI 3.0 ones (arrays, fmpy, what differs).
 
 // The crate is named after the FMI modelIdentifier `YarnBundle`.
 #![allow(non_snake_case)]
