@@ -308,7 +308,7 @@ fn dropped_yarn_holds_from_the_stable_bound_to_an_eighth_of_it_and_at_512() {
     ]);
 }
 
-/// The sweep recorded in docs/obstacle-contact.md ("Under impact"): drops
+/// The sweep recorded in docs/performance/contact.md ("Measured with the law now"): drops
 /// of 0 to 10 mm, both materials, FLIP and APIC, the other radius and
 /// ratio, and the laid yarn given 0.05 m/s along itself (kinetic friction
 /// without an impact; a rigid rope stops within 6 mm). Prints a table.

@@ -213,7 +213,7 @@ fn print(label: &str, d: &Drape, dx: f64) {
 /// [`ON_T`] with still no vertex a cell inside a circle and no crossing.
 /// The cutbacks are at most a fifth of the substeps (measured: 45 of the
 /// 350, all in the whip after the landing, 0.168 to 0.35 s; none later in
-/// the whole 1 s run; docs/yarn-model.md, "Reference scene").
+/// the whole 1 s run; docs/performance/implicit.md, "Reference scene").
 #[test]
 #[cfg_attr(debug_assertions, ignore = "release-mode test (cargo test --release)")]
 fn reference_bundle_drapes_under_backward_euler_at_a_fixed_25x_the_explicit_dt() {

@@ -13,7 +13,7 @@
 # checks them in fmpy against the FMI 2.0 FMUs and the library
 # (tools/fmu3_check.py); then runs the documented recipes for a refused
 # input (save the FMU state, restore it after the refusal) and for a
-# diverged step in simulate_fmu, as they stand in docs/fmu.md and
+# diverged step in simulate_fmu, as they stand in docs/fmu-masters.md and
 # docs/fmu3.md (tools/fmu_errors.py). Exits non-zero on failure.
 set -euo pipefail
 cd "$(dirname "$0")/.."

@@ -3,12 +3,12 @@ they stand in the docs (run by tools/fmu_check.sh).
 
 usage: fmu_errors.py SMALL.fmu SMALL-fmi3.fmu
 
-1. docs/fmu.md, "A rejected input: the error state and a state restore":
+1. docs/fmu-masters.md, "A rejected input: the error state and a state restore":
    the controller loop that saves the FMU state before setting its inputs
    and restores it when one is refused. Checks: exactly one input refused,
    and the outputs at the end bit for bit those of a run that got the safe
    value in the first place (an FMU2Slave loop written here).
-2. docs/fmu.md, "fmpy's simulate_fmu after a Discard": simulate_fmu of a
+2. docs/fmu-masters.md, "fmpy's simulate_fmu after a Discard": simulate_fmu of a
    run that diverges at 0.11 s returns a result cut there, without raising.
 3. docs/fmu3.md, "A rejected input and a Discard": the FMI 3.0 loop (same
    checks as 1) and fmpy 0.3.32's simulate_fmu of an FMI 3.0 FMU raising
@@ -82,13 +82,13 @@ def check_loop(label, scope, reference):
         failures.append(f"{label}: outputs after the restore differ from the undisturbed run")
 
 
-# 1. the FMI 2.0 controller loop of docs/fmu.md
+# 1. the FMI 2.0 controller loop of docs/fmu-masters.md
 FMU_PATH = "target/fmu/YarnBundle-small.fmu"
-scope = run_block("fmu.md", "### A rejected input: the error state and a state restore", small_fmu, FMU_PATH)
-check_loop("FMI 2.0 controller loop (docs/fmu.md)", scope, reference_fmi2(small_fmu, 20, 0.01, 5))
+scope = run_block("fmu-masters.md", "### A rejected input: the error state and a state restore", small_fmu, FMU_PATH)
+check_loop("FMI 2.0 controller loop (docs/fmu-masters.md)", scope, reference_fmi2(small_fmu, 20, 0.01, 5))
 
 # 2. simulate_fmu after a Discard, FMI 2.0
-scope = run_block("fmu.md", "### fmpy's `simulate_fmu` after a Discard", small_fmu, FMU_PATH)
+scope = run_block("fmu-masters.md", "### fmpy's `simulate_fmu` after a Discard", small_fmu, FMU_PATH)
 result, stop, last = scope["result"], scope["stop"], scope["last"]
 print(f"FMI 2.0 simulate_fmu with a Discard: no exception, {len(result)} rows, last time {last} of {stop}")
 if not (last < stop and math.isclose(last, 0.11)):

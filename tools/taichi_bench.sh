@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # yarnsim bench against the reference Taichi implementation of Jiang et al. 2017, alternating
 # (tools/taichi_bench.py; see "Against the reference Taichi implementation"
-# in docs/performance.md).
+# in docs/performance/throughput.md).
 # Usage: tools/taichi_bench.sh REFERENCE_FILE [--yarnsim BIN] [--threads 1,2] [--rounds 3] ...
 # Installs Taichi 1.7.4 into tools/.venv-taichi on first use. Does not build
 # yarnsim: it uses target/release/yarnsim unless --yarnsim is given.

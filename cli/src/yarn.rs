@@ -8,7 +8,7 @@
 //! elastic wave `c` and, with bending, the flexural bound, see
 //! [`yarnsim::mpm::driver::timestep`]. Measured on `yarn-small`, the largest stable
 //! substep lies at 1.3 to 1.8 times it when `k`, `E`, friction, gravity or
-//! the attractor change (docs/performance.md, "Stability stress"), so a
+//! the attractor change (docs/performance/stress.md), so a
 //! step above the bound is warned about and one above [`REFUSE_FACTOR`]
 //! times it, beyond all of those, is refused. (A stiff shear `gamma` is the
 //! exception: there the bound is pessimistic, up to 10x, and

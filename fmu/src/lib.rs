@@ -55,8 +55,9 @@
 //! `fmi3GetFMUState` save); the lifecycle of an instance is its phase
 //! ([`instance::Phase`]), the simulation's quantities are its values.
 //!
-//! See `docs/fmu.md` for the FMI 2.0 FMUs (variables, build command) and
-//! `docs/fmu3.md` for the FMI 3.0 ones (arrays, fmpy, what differs).
+//! See `docs/fmu.md` for the FMI 2.0 FMUs (variables, build command),
+//! `docs/fmu-masters.md` for fmpy and other masters, and `docs/fmu3.md` for
+//! the FMI 3.0 ones (arrays, fmpy, what differs).
 
 // Every unsafe operation sits in its own `unsafe` block with a SAFETY
 // comment, also inside `unsafe fn` (the C ABIs in `fmi2/`, `fmi3/` and

@@ -210,7 +210,7 @@ fn fmi2_pin_and_mass_spring_messages_name_the_variable() {
     );
 }
 
-/// The controller loop of docs/fmu.md in Rust: save the state before
+/// The controller loop of docs/fmu-masters.md in Rust: save the state before
 /// setting the inputs; an input refused puts the instance in the error
 /// state, where every step is refused; restoring the saved state leads
 /// out, and the run goes on with the bits of a run that never saw it.

@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """The benchmark's CSV as Markdown tables.
 
-    python3 tools/peers/table.py [docs/performance/peers.csv]          # README.md "Measured"
+    python3 tools/peers/table.py [docs/performance/peers.csv]          # docs/performance/peers.md, "Run of 2026-12-05"
     python3 tools/peers/table.py --at-peer-error [CSV]                 # the goals' comparison
 
 `--at-peer-error`: for every peer row of a single-yarn case (chain,

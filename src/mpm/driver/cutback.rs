@@ -29,7 +29,7 @@
 //! `max_energy_kept`): a rise that `dt / 32` does not remove is not the
 //! step size's (measured on the reference bundle: +4.97 J at dt 8.2e-5
 //! at k 1e5, the vertices pressed into a circle by the yarns above them,
-//! see docs/yarn-model.md). Not checked where a force outside the ledger does
+//! see docs/yarn-integrators.md). Not checked where a force outside the ledger does
 //! work (the attractor on, or a pin that moves), nor on the first substep
 //! of a new, loaded or edited state.
 //!

@@ -12,7 +12,7 @@
 //! (Bergou et al. 2008) per interior vertex, gravity, the attractor. On the
 //! grid those energies are sampled through the B-spline transfers (the
 //! hanging chain's period then carries the grid's error, +0.04 % at 64^2,
-//! `docs/yarn-model.md`); here they act on the vertices exactly. The step
+//! `docs/yarn-integrators.md`); here they act on the vertices exactly. The step
 //! minimises ([`energy`])
 //!
 //! ```text
