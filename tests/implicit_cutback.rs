@@ -1,4 +1,4 @@
-//! The implicit substep's cutback (src/mpm/sim/cutback.rs): a backward
+//! The implicit substep's cutback (src/mpm/driver/cutback.rs): a backward
 //! Euler substep that fails (Newton does not converge, or a vertex would
 //! move more than one cell) is undone and run as two halves, at most
 //! `MAX_CUTBACKS` halvings deep. A cut substep is the same bits as the two

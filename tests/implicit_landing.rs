@@ -8,12 +8,12 @@
 //! `YarnSim::diagnostics`) must never rise above its start: backward
 //! Euler, inelastic contact, friction and plasticity take energy out, and
 //! nothing in this scene puts any in. Before the obstacles' normal law
-//! entered the solve (`src/mpm/sim/implicit_grid.rs`) the first contact
+//! entered the solve (`src/mpm/driver/implicit_grid.rs`) the first contact
 //! substep (dt 2.85e-3) made 5.5 J of elastic energy at every `k` (1e3,
 //! 1e5: 5.49 J, 1e7: 8.64 J) out of 0.54 J of kinetic energy, and the
 //! stretch left [0.978, 1.05] within 2 ms; the substeps that still raise
 //! the energy (friction acting after the solve) are cut back
-//! (`src/mpm/sim/cutback.rs`, `ENERGY_TOL`) or, where `dt / 32` does not
+//! (`src/mpm/driver/cutback.rs`, `ENERGY_TOL`) or, where `dt / 32` does not
 //! suffice, kept and counted.
 
 use yarnsim::testing::implicit_landing_scene;

@@ -9,7 +9,7 @@
 //! The ends that whip down after the landing move faster than one cell
 //! per substep at dt 1e-3 (dx / dt = 3.906 m/s; the explicit run reaches
 //! 3.95 m/s by 0.2 s and 5.5 m/s later: this is the motion, not an
-//! instability). Those substeps are cut back (src/mpm/sim/cutback.rs):
+//! instability). Those substeps are cut back (src/mpm/driver/cutback.rs):
 //! run as halves, the clock still on the 1e-3 grid. Measured figures are
 //! printed (`--nocapture`).
 
@@ -265,7 +265,7 @@ fn reference_bundle_drapes_under_backward_euler_at_a_fixed_25x_the_explicit_dt()
     // the circles (the lower yarns touch them, the others lie on those)
     assert!(im.mean_y < 0.65 && im.touching >= 1, "{}", im.mean_y);
     // the whip was cut back; since the energy cutback
-    // (src/mpm/sim/cutback.rs) the landing's substeps that raise the total
+    // (src/mpm/driver/cutback.rs) the landing's substeps that raise the total
     // energy are halved too: measured 1682 cutbacks (1539 undone) in the
     // 350 outer substeps (before it, at most a fifth of them were cut),
     // so at most 5 per outer substep
@@ -308,11 +308,11 @@ fn implicit_auto_dt_counts_the_speed_gravity_adds() {
 const AUTO_SAFETY: f64 = 0.5;
 
 /// `dt = "auto"` with `dt_max = 1e-2` under backward Euler (the advection
-/// limit `safety dx / |v|max`, src/mpm/timestep.rs) runs the bundle through
+/// limit `safety dx / |v|max`, src/mpm/driver/timestep.rs) runs the bundle through
 /// the landing to [`DRAPE_T`] at safety [`AUTO_SAFETY`] with no vertex deeper than a cell inside a
 /// circle and no yarn-yarn crossing; its mean substep is at least 7.5x
 /// the explicit 4e-5 (measured 1.00e-3 over 249 substeps, 6.84 Newton /
-/// 840 CG per substep, before the energy cutback, src/mpm/sim/cutback.rs;
+/// 840 CG per substep, before the energy cutback, src/mpm/driver/cutback.rs;
 /// with it 3.93e-4 over 637 substeps, 6.70 Newton / 730 CG per substep:
 /// the landing's substeps that raise the total energy are halved).
 #[test]

@@ -13,7 +13,7 @@
 //! c_f cos theta)` (the incline law, `/docs/obstacle-contact.md`).
 //!
 //! The bed is held by a pin and the top yarn is free, so they move in two
-//! velocity fields (`src/mpm/fields.rs`) whose contact is Coulomb's law in
+//! velocity fields (`src/mpm/laws/fields.rs`) whose contact is Coulomb's law in
 //! impulse terms with `mu = c_f`: the same coefficient as the return
 //! mapping's, so the top yarn slips on the bed, not within its own
 //! cross-section, at the same `tan theta = c_f`.
