@@ -21,6 +21,7 @@
 use super::energy::Rod;
 use super::newton::{self, Constraint, Friction, Settings};
 use crate::math::Vec2;
+use crate::mpm::laws::contact::outward;
 use crate::scene::Obstacle;
 
 /// Most solves of one step (active-set and friction rounds).
@@ -60,7 +61,7 @@ fn ahead(rod: &Rod, v: &[Vec2], reach: f64) -> Vec<Vec2> {
 fn inside(obstacles: &[Obstacle], y: Vec2) -> Option<usize> {
     let mut best: Option<(usize, f64)> = None;
     for (k, o) in obstacles.iter().enumerate() {
-        let depth = o.radius - (y - Vec2::from(o.center)).norm();
+        let depth = o.radius - outward(o, y).1;
         if depth > 0.0 && best.is_none_or(|(_, d)| depth > d) {
             best = Some((k, depth));
         }
@@ -71,9 +72,7 @@ fn inside(obstacles: &[Obstacle], y: Vec2) -> Option<usize> {
 /// The constraint of vertex `x` in contact with `o` when its velocity
 /// moves it over `dt`.
 fn contact(o: &Obstacle, x: Vec2, dt: f64) -> Constraint {
-    let r = x - Vec2::from(o.center);
-    let d = r.norm();
-    let n = if d > 0.0 { r / d } else { Vec2::new(0.0, 1.0) };
+    let (n, d) = outward(o, x);
     Constraint::Normal {
         n,
         b: (o.radius - d) / dt,

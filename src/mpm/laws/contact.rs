@@ -103,19 +103,30 @@ pub fn obstacle_normal(
 /// implicit solve's contact term.
 #[inline]
 pub fn normal_share(o: &Obstacle, xi: Vec2, touching: f64) -> (f64, Vec2, f64) {
-    let r = xi - Vec2::from(o.center);
-    let dist = r.norm();
+    let (n, dist) = outward(o, xi);
     let share = if dist < o.radius {
         1.0
     } else {
         touching.min(1.0)
     };
+    (share, n, dist)
+}
+
+/// The outward unit normal of obstacle `o` at `x` and the distance of `x`
+/// from its centre (the normal is +y at the centre itself): the geometry
+/// of the obstacle law, shared by the grid integrators' node projection
+/// ([`normal_share`]) and the vertex integrator's contact constraints
+/// (`crate::mpm::implicit_vertex::contacts`).
+#[inline]
+pub fn outward(o: &Obstacle, x: Vec2) -> (Vec2, f64) {
+    let r = x - Vec2::from(o.center);
+    let dist = r.norm();
     let n = if dist > 0.0 {
         r / dist
     } else {
         Vec2::new(0.0, 1.0)
     };
-    (share, n, dist)
+    (n, dist)
 }
 
 /// Number of friction wedges around obstacle `o` on a grid of spacing `dx`.
