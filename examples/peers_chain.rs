@@ -1,5 +1,5 @@
 //! yarnsim's entry of the rod benchmark against MuJoCo and PyElastica
-//! (`tools/peers/bench.py`): the oracle scenes of `tests/yarn_oracles.rs`
+//! (`tools/bench/peers/bench.py`): the oracle scenes of `tests/yarn_oracles.rs`
 //! run through the library, timing the stepping loop only, one JSON line
 //! on stdout per run.
 //!
@@ -234,7 +234,7 @@ fn capstan(r: f64, l1: f64, l2: f64, mu: f64, integ: Integrator, dt: Option<f64>
 
 /// The end of the bundle's first timed window (s): it falls, lands on the
 /// top circle at about 0.1 s and settles into the drape by then
-/// (`BUNDLE["landed"]` in `tools/peers/oracles.py`).
+/// (`BUNDLE["landed"]` in `tools/bench/peers/oracles.py`).
 const BUNDLE_LANDED: f64 = 0.2;
 
 fn bundle(duration: f64, integ: Integrator, dt: Option<&str>) -> String {

@@ -7,7 +7,7 @@
 # missing features in cli/Cargo.toml (section "Feature unification").
 # Needs no build: `cargo tree` resolves features the way the build does.
 set -euo pipefail
-cd "$(dirname "$0")/.."
+cd "$(dirname "$0")/../.."
 resolve() {
     cargo tree --locked "$@" --format '{p} [{f}]' --prefix none | sed 's/ (\*)$//' | sort -u
 }

@@ -9,15 +9,15 @@ the folder>::B`, or `super::B` from a file directly inside the folder (or a
 `#[cfg(test)]` line (the unit-test module at the end of a file) is left out:
 tests may reach across. Re-exports count like any other use.
 
-Usage: tools/check_modules.py [CRATE_SRC ...]   (default: every crate's src/)
-       tools/check_modules.py --self-test
+Usage: tools/checks/check_modules.py [CRATE_SRC ...]   (default: every crate's src/)
+       tools/checks/check_modules.py --self-test
 Prints each circle as `crate folder: a -> b -> a` and exits 1 if any.
 """
 import re
 import sys
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parent.parent
+ROOT = Path(__file__).resolve().parents[2]
 CRATES = ["src", "cli/src", "evidence/src", "fmu/src", "fmu-pack/src"]
 IDENT = r"[A-Za-z_][A-Za-z0-9_]*"
 
