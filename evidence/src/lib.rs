@@ -26,8 +26,11 @@ pub mod chain;
 pub mod plot;
 pub mod precision;
 pub mod roofline;
+mod scene;
 pub mod skip;
 pub mod stress;
+
+pub use scene::small_yarn_scene;
 
 use std::fmt::Write;
 use std::path::Path;

@@ -4,10 +4,10 @@
 //! on stdout per run.
 //!
 //! ```text
-//! cargo run --release --example peers_chain -- chain VERTICES GRID DT [INTEGRATOR [K]]
-//! cargo run --release --example peers_chain -- cantilever VERTICES [INTEGRATOR [DT]]
-//! cargo run --release --example peers_chain -- capstan R L1 L2 MU [INTEGRATOR [DT]]
-//! cargo run --release --example peers_chain -- bundle DURATION [INTEGRATOR [DT]]
+//! cargo run --release -p yarnsim-evidence --example peers_chain -- chain VERTICES GRID DT [INTEGRATOR [K]]
+//! cargo run --release -p yarnsim-evidence --example peers_chain -- cantilever VERTICES [INTEGRATOR [DT]]
+//! cargo run --release -p yarnsim-evidence --example peers_chain -- capstan R L1 L2 MU [INTEGRATOR [DT]]
+//! cargo run --release -p yarnsim-evidence --example peers_chain -- bundle DURATION [INTEGRATOR [DT]]
 //! ```
 //!
 //! `INTEGRATOR` is `explicit` (the default) or `implicit` (the scene's
