@@ -1,9 +1,15 @@
-//! Helpers for tests and evidence studies, not part of the simulator: a
-//! small yarn scene for quick runs, the reference material, and the Bessel
-//! function `J0` that the hanging-chain oracles are written in. Built only
+//! Helpers for tests and the measurement programs, not part of the
+//! simulator: the reference material, the oracle scenes (hanging chain,
+//! capstan, cantilever, implicit landing) and their measurements. Built only
 //! with the cargo feature `testing` (the crate's own tests switch it on
-//! through a dev-dependency on the crate itself; `yarnsim-evidence` names it
-//! in its manifest).
+//! through a dev-dependency on the crate itself, and so do the tests and
+//! examples of `yarnsim-fmu` and `yarnsim-evidence`); the CLI's release
+//! build leaves it out. The analytic oracles (`J0`, the extensible chain)
+//! are re-exported from `yarnsim-oracles`, which the evidence studies use
+//! without this feature; the small yarn scene of the studies and tests is
+//! `yarnsim_evidence::small_yarn_scene`.
+
+pub use yarnsim_oracles::{bessel_j0, extensible_chain_omega, J0_FIRST_ZERO};
 
 use crate::scene::builtin::yarn_reference;
 use crate::scene::{Integrator, Material, Obstacle, StepSize, YarnScene, YarnSpec};
@@ -11,34 +17,6 @@ use crate::scene::{Integrator, Material, Obstacle, StepSize, YarnScene, YarnSpec
 /// The material of the reference scene (`yarn-reference`).
 pub fn reference_material() -> Material {
     yarn_reference().material
-}
-
-/// A small yarn scene for quick measurements: `yarns` yarns of `vertices`
-/// vertices (0.8 m long, 0.02 m apart) on a `resolution`^2 grid over 1 m,
-/// falling from y = 0.75 onto one circle (centre (0.5, 0.55), radius 0.1),
-/// reference material, gravity -9.8, sticky walls, dt 1e-4. Used by the
-/// evidence studies (`yarnsim-evidence`) and by the library's own tests.
-/// Its name is `small-bundle` (`yarn-small` is `fmu/scenes/small.toml`).
-pub fn small_yarn_scene(yarns: u32, vertices: u32, resolution: u32) -> YarnScene {
-    let mut s = yarn_reference();
-    s.name = "small-bundle".into();
-    s.description =
-        format!("{yarns} yarns x {vertices} vertices on {resolution}^2 falling onto one circle");
-    s.grid.resolution = resolution;
-    s.time.dt = StepSize::Fixed(1e-4);
-    s.obstacles = vec![Obstacle {
-        center: [0.5, 0.55],
-        radius: 0.1,
-        friction: 0.3,
-    }];
-    // The reference bundle's yarn: from (0.1, 0.75) along +x, 0.8 m long.
-    s.yarns = vec![YarnSpec {
-        vertices,
-        count: yarns,
-        spacing: [0.0, 0.02],
-        ..s.yarns[0].clone()
-    }];
-    s
 }
 
 /// The grid implicit integrator's landing scene: a small bundle (3 yarns
@@ -69,27 +47,6 @@ pub fn implicit_landing_scene(k: f64, mu: f64) -> YarnScene {
     s.validate().unwrap();
     s
 }
-
-/// `J0(x)`, the Bessel function of the first kind of order 0, by its power
-/// series `sum_k (-1)^k (x/2)^(2k) / (k!)^2` (to round-off for `|x| <= 10`):
-/// the mode shapes of the hanging chain, the oracle of the yarn tests and of
-/// the work-precision study.
-pub fn bessel_j0(x: f64) -> f64 {
-    let q = -(x * x) / 4.0;
-    let mut term = 1.0;
-    let mut sum = 1.0;
-    for k in 1..60 {
-        term *= q / (k * k) as f64;
-        sum += term;
-        if term.abs() < 1e-17 * sum.abs().max(1e-300) {
-            break;
-        }
-    }
-    sum
-}
-
-/// The first zero of `J0`, `j_{0,1}`.
-pub const J0_FIRST_ZERO: f64 = 2.404_825_557_695_773;
 
 /// The hanging chain's length (m) and gravity (m/s^2).
 pub const CHAIN_LENGTH: f64 = 0.8;
@@ -144,64 +101,6 @@ end = "start"
 pub fn hanging_chain_period() -> f64 {
     let omega = J0_FIRST_ZERO / 2.0 * (CHAIN_GRAVITY / CHAIN_LENGTH).sqrt();
     2.0 * std::f64::consts::PI / omega
-}
-
-/// First angular frequency of a discrete *extensible* hanging chain: `n`
-/// equal segments of rest length `l / n`, line density `rho`, fiber
-/// stiffness `k` (tension `k` times strain), in gravity `g`, top node fixed,
-/// each segment stretched by its static tension (the weight below it).
-/// Small transverse oscillations `M u'' = -K u` with `K` from the tensions
-/// over the stretched lengths; the smallest eigenvalue of the symmetric
-/// tridiagonal `M^-1/2 K M^-1/2` by bisection on its Sturm count. With
-/// `k -> infinity` and large `n` it tends to the inextensible continuum's `(j01 / 2) sqrt(g / l)`; the
-/// difference at finite `k` is the model error that stretching adds.
-pub fn extensible_chain_omega(n: usize, l: f64, rho: f64, k: f64, g: f64) -> f64 {
-    let l0 = l / n as f64;
-    // node i = 1..=n (index i - 1); node 0 is the pin
-    let m: Vec<f64> = (1..=n)
-        .map(|i| if i < n { rho * l0 } else { 0.5 * rho * l0 })
-        .collect();
-    // tension and stretched length of segment j = 1..=n (index j - 1)
-    let mut below = 0.0;
-    let mut t = vec![0.0; n];
-    for j in (0..n).rev() {
-        below += m[j];
-        t[j] = g * below;
-    }
-    let s: Vec<f64> = t.iter().map(|tj| tj / (l0 * (1.0 + tj / k))).collect();
-    let a: Vec<f64> = (0..n)
-        .map(|i| (s[i] + if i + 1 < n { s[i + 1] } else { 0.0 }) / m[i])
-        .collect();
-    let b: Vec<f64> = (0..n - 1)
-        .map(|i| -s[i + 1] / (m[i] * m[i + 1]).sqrt())
-        .collect();
-    // eigenvalues below x
-    let count = |x: f64| {
-        let mut c = 0;
-        let mut q = 1.0;
-        for i in 0..n {
-            let off = if i > 0 { b[i - 1] * b[i - 1] / q } else { 0.0 };
-            q = a[i] - x - off;
-            if q == 0.0 {
-                q = -1e-300;
-            }
-            if q < 0.0 {
-                c += 1;
-            }
-        }
-        c
-    };
-    // the inextensible continuum's omega_1^2 = (j01 / 2)^2 g / l, times 4
-    let (mut lo, mut hi) = (0.0, (J0_FIRST_ZERO * J0_FIRST_ZERO) * g / l);
-    for _ in 0..200 {
-        let mid = 0.5 * (lo + hi);
-        if count(mid) >= 1 {
-            hi = mid;
-        } else {
-            lo = mid;
-        }
-    }
-    (0.5 * (lo + hi)).sqrt()
 }
 
 /// The hanging chain's first-mode period (s) as the linearised discrete
@@ -415,11 +314,6 @@ mod tests {
     use super::*;
 
     #[test]
-    fn first_zero_of_j0() {
-        assert!(bessel_j0(J0_FIRST_ZERO).abs() < 1e-12);
-    }
-
-    #[test]
     fn oracle_scenes_are_valid() {
         YarnScene::from_toml_str(&hanging_chain_toml(100, 64, "1e-4"))
             .unwrap()
@@ -450,11 +344,6 @@ mod tests {
         let d: Vec<f64> = (0..2000).map(|k| f(k as f64 * h)).collect();
         let (a, e) = two_periods_about_mean(&d).unwrap();
         assert!(((e - a) as f64 * h - 2.0 * period).abs() < 2.0 * h);
-    }
-
-    #[test]
-    fn small_scene_is_valid() {
-        small_yarn_scene(2, 40, 64).validate().unwrap();
     }
 }
 

@@ -127,7 +127,7 @@ fn yarn_stretched_to_three_times_its_length_snaps_back() {
 
 #[test]
 fn yarns_crushed_against_an_obstacle() {
-    let mut sc = yarnsim::testing::small_yarn_scene(4, 40, 64);
+    let mut sc = yarnsim_evidence::small_yarn_scene(4, 40, 64);
     sc.gravity = [0.0, -200.0];
     sc.time.dt = 5e-5.into();
     sc.obstacles[0].center = [0.5, 0.4];
@@ -195,7 +195,7 @@ fn degenerate_and_inverted_deformation_gradients_give_finite_stress() {
 }
 
 fn wall_scene(mode: WallMode, vx: f64) -> yarnsim::YarnScene {
-    let mut sc = yarnsim::testing::small_yarn_scene(3, 40, 64);
+    let mut sc = yarnsim_evidence::small_yarn_scene(3, 40, 64);
     sc.gravity = [0.0, 0.0];
     sc.obstacles.clear();
     sc.walls.mode = mode;
@@ -241,7 +241,7 @@ fn particles_driven_at_the_walls_at_high_speed_stay_on_the_grid() {
 
 #[test]
 fn huge_gravity_is_bounded_or_refused() {
-    let base = yarnsim::testing::small_yarn_scene(3, 40, 64);
+    let base = yarnsim_evidence::small_yarn_scene(3, 40, 64);
     let mut sim = YarnSim::new(&base).unwrap();
     // Beyond the documented limit: refused, state untouched.
     assert!(matches!(
@@ -272,7 +272,7 @@ fn huge_gravity_is_bounded_or_refused() {
 
 #[test]
 fn attractor_inside_an_obstacle_cannot_pull_yarn_into_it() {
-    let base = yarnsim::testing::small_yarn_scene(3, 40, 64);
+    let base = yarnsim_evidence::small_yarn_scene(3, 40, 64);
     let mut sim = YarnSim::new(&base).unwrap();
     let o = base.obstacles[0].clone();
     sim.set_attractor(Attractor {

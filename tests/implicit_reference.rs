@@ -60,7 +60,7 @@ fn yarns(sim: &YarnSim) -> Vec<&[Vec2]> {
 
 /// Whether segments `a0 a1` and `b0 b1` cross properly (each meets the
 /// other's interior; touching end points or collinear overlaps do not
-/// count, as in tools/peers/bundle_metrics.py).
+/// count, as in tools/bench/peers/bundle_metrics.py).
 fn segments_cross(a0: Vec2, a1: Vec2, b0: Vec2, b1: Vec2) -> bool {
     let cross = |u: Vec2, v: Vec2| u.x * v.y - u.y * v.x;
     let (r, s) = (a1 - a0, b1 - b0);

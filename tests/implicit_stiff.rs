@@ -107,7 +107,7 @@ fn stiff_chain_under_backward_euler_keeps_its_step() {
 }
 
 /// The stiff chain at the large steps of the peers benchmark
-/// (`tools/peers/`, where dt 5e-3 meets MuJoCo's +0.053 %): the period
+/// (`tools/bench/peers/`, where dt 5e-3 meets MuJoCo's +0.053 %): the period
 /// within 0.15 % of the continuum oracle at dt 5e-3 and 1e-2 (measured
 /// over these 5 periods: +0.055 % and +0.098 %; the 64^2 grid's part is
 /// about +0.042 % (dt 1e-3), backward Euler's lengthening at dt 1e-2

@@ -34,7 +34,7 @@ fn random_scene(
     stiffness: f64,
     dt: f64,
 ) -> YarnScene {
-    let mut s = yarnsim::testing::small_yarn_scene(count, vertices, 64);
+    let mut s = yarnsim_evidence::small_yarn_scene(count, vertices, 64);
     // Keep the yarn (and its parallel copies) inside the margin.
     let dir = [angle.cos(), angle.sin()];
     let y = &mut s.yarns[0];

@@ -11,10 +11,10 @@ use yarnsim::math::{perp, Mat2, Vec2};
 use yarnsim::scene::{SceneError, TransferScheme, WallMode, YarnScene};
 use yarnsim::testing::{
     cantilever_setup, cantilever_toml, capstan_toml, hanging_chain_period, hanging_chain_toml,
-    small_yarn_scene, two_periods_about_mean, Capstan, ZeroCrossings, CAPSTAN_PURE_STRING,
-    CHAIN_GRAVITY,
+    two_periods_about_mean, Capstan, ZeroCrossings, CAPSTAN_PURE_STRING, CHAIN_GRAVITY,
 };
 use yarnsim::YarnSim;
+use yarnsim_evidence::small_yarn_scene;
 
 // ---- capstan ---------------------------------------------------------------
 

@@ -15,7 +15,7 @@
 //! * [`roofline`]: this core's peak flop/s and bandwidth (simple kernels),
 //!   flops and bytes per particle of each pass (counted from the kernels)
 //!   and where each pass of the reference scene sits against that limit.
-//! * [`plot`]: hand-written SVG plots.
+//! * [`plot`]: SVG line plots and bar charts (`plotters`, SVG backend).
 //!
 //! Every report renders as CSV ([`Table::to_csv`]), a text table
 //! ([`Table::to_text`]) and an SVG plot, and [`write_report`] stores them in a
@@ -26,8 +26,11 @@ pub mod chain;
 pub mod plot;
 pub mod precision;
 pub mod roofline;
+mod scene;
 pub mod skip;
 pub mod stress;
+
+pub use scene::small_yarn_scene;
 
 use std::fmt::Write;
 use std::path::Path;

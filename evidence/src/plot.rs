@@ -1,8 +1,11 @@
-//! Hand-written SVG plots: log-log line plots (work-precision, stability
-//! maps) and horizontal bar charts. No plotting crate needed; the output is
-//! plain SVG 1.1 that any browser opens.
+//! SVG plots drawn with `plotters` (its SVG backend): log-log line plots
+//! (work-precision, stability maps) and horizontal bar charts, as plain SVG
+//! 1.1 that any browser opens. A logarithmic axis is drawn over the
+//! decimal logarithm of the data, its ticks labelled `1eN`.
 
-use std::fmt::Write;
+use plotters::coord::Shift;
+use plotters::element::DashedPathElement;
+use plotters::prelude::*;
 
 /// One line of a [`LinePlot`].
 #[derive(Clone, Debug, Default)]
@@ -47,21 +50,16 @@ const PALETTE: [&str; 10] = [
     "#7f7f7f", "#bcbd22",
 ];
 
-const W: f64 = 880.0;
-const H: f64 = 480.0;
-const LEFT: f64 = 80.0;
-const RIGHT: f64 = 300.0;
-const TOP: f64 = 40.0;
-const BOTTOM: f64 = 60.0;
+const W: u32 = 880;
+const H: u32 = 480;
+/// Width of the legend to the right of the plot.
+const RIGHT: u32 = 300;
+/// Font sizes as plotters takes them (its SVG backend writes `size / 1.24`
+/// px): 15 px titles, 12 px labels.
+const TITLE: f64 = 15.0 * 1.24;
+const LABEL: f64 = 12.0 * 1.24;
 
-/// Escapes text for SVG.
-pub fn esc(s: &str) -> String {
-    s.replace('&', "&amp;")
-        .replace('<', "&lt;")
-        .replace('>', "&gt;")
-        .replace('"', "&quot;")
-}
-
+/// One axis: linear, or the decimal logarithm of the data.
 struct Axis {
     log: bool,
     lo: f64,
@@ -97,24 +95,27 @@ impl Axis {
         }
         Some(Axis { log, lo, hi })
     }
-    fn frac(&self, v: f64) -> f64 {
-        let v = if self.log { v.log10() } else { v };
-        (v - self.lo) / (self.hi - self.lo)
-    }
-    fn ticks(&self) -> Vec<(f64, String)> {
+    /// The plotted coordinate of a data value.
+    fn at(&self, v: f64) -> f64 {
         if self.log {
-            let step = ((self.hi - self.lo) / 10.0).ceil().max(1.0) as i64;
-            (self.lo as i64..=self.hi as i64)
-                .step_by(step as usize)
-                .map(|e| (10f64.powi(e as i32), format!("1e{e}")))
-                .collect()
+            v.log10()
         } else {
-            (0..=5)
-                .map(|i| {
-                    let v = self.lo + (self.hi - self.lo) * i as f64 / 5.0;
-                    (v, format!("{v:.3}"))
-                })
-                .collect()
+            v
+        }
+    }
+    /// How many tick labels: one per decade (at most 11) on a log axis.
+    fn labels(&self) -> usize {
+        if self.log {
+            ((self.hi - self.lo) as usize + 1).min(11)
+        } else {
+            6
+        }
+    }
+    fn label(&self, v: f64) -> String {
+        if self.log {
+            format!("1e{}", v.round() as i64)
+        } else {
+            format!("{v:.3}")
         }
     }
 }
@@ -123,9 +124,57 @@ fn usable(log: bool, v: f64) -> bool {
     v.is_finite() && (!log || v > 0.0)
 }
 
+fn color(i: usize) -> RGBColor {
+    let hex = PALETTE[i % PALETTE.len()];
+    let c = |k: usize| u8::from_str_radix(&hex[k..k + 2], 16).unwrap_or(0);
+    RGBColor(c(1), c(3), c(5))
+}
+
+/// Draws the markers of a series at `points` of `area`'s coordinates: a
+/// filled circle (r 3) or square (7 px), or, for markers-only series, a
+/// ring (r 5) or hollow square (9 px).
+fn draw_markers<DB: DrawingBackend, CT: CoordTranslate>(
+    area: &DrawingArea<DB, CT>,
+    points: &[CT::From],
+    s: &Series,
+    c: RGBColor,
+) -> Result<(), String>
+where
+    CT::From: Clone,
+{
+    let err = |e: DrawingAreaErrorKind<DB::ErrorType>| e.to_string();
+    for q in points {
+        let at = EmptyElement::at(q.clone());
+        match (s.markers_only, s.marker) {
+            (true, Marker::Circle) => area.draw(&(at + Circle::new((0, 0), 5, c.stroke_width(2)))),
+            (false, Marker::Circle) => area.draw(&(at + Circle::new((0, 0), 3, c.filled()))),
+            (true, Marker::Square) => {
+                area.draw(&(at + Rectangle::new([(-4, -4), (5, 5)], c.stroke_width(2))))
+            }
+            (false, Marker::Square) => {
+                area.draw(&(at + Rectangle::new([(-3, -3), (4, 4)], c.filled())))
+            }
+        }
+        .map_err(err)?;
+    }
+    Ok(())
+}
+
 impl LinePlot {
     /// The plot as an SVG document.
     pub fn to_svg(&self) -> String {
+        let mut out = String::new();
+        {
+            let root = SVGBackend::with_string(&mut out, (W, H)).into_drawing_area();
+            // Writing into a String does not fail.
+            let _ = self.draw(root);
+        }
+        out
+    }
+
+    fn draw(&self, root: DrawingArea<SVGBackend<'_>, Shift>) -> Result<(), String> {
+        let err = |e: DrawingAreaErrorKind<_>| e.to_string();
+        root.fill(&WHITE).map_err(err)?;
         let pts = |s: &Series| -> Vec<(f64, f64)> {
             s.points
                 .iter()
@@ -134,188 +183,165 @@ impl LinePlot {
                 .collect()
         };
         let all: Vec<(f64, f64)> = self.series.iter().flat_map(pts).collect();
-        let mut out = String::new();
-        let _ = writeln!(
-            out,
-            r#"<svg xmlns="http://www.w3.org/2000/svg" width="{W}" height="{H}" viewBox="0 0 {W} {H}" font-family="sans-serif" font-size="12">"#
-        );
-        let _ = writeln!(out, r#"<rect width="{W}" height="{H}" fill="white"/>"#);
-        let _ = writeln!(
-            out,
-            r#"<text x="{}" y="22" text-anchor="middle" font-size="15">{}</text>"#,
-            (LEFT + W - RIGHT) / 2.0,
-            esc(&self.title)
-        );
-        let pw = W - LEFT - RIGHT;
-        let ph = H - TOP - BOTTOM;
         let (Some(ax), Some(ay)) = (
             Axis::new(self.log_x, all.iter().map(|p| p.0)),
             Axis::new(self.log_y, all.iter().map(|p| p.1)),
         ) else {
-            let _ = writeln!(
-                out,
-                r#"<text x="{}" y="{}" text-anchor="middle">no finite data</text></svg>"#,
-                W / 2.0,
-                H / 2.0
-            );
-            return out;
+            root.draw(&Text::new(
+                "no finite data",
+                (W as i32 / 2, H as i32 / 2),
+                ("sans-serif", LABEL).into_font().color(&BLACK),
+            ))
+            .map_err(err)?;
+            return root.present().map_err(err);
         };
-        let px = |x: f64| LEFT + ax.frac(x) * pw;
-        let py = |y: f64| TOP + (1.0 - ay.frac(y)) * ph;
-        // Grid and ticks.
-        for (v, label) in ax.ticks() {
-            let x = px(v);
-            let _ = writeln!(
-                out,
-                r##"<line x1="{x:.1}" y1="{TOP}" x2="{x:.1}" y2="{:.1}" stroke="#ddd"/><text x="{x:.1}" y="{:.1}" text-anchor="middle">{}</text>"##,
-                TOP + ph,
-                TOP + ph + 16.0,
-                esc(&label)
-            );
-        }
-        for (v, label) in ay.ticks() {
-            let y = py(v);
-            let _ = writeln!(
-                out,
-                r##"<line x1="{LEFT}" y1="{y:.1}" x2="{:.1}" y2="{y:.1}" stroke="#ddd"/><text x="{:.1}" y="{:.1}" text-anchor="end">{}</text>"##,
-                LEFT + pw,
-                LEFT - 6.0,
-                y + 4.0,
-                esc(&label)
-            );
-        }
-        let _ = writeln!(
-            out,
-            r#"<rect x="{LEFT}" y="{TOP}" width="{pw}" height="{ph}" fill="none" stroke="black"/>"#
-        );
-        let _ = writeln!(
-            out,
-            r#"<text x="{:.1}" y="{:.1}" text-anchor="middle">{}</text>"#,
-            LEFT + pw / 2.0,
-            H - 18.0,
-            esc(&self.x_label)
-        );
-        let _ = writeln!(
-            out,
-            r#"<text x="18" y="{:.1}" text-anchor="middle" transform="rotate(-90 18 {:.1})">{}</text>"#,
-            TOP + ph / 2.0,
-            TOP + ph / 2.0,
-            esc(&self.y_label)
-        );
-        // Series.
+        let (plot_area, legend) = root.split_horizontally(W - RIGHT);
+        let mut chart = ChartBuilder::on(&plot_area)
+            .caption(&self.title, ("sans-serif", TITLE))
+            .margin(10)
+            .x_label_area_size(40)
+            .y_label_area_size(70)
+            .build_cartesian_2d(ax.lo..ax.hi, ay.lo..ay.hi)
+            .map_err(|e| e.to_string())?;
+        chart
+            .configure_mesh()
+            .label_style(("sans-serif", LABEL))
+            .axis_desc_style(("sans-serif", LABEL))
+            .x_desc(&self.x_label)
+            .y_desc(&self.y_label)
+            .x_labels(ax.labels())
+            .y_labels(ay.labels())
+            .x_label_formatter(&|v| ax.label(*v))
+            .y_label_formatter(&|v| ay.label(*v))
+            .max_light_lines(0)
+            .bold_line_style(RGBColor(0xdd, 0xdd, 0xdd))
+            .draw()
+            .map_err(|e| e.to_string())?;
         for (i, s) in self.series.iter().enumerate() {
-            let c = PALETTE[s.color.unwrap_or(i) % PALETTE.len()];
-            let dash = if s.dashed {
-                r#" stroke-dasharray="6 4""#
-            } else {
-                ""
-            };
-            let p = pts(s);
+            let c = color(s.color.unwrap_or(i));
+            let p: Vec<(f64, f64)> = pts(s)
+                .into_iter()
+                .map(|(x, y)| (ax.at(x), ay.at(y)))
+                .collect();
             if p.len() > 1 && !s.markers_only {
-                let coords: Vec<String> = p
-                    .iter()
-                    .map(|&(x, y)| format!("{:.1},{:.1}", px(x), py(y)))
-                    .collect();
-                let _ = writeln!(
-                    out,
-                    r#"<polyline class="series" points="{}" fill="none" stroke="{c}" stroke-width="2"{dash}/>"#,
-                    coords.join(" ")
-                );
+                let r = if s.dashed {
+                    chart.draw_series(DashedLineSeries::new(
+                        p.iter().copied(),
+                        6,
+                        4,
+                        c.stroke_width(2),
+                    ))
+                } else {
+                    chart.draw_series(LineSeries::new(p.iter().copied(), c.stroke_width(2)))
+                };
+                r.map_err(|e| e.to_string())?;
             }
-            let marker = |x: f64, y: f64| match (s.markers_only, s.marker) {
-                (true, Marker::Circle) => format!(
-                    r#"<circle cx="{x:.1}" cy="{y:.1}" r="5" fill="none" stroke="{c}" stroke-width="2"/>"#
-                ),
-                (false, Marker::Circle) => {
-                    format!(r#"<circle cx="{x:.1}" cy="{y:.1}" r="3" fill="{c}"/>"#)
+            draw_markers(chart.plotting_area(), &p, s, c)?;
+            // The legend key: the line (dashed as the series), with the
+            // marker where it is not the plain circle, or the marker alone.
+            let (lx, ly) = (12, 54 + 18 * i as i32);
+            if !s.markers_only {
+                let key = [(lx, ly), (lx + 20, ly)];
+                let style = c.stroke_width(3);
+                if s.dashed {
+                    legend
+                        .draw(&DashedPathElement::new(key, 6, 4, style))
+                        .map_err(err)?;
+                } else {
+                    legend.draw(&PathElement::new(key, style)).map_err(err)?;
                 }
-                (true, Marker::Square) => format!(
-                    r#"<rect x="{:.1}" y="{:.1}" width="9" height="9" fill="none" stroke="{c}" stroke-width="2"/>"#,
-                    x - 4.5,
-                    y - 4.5
-                ),
-                (false, Marker::Square) => format!(
-                    r#"<rect class="marker" x="{:.1}" y="{:.1}" width="7" height="7" fill="{c}"/>"#,
-                    x - 3.5,
-                    y - 3.5
-                ),
-            };
-            for &(x, y) in &p {
-                let _ = writeln!(out, "{}", marker(px(x), py(y)));
             }
-            let ly = TOP + 14.0 + 18.0 * i as f64;
-            let lx = LEFT + pw + 12.0;
-            let key = if s.markers_only {
-                marker(lx + 10.0, ly)
-            } else {
-                let mut k = format!(
-                    r#"<line x1="{lx}" y1="{ly}" x2="{}" y2="{ly}" stroke="{c}" stroke-width="3"{dash}/>"#,
-                    lx + 20.0
-                );
-                if s.marker != Marker::Circle {
-                    k.push_str(&marker(lx + 10.0, ly));
-                }
-                k
-            };
-            let _ = writeln!(
-                out,
-                r#"{key}<text x="{}" y="{}">{}</text>"#,
-                lx + 26.0,
-                ly + 4.0,
-                esc(&s.name)
-            );
+            if s.markers_only || s.marker != Marker::Circle {
+                draw_markers(&legend, &[(lx + 10, ly)], s, c)?;
+            }
+            legend
+                .draw(&Text::new(
+                    s.name.as_str(),
+                    (lx + 26, ly - 6),
+                    ("sans-serif", LABEL).into_font().color(&BLACK),
+                ))
+                .map_err(err)?;
         }
-        out.push_str("</svg>\n");
-        out
+        root.present().map_err(err)
     }
 }
 
-/// A horizontal bar chart (one bar per label).
+/// A horizontal bar chart (one bar per label, top down, its value written
+/// after it).
 pub fn bar_chart(title: &str, x_label: &str, bars: &[(String, f64)]) -> String {
-    let bh = 22.0;
-    let left = 260.0;
-    let width = 760.0;
-    let height = 70.0 + bh * bars.len() as f64;
+    let (width, height) = (760u32, 90 + 22 * bars.len() as u32);
     let max = bars
         .iter()
         .map(|b| b.1)
         .filter(|v| v.is_finite())
         .fold(0.0f64, f64::max)
         .max(1e-300);
-    let pw = width - left - 90.0;
     let mut out = String::new();
-    let _ = writeln!(
-        out,
-        r#"<svg xmlns="http://www.w3.org/2000/svg" width="{width}" height="{height}" viewBox="0 0 {width} {height}" font-family="sans-serif" font-size="12">"#
-    );
-    let _ = writeln!(
-        out,
-        r#"<rect width="{width}" height="{height}" fill="white"/><text x="{}" y="22" text-anchor="middle" font-size="15">{}</text>"#,
-        width / 2.0,
-        esc(title)
-    );
-    for (i, (label, v)) in bars.iter().enumerate() {
-        let y = 40.0 + bh * i as f64;
-        let w = if v.is_finite() { pw * v / max } else { 0.0 };
-        let _ = writeln!(
-            out,
-            r##"<text x="{:.1}" y="{:.1}" text-anchor="end">{}</text><rect class="bar" x="{left}" y="{y:.1}" width="{w:.1}" height="{:.1}" fill="#1f77b4"/><text x="{:.1}" y="{:.1}">{v:.4}</text>"##,
-            left - 6.0,
-            y + 15.0,
-            esc(label),
-            bh - 4.0,
-            left + w + 4.0,
-            y + 15.0
-        );
+    {
+        let root = SVGBackend::with_string(&mut out, (width, height)).into_drawing_area();
+        // Writing into a String does not fail.
+        let _ = draw_bars(&root, title, x_label, bars, max);
     }
-    let _ = writeln!(
-        out,
-        r#"<text x="{:.1}" y="{:.1}" text-anchor="middle">{}</text></svg>"#,
-        left + pw / 2.0,
-        height - 8.0,
-        esc(x_label)
-    );
     out
+}
+
+fn draw_bars(
+    root: &DrawingArea<SVGBackend<'_>, Shift>,
+    title: &str,
+    x_label: &str,
+    bars: &[(String, f64)],
+    max: f64,
+) -> Result<(), String> {
+    root.fill(&WHITE).map_err(|e| e.to_string())?;
+    let n = bars.len();
+    let mut chart = ChartBuilder::on(root)
+        .caption(title, ("sans-serif", TITLE))
+        .margin(10)
+        .margin_right(90)
+        .x_label_area_size(30)
+        .y_label_area_size(250)
+        .build_cartesian_2d(0.0..max, (0..n).into_segmented())
+        .map_err(|e| e.to_string())?;
+    chart
+        .configure_mesh()
+        .disable_mesh()
+        .label_style(("sans-serif", LABEL))
+        .axis_desc_style(("sans-serif", LABEL))
+        .x_desc(x_label)
+        .y_labels(n.max(1))
+        .y_label_formatter(&|v| match v {
+            SegmentValue::CenterOf(r) if *r < n => bars[n - 1 - r].0.clone(),
+            _ => String::new(),
+        })
+        .draw()
+        .map_err(|e| e.to_string())?;
+    let fill = color(0).filled();
+    // The first bar on top: bar `i` in row `n - 1 - i` (rows count upwards).
+    let row = |i: usize| n - 1 - i;
+    let width = |v: f64| if v.is_finite() { v } else { 0.0 };
+    chart
+        .draw_series(bars.iter().enumerate().map(|(i, (_, v))| {
+            let mut r = Rectangle::new(
+                [
+                    (0.0, SegmentValue::Exact(row(i))),
+                    (width(*v), SegmentValue::Exact(row(i) + 1)),
+                ],
+                fill,
+            );
+            r.set_margin(2, 2, 0, 0);
+            r
+        }))
+        .map_err(|e| e.to_string())?;
+    chart
+        .draw_series(bars.iter().enumerate().map(|(i, (_, v))| {
+            Text::new(
+                format!("{v:.4}"),
+                (width(*v), SegmentValue::CenterOf(row(i))),
+                ("sans-serif", LABEL).into_font().color(&BLACK),
+            )
+        }))
+        .map_err(|e| e.to_string())?;
+    root.present().map_err(|e| e.to_string())
 }
 
 #[cfg(test)]
@@ -358,23 +384,42 @@ mod tests {
             },
         ]);
         assert!(svg.starts_with("<svg") && svg.trim_end().ends_with("</svg>"));
+        // plotters writes colours in upper case
+        let (c0, c2) = (PALETTE[0].to_uppercase(), PALETTE[2].to_uppercase());
+        let lines = |color: &str, width: u32| {
+            let key = format!(
+                r#"<polyline fill="none" opacity="1" stroke="{color}" stroke-width="{width}""#
+            );
+            svg.matches(&key).count()
+        };
         assert_eq!(
-            svg.matches("<polyline").count(),
-            2,
+            lines(&c2, 2) + lines(&c2, 3),
+            0,
             "markers-only series has no line"
         );
-        assert_eq!(
-            svg.matches("stroke-dasharray").count(),
-            2,
-            "dashed line and its legend key"
-        );
+        // the solid line is one polyline through its 3 points; the dashed
+        // twin's line is drawn as dashes (many short polylines), and so is
+        // its legend key (2 dashes of 6 px over 20 px beside the solid key)
+        let solid = svg
+            .lines()
+            .filter(|l| l.contains(&format!(r#"stroke="{c0}" stroke-width="2""#)))
+            .filter(|l| l.matches(',').count() == 3)
+            .count();
+        assert_eq!(solid, 1);
+        assert!(lines(&c0, 2) > 1 + 10, "{}", lines(&c0, 2));
+        assert_eq!(lines(&c0, 3), 1 + 2, "solid legend key and the dashed one");
         // 3 + 2 filled markers, 1 ring in the plot and 1 in the legend
         assert_eq!(svg.matches(r#"r="3""#).count(), 5);
         assert_eq!(svg.matches(r#"r="5""#).count(), 2);
         // the twin takes palette colour 0 like the first series
-        assert_eq!(svg.matches(PALETTE[0]).count(), 3 + 2 + 2 + 2);
+        assert_eq!(svg.matches(&format!(r#"fill="{c0}""#)).count(), 3 + 2);
+        assert_eq!(svg.matches(&format!(r#"stroke="{c2}""#)).count(), 2);
         assert!(svg.contains("t &lt;&amp;&gt;"));
         assert!(!svg.contains("NaN") && !svg.contains("inf"));
+        // the decades of both log axes are labelled
+        for tick in ["1e0", "1e1", "1e2", "1e-5", "1e-4", "1e-3", "1e-2"] {
+            assert!(svg.contains(&format!("\n{tick}\n")), "{tick}");
+        }
     }
 
     #[test]
@@ -385,7 +430,14 @@ mod tests {
             marker: Marker::Square,
             ..Series::default()
         }]);
-        assert_eq!(svg.matches(r#"class="marker""#).count(), 3);
+        // 2 filled squares in the plot, 1 in the legend
+        let fill = format!(r#"fill="{}""#, PALETTE[0].to_uppercase());
+        let squares = svg
+            .lines()
+            .filter(|l| l.starts_with("<rect") && l.contains(r#"width="7" height="7""#))
+            .filter(|l| l.contains(&fill))
+            .count();
+        assert_eq!(squares, 3);
         assert_eq!(svg.matches("<circle").count(), 0);
     }
 
@@ -397,5 +449,47 @@ mod tests {
             ..Series::default()
         }]);
         assert!(svg.contains("no finite data"));
+    }
+
+    #[test]
+    fn bar_chart_draws_one_bar_per_label_top_down() {
+        let svg = bar_chart(
+            "bars <&>",
+            "seconds",
+            &[
+                ("a".into(), 1.0),
+                ("b & c".into(), 0.25),
+                ("nan".into(), f64::NAN),
+            ],
+        );
+        assert!(svg.starts_with("<svg") && svg.trim_end().ends_with("</svg>"));
+        let fill = format!(r#"fill="{}""#, PALETTE[0].to_uppercase());
+        // (y, width) of each bar, in drawing order
+        let bars: Vec<(f64, f64)> = svg
+            .lines()
+            .filter(|l| l.starts_with("<rect") && l.contains(&fill))
+            .map(|l| {
+                let attr = |name: &str| -> f64 {
+                    let v = l.split(&format!(r#" {name}=""#)).nth(1).unwrap();
+                    v[..v.find('"').unwrap()].parse().unwrap()
+                };
+                (attr("y"), attr("width"))
+            })
+            .collect();
+        assert_eq!(bars.len(), 3);
+        // the first label on top, widths in proportion, the NaN bar empty
+        assert!(bars[0].0 < bars[1].0 && bars[1].0 < bars[2].0, "{bars:?}");
+        assert!((bars[1].1 / bars[0].1 - 0.25).abs() < 0.01, "{bars:?}");
+        assert_eq!(bars[2].1, 0.0);
+        for text in [
+            "bars &lt;&amp;&gt;",
+            "seconds",
+            "\nb &amp; c\n",
+            "1.0000",
+            "0.2500",
+            "NaN",
+        ] {
+            assert!(svg.contains(text), "{text}");
+        }
     }
 }

@@ -21,13 +21,13 @@
 //! attractor (strength `a`) can give in the probe time `T` (Courant number 1).
 
 use crate::plot::{LinePlot, Series};
+use crate::small_yarn_scene;
 use crate::{extent, num, Table};
 use yarnsim::massspring::integrators::stability::analyze;
 use yarnsim::massspring::{scenes, Integrator, IntegratorOptions, Simulation, System};
 use yarnsim::math::Vec2;
 use yarnsim::mpm::{Attractor, YarnSim};
 use yarnsim::scene::YarnScene;
-use yarnsim::testing::small_yarn_scene;
 
 /// Simulated time of one probe run, in s.
 pub const PROBE_TIME: f64 = 0.5;

@@ -1,12 +1,17 @@
 //! The FMU packager (`build-fmu`), a crate of its own so that the FMU's
 //! shared library does not carry it.
 //!
-//! Packaging: the `.fmu` zip archive (written here, "stored" entries with a
-//! fixed timestamp, so the same inputs give the same bytes), the generated
-//! documentation page and a small ELF reader that checks the shared library
-//! before it is packed (exported `fmi2*` symbols, `DT_NEEDED` libraries).
+//! Packaging: the `.fmu` zip archive (the `zip` crate, "stored" entries with
+//! a fixed timestamp, so the same inputs give the same bytes), the generated
+//! documentation page and the check of the shared library before it is
+//! packed (the `object` crate's ELF reader: exported `fmi2*` and `fmi3*`
+//! symbols, `DT_NEEDED` libraries).
 
 use std::fmt::Write as _;
+use std::io::{Cursor, Read, Write};
+
+use zip::write::SimpleFileOptions;
+use zip::{CompressionMethod, DateTime};
 
 use yarnsim::scene::Scene;
 pub use yarnsim_fmu::fmi2::FMI2_FUNCTIONS;
@@ -14,135 +19,68 @@ pub use yarnsim_fmu::fmi3::FMI3_FUNCTIONS;
 use yarnsim_fmu::model_description::{xml_escape, SCENE_FILE};
 use yarnsim_fmu::SceneFmu;
 
-/// CRC-32 (IEEE 802.3, reflected, as zip uses it).
+/// CRC-32 (IEEE 802.3, reflected, as zip uses it), by `crc32fast` (the
+/// checksum the `zip` crate writes).
 pub fn crc32(data: &[u8]) -> u32 {
-    let mut table = [0u32; 256];
-    for (i, t) in table.iter_mut().enumerate() {
-        let mut c = i as u32;
-        for _ in 0..8 {
-            c = if c & 1 != 0 {
-                0xEDB8_8320 ^ (c >> 1)
-            } else {
-                c >> 1
-            };
-        }
-        *t = c;
-    }
-    let mut crc = !0u32;
-    for &b in data {
-        crc = table[((crc ^ b as u32) & 0xff) as usize] ^ (crc >> 8);
-    }
-    !crc
+    crc32fast::hash(data)
 }
 
 /// A zip archive of stored (uncompressed) entries, which every unzip
-/// implementation reads (FMI allows deflate or store).
-#[derive(Default)]
+/// implementation reads (FMI allows deflate or store), written by the `zip`
+/// crate with a fixed timestamp (1980-01-01 00:00) and fixed unix modes, so
+/// the same inputs give the same bytes.
 pub struct Zip {
-    out: Vec<u8>,
-    central: Vec<u8>,
-    entries: u16,
+    writer: zip::ZipWriter<Cursor<Vec<u8>>>,
 }
 
-/// 1980-01-01 00:00 in DOS format: a fixed timestamp keeps builds reproducible.
-const DOS_TIME: u16 = 0;
-const DOS_DATE: u16 = (1 << 5) | 1;
+impl Default for Zip {
+    fn default() -> Zip {
+        Zip {
+            writer: zip::ZipWriter::new(Cursor::new(Vec::new())),
+        }
+    }
+}
 
 impl Zip {
     /// Adds a file; `name` uses forward slashes. `executable` sets the unix
     /// mode 0755 instead of 0644.
     pub fn add(&mut self, name: &str, data: &[u8], executable: bool) -> Result<(), String> {
-        if data.len() > u32::MAX as usize - 1 || self.out.len() + data.len() > u32::MAX as usize - 1
-        {
-            return Err(format!("{name}: too large for a zip without zip64"));
-        }
-        let crc = crc32(data);
-        let offset = self.out.len() as u32;
-        let n = name.len() as u16;
-        let size = data.len() as u32;
-        let o = &mut self.out;
-        o.extend_from_slice(&0x0403_4b50u32.to_le_bytes());
-        for v in [20u16, 0, 0, DOS_TIME, DOS_DATE] {
-            o.extend_from_slice(&v.to_le_bytes());
-        }
-        for v in [crc, size, size] {
-            o.extend_from_slice(&v.to_le_bytes());
-        }
-        o.extend_from_slice(&n.to_le_bytes());
-        o.extend_from_slice(&0u16.to_le_bytes());
-        o.extend_from_slice(name.as_bytes());
-        o.extend_from_slice(data);
-
-        let mode: u32 = if executable { 0o100755 } else { 0o100644 };
-        let c = &mut self.central;
-        c.extend_from_slice(&0x0201_4b50u32.to_le_bytes());
-        // Made by: unix (3), spec 2.0; needed: 2.0.
-        for v in [0x0314u16, 20, 0, 0, DOS_TIME, DOS_DATE] {
-            c.extend_from_slice(&v.to_le_bytes());
-        }
-        for v in [crc, size, size] {
-            c.extend_from_slice(&v.to_le_bytes());
-        }
-        for v in [n, 0, 0, 0, 0] {
-            c.extend_from_slice(&v.to_le_bytes());
-        }
-        c.extend_from_slice(&(mode << 16).to_le_bytes());
-        c.extend_from_slice(&offset.to_le_bytes());
-        c.extend_from_slice(name.as_bytes());
-        self.entries += 1;
-        Ok(())
+        let options = SimpleFileOptions::default()
+            .compression_method(CompressionMethod::Stored)
+            .last_modified_time(DateTime::default())
+            .unix_permissions(if executable { 0o755 } else { 0o644 })
+            .large_file(false);
+        self.writer
+            .start_file(name, options)
+            .and_then(|()| self.writer.write_all(data).map_err(Into::into))
+            .map_err(|e| format!("{name}: {e}"))
     }
 
     /// The archive bytes.
-    pub fn finish(mut self) -> Vec<u8> {
-        let cd_offset = self.out.len() as u32;
-        let cd_size = self.central.len() as u32;
-        self.out.extend_from_slice(&self.central);
-        self.out.extend_from_slice(&0x0605_4b50u32.to_le_bytes());
-        for v in [0u16, 0, self.entries, self.entries] {
-            self.out.extend_from_slice(&v.to_le_bytes());
-        }
-        self.out.extend_from_slice(&cd_size.to_le_bytes());
-        self.out.extend_from_slice(&cd_offset.to_le_bytes());
-        self.out.extend_from_slice(&0u16.to_le_bytes());
-        self.out
+    pub fn finish(self) -> Vec<u8> {
+        self.writer
+            .finish()
+            .expect("writing a zip into memory")
+            .into_inner()
     }
 }
 
-/// Reads the names of a stored zip's entries (central directory), for tests
-/// and the packager's self-check.
+/// Reads the entries of a zip archive (names and data, in archive order,
+/// each checked against its CRC-32), for tests and the packager's
+/// self-check.
 pub fn zip_entries(zip: &[u8]) -> Result<Vec<(String, Vec<u8>)>, String> {
-    let eocd = zip
-        .len()
-        .checked_sub(22)
-        .filter(|&i| zip[i..i + 4] == 0x0605_4b50u32.to_le_bytes())
-        .ok_or("no end of central directory record")?;
-    let u16_at = |i: usize| u16::from_le_bytes([zip[i], zip[i + 1]]) as usize;
-    let u32_at = |i: usize| u32::from_le_bytes(zip[i..i + 4].try_into().unwrap()) as usize;
-    let count = u16_at(eocd + 10);
-    let mut at = u32_at(eocd + 16);
-    let mut out = Vec::with_capacity(count);
-    for _ in 0..count {
-        if at + 46 > zip.len() || u32_at(at) != 0x0201_4b50 {
-            return Err("bad central directory header".into());
-        }
-        let size = u32_at(at + 20);
-        let n = u16_at(at + 28);
-        let skip = n + u16_at(at + 30) + u16_at(at + 32);
-        let name = String::from_utf8_lossy(&zip[at + 46..at + 46 + n]).into_owned();
-        let local = u32_at(at + 42);
-        let data_at = local + 30 + u16_at(local + 26) + u16_at(local + 28);
-        let data = zip
-            .get(data_at..data_at + size)
-            .ok_or("entry data out of bounds")?
-            .to_vec();
-        if crc32(&data) != u32_at(at + 16) as u32 {
-            return Err(format!("{name}: CRC mismatch"));
-        }
-        out.push((name, data));
-        at += 46 + skip;
-    }
-    Ok(out)
+    let mut archive = zip::ZipArchive::new(Cursor::new(zip)).map_err(|e| e.to_string())?;
+    (0..archive.len())
+        .map(|i| {
+            let mut entry = archive.by_index(i).map_err(|e| e.to_string())?;
+            let name = entry.name().map_err(|e| e.to_string())?.into_owned();
+            let mut data = Vec::with_capacity(entry.size() as usize);
+            entry
+                .read_to_end(&mut data)
+                .map_err(|e| format!("{name}: {e}"))?;
+            Ok((name, data))
+        })
+        .collect()
 }
 
 /// The FMI version of an FMU to pack.
@@ -313,67 +251,38 @@ pub struct ElfInfo {
 }
 
 /// Reads the exported dynamic symbols and `DT_NEEDED` entries of a 64-bit
-/// little-endian ELF file.
+/// little-endian ELF file (with the `object` crate's ELF reader).
 pub fn elf_info(b: &[u8]) -> Result<ElfInfo, String> {
-    if b.len() < 64 || &b[..4] != b"\x7fELF" || b[4] != 2 || b[5] != 1 {
-        return Err("not a 64-bit little-endian ELF file".into());
-    }
-    let get = |at: usize, n: usize| -> Result<u64, String> {
-        let s = b.get(at..at + n).ok_or("ELF read out of bounds")?;
-        let mut v = [0u8; 8];
-        v[..n].copy_from_slice(s);
-        Ok(u64::from_le_bytes(v))
-    };
-    let shoff = get(0x28, 8)? as usize;
-    let shentsize = get(0x3a, 2)? as usize;
-    let shnum = get(0x3c, 2)? as usize;
-    // (type, offset, size, link, entsize) of every section.
-    let mut sections = Vec::with_capacity(shnum);
-    for i in 0..shnum {
-        let s = shoff + i * shentsize;
-        sections.push((
-            get(s + 4, 4)? as u32,
-            get(s + 0x18, 8)? as usize,
-            get(s + 0x20, 8)? as usize,
-            get(s + 0x28, 4)? as usize,
-            get(s + 0x38, 8)? as usize,
-        ));
-    }
-    let cstr = |strtab: usize, off: usize| -> Result<String, String> {
-        let (_, o, size, _, _) = *sections.get(strtab).ok_or("bad string table")?;
-        let s = b.get(o + off..o + size).ok_or("bad string offset")?;
-        let end = s.iter().position(|&c| c == 0).unwrap_or(s.len());
-        Ok(String::from_utf8_lossy(&s[..end]).into_owned())
-    };
+    use object::read::elf::{Dyn, ElfFile64, FileHeader};
+    use object::{elf, LittleEndian, Object, ObjectSymbol};
+    let file = ElfFile64::<LittleEndian>::parse(b)
+        .map_err(|e| format!("not a 64-bit little-endian ELF file: {e}"))?;
     let mut info = ElfInfo::default();
-    for &(ty, off, size, link, entsize) in &sections {
-        match ty {
-            // SHT_DYNSYM
-            11 => {
-                let entsize = entsize.max(24);
-                for k in 1..size / entsize {
-                    let e = off + k * entsize;
-                    let name = get(e, 4)? as usize;
-                    let bind = b[e + 4] >> 4;
-                    let shndx = get(e + 6, 2)?;
-                    if shndx != 0 && (bind == 1 || bind == 2) {
-                        info.exported.push(cstr(link, name)?);
-                    }
-                }
+    // Defined dynamic symbols of global or weak binding.
+    for sym in file.dynamic_symbols() {
+        if !sym.is_undefined() && sym.is_global() {
+            info.exported
+                .push(sym.name().map_err(|e| e.to_string())?.to_string());
+        }
+    }
+    let endian = file.endian();
+    let sections = file
+        .elf_header()
+        .sections(endian, b)
+        .map_err(|e| e.to_string())?;
+    if let Some((dynamic, link)) = sections.dynamic(endian, b).map_err(|e| e.to_string())? {
+        let strings = sections
+            .strings(endian, b, link)
+            .map_err(|e| e.to_string())?;
+        for d in dynamic {
+            let tag = d.d_tag(endian);
+            if tag == elf::DT_NULL {
+                break;
             }
-            // SHT_DYNAMIC
-            6 => {
-                for k in 0..size / 16 {
-                    let tag = get(off + 16 * k, 8)?;
-                    let val = get(off + 16 * k + 8, 8)? as usize;
-                    match tag {
-                        0 => break,
-                        1 => info.needed.push(cstr(link, val)?),
-                        _ => {}
-                    }
-                }
+            if tag == elf::DT_NEEDED {
+                let name = d.string(endian, strings).map_err(|e| e.to_string())?;
+                info.needed.push(String::from_utf8_lossy(name).into_owned());
             }
-            _ => {}
         }
     }
     Ok(info)

@@ -28,7 +28,7 @@
 //! folder:
 //! * [`fmi2`], [`fmi3`]: the FMI 2.0 and FMI 3.0 C ABIs, one file per
 //!   function group; siblings, neither names the other (checked by
-//!   `tools/check_modules.py`).
+//!   `tools/checks/check_modules.py`).
 //! * [`shell`]: the C-ABI shell both share (the instance check, the logged
 //!   failures, the caught panics, the pointer helpers, the export macros,
 //!   the FMU-state function bodies).

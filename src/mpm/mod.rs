@@ -21,7 +21,7 @@
 //!   dynamic state, diagnostics and statistics.
 //! * [`error`]: the error of a failed step or input, [`SimError`].
 //!
-//! A layer uses only the layers below it (`tools/check_modules.py` checks
+//! A layer uses only the layers below it (`tools/checks/check_modules.py` checks
 //! it): laws use the machinery, integrators the laws and the machinery,
 //! the driver everything; no integrator uses another.
 

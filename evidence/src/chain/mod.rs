@@ -45,7 +45,7 @@ use yarnsim::scene::{
     GridSpec, Integrator, Material, PinSpec, StepSize, TimeSpec, TransferScheme, TransferSpec,
     WallMode, Walls, YarnEnd, YarnScene, YarnSpec, DEFAULT_SAFETY,
 };
-use yarnsim::testing::bessel_j0;
+use yarnsim_oracles::bessel_j0;
 
 mod oracle;
 mod report;

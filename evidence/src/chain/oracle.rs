@@ -4,7 +4,7 @@
 //! frequency of a run from its zero crossings.
 
 /// First zero of `J0`.
-pub const J01: f64 = 2.404_825_557_695_773;
+pub const J01: f64 = yarnsim_oracles::J0_FIRST_ZERO;
 
 /// The oracle: first angular frequency (rad/s) of the uniform inextensible
 /// chain of length `l` hanging in gravity `g`.
@@ -12,9 +12,9 @@ pub fn oracle_omega(g: f64, l: f64) -> f64 {
     0.5 * J01 * (g / l).sqrt()
 }
 
-/// The linearised discrete extensible chain (in `yarnsim::testing`,
+/// The linearised discrete extensible chain (in `yarnsim-oracles`,
 /// shared with the library's tests).
-pub use yarnsim::testing::extensible_chain_omega;
+pub use yarnsim_oracles::extensible_chain_omega;
 
 /// Angular frequency from the zero crossings of `(t, x)` samples: the
 /// crossing times by linear interpolation, `omega = pi (n - 1) / (t_n - t_1)`

@@ -30,7 +30,7 @@ impl Default for RooflineOptions {
             steps: 200,
             warmup: 100,
             repeats: 7,
-            // tools/taichi_bench.sh on this host (docs/performance/throughput.md, "Against the
+            // tools/bench/taichi_bench.sh on this host (docs/performance/throughput.md, "Against the
             // reference Taichi implementation")
             reference_rate: (1.9e6, 2.7e6),
             goal_factor: 20.0,

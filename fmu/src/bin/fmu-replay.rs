@@ -1,4 +1,4 @@
-//! The Rust side of `tools/fmu_check.sh`: runs a scene straight on the
+//! The Rust side of `tools/fmu/fmu_check.sh`: runs a scene straight on the
 //! library (no FMU) with the inputs of a CSV table, the way an FMI master
 //! steps the FMU, and writes the outputs as CSV.
 //!

@@ -10,7 +10,7 @@ def fmu_path(name):
     d = pathlib.Path(os.environ.get("YARNSIM_FMU_DIR", ROOT / "target" / "fmu"))
     p = d / name
     if not p.is_file():
-        pytest.fail(f"{p} is missing: build it first (bash tools/fmu_check.sh builds it; YARNSIM_FMU_DIR points elsewhere)")
+        pytest.fail(f"{p} is missing: build it first (bash tools/fmu/fmu_check.sh builds it; YARNSIM_FMU_DIR points elsewhere)")
     return str(p)
 
 

@@ -1,4 +1,4 @@
-"""fmusim against fmpy on the same FMUs (run by tools/fmusim.sh).
+"""fmusim against fmpy on the same FMUs (run by tools/fmu/fmusim.sh).
 
 usage: fmusim_check.py FMUSIM WORKDIR FMU [FMU ...]
 

@@ -8,7 +8,7 @@
 //! medians are printed.
 //!
 //! ```text
-//! cargo run --release --example implicit_cost [RUNS]
+//! cargo run --release -p yarnsim-evidence --example implicit_cost [RUNS]
 //! ```
 
 use std::time::Instant;

@@ -16,7 +16,7 @@
 # so that a local mirror works offline). FMUCC_BIN=path/to/fmuCheck.linux64
 # uses an existing checker instead.
 set -euo pipefail
-cd "$(dirname "$0")/.."
+cd "$(dirname "$0")/../.."
 root=$(pwd)
 dir=tools/.fmucc
 FMUCC_GIT=${FMUCC_GIT:-https://github.com/modelica-tools/FMUComplianceChecker.git}

@@ -1,4 +1,4 @@
-"""Input tables and helpers shared by the fmpy checks (tools/fmu_check.py, tools/fmu3_check.py)."""
+"""Input tables and helpers shared by the fmpy checks (tools/fmu/fmu_check.py, tools/fmu/fmu3_check.py)."""
 import math
 import sys
 

@@ -2,9 +2,9 @@
 """yarnsim against the reference Taichi implementation of Jiang et al. 2017's
 yarn bundle, side by side.
 
-Usage (normally through tools/taichi_bench.sh, which sets up Taichi 1.7.4):
+Usage (normally through tools/bench/taichi_bench.sh, which sets up Taichi 1.7.4):
 
-    python tools/taichi_bench.py REFERENCE_FILE [--yarnsim BIN] [--threads 1,2]
+    python tools/bench/taichi_bench.py REFERENCE_FILE [--yarnsim BIN] [--threads 1,2]
         [--rounds 3] [--steps 1000] [--warmup 100] [--f64]
 
 REFERENCE_FILE is `aempm/aempm_2d_pill.py` of
@@ -183,7 +183,7 @@ def main():
         digest = hashlib.sha256(f.read()).hexdigest()
     if digest != REFERENCE_SHA256:
         print(f"warning: {reference} is not the 3cc3af6 version (sha256 {digest})")
-    root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    root = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
     yarnsim = args.yarnsim or os.path.join(root, "target", "release", "yarnsim")
     if not os.access(yarnsim, os.X_OK):
         sys.exit(f"no yarnsim binary at {yarnsim}: cargo build --release -p yarnsim-cli, or pass --yarnsim")

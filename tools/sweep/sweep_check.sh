@@ -3,10 +3,10 @@
 # the tool with its pinned dependencies (dask and distributed 2026.8.0,
 # pyarrow 26.0.1, pandas 3.1.1, matplotlib 3.11.2, pytest 9.2.0) into
 # tools/.venv, packs the small YarnBundle FMU and the wire's MassSpring FMU
-# (if tools/fmu_check.sh has not just done so) and runs pytest on 2-worker
+# (if tools/fmu/fmu_check.sh has not just done so) and runs pytest on 2-worker
 # LocalClusters. Exits non-zero on failure (also when no test ran).
 set -euo pipefail
-cd "$(dirname "$0")/.."
+cd "$(dirname "$0")/../.."
 venv=tools/.venv
 [ -x "$venv/bin/python" ] || python3 -m venv "$venv"
 if ! "$venv/bin/python" - <<'PY' 2>/dev/null

@@ -1,4 +1,4 @@
-"""libcosimpy checks of the FMUs (run by tools/fmu_check.sh after the fmpy checks).
+"""libcosimpy checks of the FMUs (run by tools/fmu/fmu_check.sh after the fmpy checks).
 
 usage: cosim_check.py SMALL.fmu WIRE.fmu
 

@@ -3,7 +3,7 @@
 1.0.0 on the oracle scenes of yarnsim's tests (hanging chain, cantilever,
 heavy-rope capstan) and the reference bundle.
 
-    bash tools/peers/setup.sh && tools/peers/.venv/bin/python tools/peers/bench.py
+    bash tools/bench/peers/setup.sh && tools/bench/peers/.venv/bin/python tools/bench/peers/bench.py
         [--quick] [--rounds 3] [--out docs/performance] [--skip-bundle]
 
 Every run is one thread (NUMBA_NUM_THREADS, OMP_NUM_THREADS and

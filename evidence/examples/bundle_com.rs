@@ -4,7 +4,7 @@
 //! impact"):
 //!
 //! ```text
-//! cargo run --release --example bundle_com -- DT [apic]
+//! cargo run --release -p yarnsim-evidence --example bundle_com -- DT [apic]
 //! ```
 //!
 //! `DT` is a number (s) or `auto`. Prints one line.

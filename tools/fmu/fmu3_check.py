@@ -1,4 +1,4 @@
-"""fmpy checks of the FMI 3.0 YarnBundle and MassSpring FMUs (run by tools/fmu_check.sh).
+"""fmpy checks of the FMI 3.0 YarnBundle and MassSpring FMUs (run by tools/fmu/fmu_check.sh).
 
 usage: fmu3_check.py WORKDIR REPLAY_EXE SMALL_SCENE SMALL3.fmu SMALL2.fmu REF3.fmu REF2.fmu WIRE3.fmu WIRE2.fmu DRIVEN3.fmu DRIVEN2.fmu
 

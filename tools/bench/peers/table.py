@@ -1,8 +1,8 @@
 #!/usr/bin/env python3
 """The benchmark's CSV as Markdown tables.
 
-    python3 tools/peers/table.py [docs/performance/peers.csv]          # docs/performance/peers.md, "Run of 2026-12-05"
-    python3 tools/peers/table.py --at-peer-error [CSV]                 # the goals' comparison
+    python3 tools/bench/peers/table.py [docs/performance/peers.csv]          # docs/performance/peers.md, "Run of 2026-12-05"
+    python3 tools/bench/peers/table.py --at-peer-error [CSV]                 # the goals' comparison
 
 `--at-peer-error`: for every peer row of a single-yarn case (chain,
 cantilever, capstan), the cheapest row of yarnsim's implicit integrators

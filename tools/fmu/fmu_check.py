@@ -1,4 +1,4 @@
-"""fmpy checks of the YarnBundle and MassSpring FMUs (run by tools/fmu_check.sh).
+"""fmpy checks of the YarnBundle and MassSpring FMUs (run by tools/fmu/fmu_check.sh).
 
 usage: fmu_check.py SMALL.fmu REFERENCE_SCENE.fmu WORKDIR REPLAY_EXE SMALL_SCENE WIRE.fmu DRIVEN.fmu DRIVEN_SCENE
 

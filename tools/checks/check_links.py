@@ -10,9 +10,9 @@ to repeated slugs. External links (`https:`, `mailto:`, ...) are not
 checked. Links inside code blocks and code spans are not links.
 
 Usage:
-    python3 tools/check_links.py              # every tracked *.md file
-    python3 tools/check_links.py FILE.md ...  # only these files
-    python3 tools/check_links.py --self-test  # the checker's own tests
+    python3 tools/checks/check_links.py              # every tracked *.md file
+    python3 tools/checks/check_links.py FILE.md ...  # only these files
+    python3 tools/checks/check_links.py --self-test  # the checker's own tests
 
 Python 3.11, standard library only.
 """
@@ -240,7 +240,7 @@ def self_test() -> int:
 
 
 def main(argv: list[str]) -> int:
-    root = Path(__file__).resolve().parent.parent
+    root = Path(__file__).resolve().parents[2]
     if argv[1:] == ["--self-test"]:
         return self_test()
     if any(a.startswith("-") for a in argv[1:]):

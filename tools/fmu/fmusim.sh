@@ -3,9 +3,9 @@
 # Modelica Association's Reference-FMUs at commit c8d4e6d (the last one that
 # has it; it was removed on 2026-07-09), built here without CMake from that
 # commit's own sources, then run on each FMU beside fmpy
-# (tools/fmusim_check.py compares every output of every row).
+# (tools/fmu/fmusim_check.py compares every output of every row).
 #
-# usage: tools/fmusim.sh [--reference-fmus DIR] [FMU ...]
+# usage: tools/fmu/fmusim.sh [--reference-fmus DIR] [FMU ...]
 #   DIR   a local clone of https://github.com/modelica/Reference-FMUs that
 #         holds c8d4e6d (default: $REFERENCE_FMUS, else a fresh clone into
 #         target/fmusim/Reference-FMUs, which needs the network)
@@ -24,7 +24,7 @@
 #   only Model Exchange, which these FMUs do not have);
 # - no source file is changed.
 set -euo pipefail
-cd "$(dirname "$0")/.."
+cd "$(dirname "$0")/../.."
 commit=c8d4e6d
 ref=${REFERENCE_FMUS:-}
 if [ "${1:-}" = "--reference-fmus" ]; then
@@ -98,4 +98,4 @@ if ! "$venv/bin/python" -c 'import fmpy; assert fmpy.__version__ == "0.3.32"' 2>
 fi
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
-"$venv/bin/python" tools/fmusim_check.py "$out/fmusim" "$work" "$@"
+"$venv/bin/python" tools/fmu/fmusim_check.py "$out/fmusim" "$work" "$@"

@@ -16,7 +16,7 @@ BUNDLE = dict(
     cylinders=[(0.25, 0.6), (0.5, 0.3), (0.75, 0.5)], cyl_radius=0.08, cyl_friction=0.3,
     box=(0.0, 1.0),
     # end of the first timed window (s): the fall and the landing on the top
-    # circle (about 0.1 s); `BUNDLE_LANDED` in examples/peers_chain.rs
+    # circle (about 0.1 s); `BUNDLE_LANDED` in evidence/examples/peers_chain.rs
     landed=0.2,
 )
 

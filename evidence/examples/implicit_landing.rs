@@ -6,7 +6,7 @@
 //! kinetic, elastic, potential and total energy, the stretch range.
 //!
 //! ```text
-//! cargo run --release --example implicit_landing -- K [DURATION] [SAFETY|-] [FRICTION]
+//! cargo run --release -p yarnsim-evidence --example implicit_landing -- K [DURATION] [SAFETY|-] [FRICTION]
 //! ```
 
 use yarnsim::testing::implicit_landing_scene;

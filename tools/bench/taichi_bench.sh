@@ -1,9 +1,9 @@
 #!/usr/bin/env bash
 # yarnsim bench against the reference Taichi implementation of Jiang et al. 2017, alternating
-# (tools/taichi_bench.py; see "Against the reference Taichi implementation"
+# (tools/bench/taichi_bench.py; see "Against the reference Taichi implementation"
 # in docs/performance/throughput.md).
-# Usage: tools/taichi_bench.sh REFERENCE_FILE [--yarnsim BIN] [--threads 1,2] [--rounds 3] ...
-# Installs Taichi 1.7.4 into tools/.venv-taichi on first use. Does not build
+# Usage: tools/bench/taichi_bench.sh REFERENCE_FILE [--yarnsim BIN] [--threads 1,2] [--rounds 3] ...
+# Installs Taichi 1.7.4 into tools/bench/.venv-taichi on first use. Does not build
 # yarnsim: it uses target/release/yarnsim unless --yarnsim is given.
 set -euo pipefail
 here=$(cd "$(dirname "$0")" && pwd)

@@ -1,13 +1,13 @@
 //! yarnsim's entry of the rod benchmark against MuJoCo and PyElastica
-//! (`tools/peers/bench.py`): the oracle scenes of `tests/yarn_oracles.rs`
+//! (`tools/bench/peers/bench.py`): the oracle scenes of `tests/yarn_oracles.rs`
 //! run through the library, timing the stepping loop only, one JSON line
 //! on stdout per run.
 //!
 //! ```text
-//! cargo run --release --example peers_chain -- chain VERTICES GRID DT [INTEGRATOR [K]]
-//! cargo run --release --example peers_chain -- cantilever VERTICES [INTEGRATOR [DT]]
-//! cargo run --release --example peers_chain -- capstan R L1 L2 MU [INTEGRATOR [DT]]
-//! cargo run --release --example peers_chain -- bundle DURATION [INTEGRATOR [DT]]
+//! cargo run --release -p yarnsim-evidence --example peers_chain -- chain VERTICES GRID DT [INTEGRATOR [K]]
+//! cargo run --release -p yarnsim-evidence --example peers_chain -- cantilever VERTICES [INTEGRATOR [DT]]
+//! cargo run --release -p yarnsim-evidence --example peers_chain -- capstan R L1 L2 MU [INTEGRATOR [DT]]
+//! cargo run --release -p yarnsim-evidence --example peers_chain -- bundle DURATION [INTEGRATOR [DT]]
 //! ```
 //!
 //! `INTEGRATOR` is `explicit` (the default) or `implicit` (the scene's
@@ -234,7 +234,7 @@ fn capstan(r: f64, l1: f64, l2: f64, mu: f64, integ: Integrator, dt: Option<f64>
 
 /// The end of the bundle's first timed window (s): it falls, lands on the
 /// top circle at about 0.1 s and settles into the drape by then
-/// (`BUNDLE["landed"]` in `tools/peers/oracles.py`).
+/// (`BUNDLE["landed"]` in `tools/bench/peers/oracles.py`).
 const BUNDLE_LANDED: f64 = 0.2;
 
 fn bundle(duration: f64, integ: Integrator, dt: Option<&str>) -> String {

@@ -1,5 +1,5 @@
 """yarnsim entry: the oracle scenes of `tests/yarn_oracles.rs` through the
-release example `examples/peers_chain.rs` (one JSON line per run; it times
+release example `evidence/examples/peers_chain.rs` (one JSON line per run; it times
 the stepping loop only), one thread (RAYON_NUM_THREADS=1), under the
 explicit or the implicit integrator (`[time] integrator`); a scene the
 implicit integrator refuses comes back as `ok` false with the refusal in
@@ -9,12 +9,12 @@ import json
 import os
 import subprocess
 
-ROOT = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", ".."))
+ROOT = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", "..", ".."))
 BIN = os.path.join(ROOT, "target", "release", "examples", "peers_chain")
 
 
 def build():
-    subprocess.run(["cargo", "build", "--release", "--example", "peers_chain"], cwd=ROOT,
+    subprocess.run(["cargo", "build", "--release", "-p", "yarnsim-evidence", "--example", "peers_chain"], cwd=ROOT,
                    check=True)
 
 

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
-# Creates tools/peers/.venv with the pinned peers of the rod benchmark
+# Creates tools/bench/peers/.venv with the pinned peers of the rod benchmark
 # (MuJoCo 4.0.0, PyElastica 1.0.0, numpy) and builds yarnsim's entry
-# (examples/peers_chain.rs). Idempotent: does nothing when the pinned
+# (evidence/examples/peers_chain.rs). Idempotent: does nothing when the pinned
 # versions are installed (then it needs no network).
 set -euo pipefail
 here=$(cd "$(dirname "$0")" && pwd)
@@ -15,5 +15,5 @@ if ! "$venv/bin/python" -c "$want" 2>/dev/null; then
     "$venv/bin/pip" install --quiet mujoco==4.0.0 pyelastica==1.0.0 numpy
     "$venv/bin/python" -c "$want"
 fi
-(cd "$here/../.." && cargo build --release --example peers_chain)
+(cd "$here/../../.." && cargo build --release -p yarnsim-evidence --example peers_chain)
 echo "peers ready: $venv/bin/python $here/bench.py"

@@ -1,5 +1,5 @@
 """The documented fmpy recipes for refused inputs and diverged steps, run as
-they stand in the docs (run by tools/fmu_check.sh).
+they stand in the docs (run by tools/fmu/fmu_check.sh).
 
 usage: fmu_errors.py SMALL.fmu SMALL-fmi3.fmu
 
@@ -26,7 +26,7 @@ from fmpy.fmi2 import FMU2Slave
 from fmu_inputs import finish
 
 small_fmu, small_fmu3 = sys.argv[1:3]
-root = pathlib.Path(__file__).resolve().parent.parent
+root = pathlib.Path(__file__).resolve().parents[2]
 failures = []
 
 

@@ -4,8 +4,8 @@
 //! solver's counts (cutbacks included), then the state at the end.
 //!
 //! ```text
-//! cargo run --release --example reference_implicit -- DT [fixed|auto] T [EVERY]
-//! cargo run --release --example reference_implicit -- 1e-3 fixed 1.0 50
+//! cargo run --release -p yarnsim-evidence --example reference_implicit -- DT [fixed|auto] T [EVERY]
+//! cargo run --release -p yarnsim-evidence --example reference_implicit -- 1e-3 fixed 1.0 50
 //! ```
 //! `auto`: `dt = "auto"` with `dt_max = DT`. `EXPLICIT=1` in the
 //! environment runs the explicit integrator instead (for the comparison;

@@ -23,8 +23,8 @@ module has a rank, and a child may name only children of a lower rank
 missing from the table is an error too. `src/mpm`: the machinery below the
 laws, the laws below the integrators, the integrators below the driver.
 
-Usage: tools/check_modules.py [CRATE_SRC ...]   (default: every crate's src/)
-       tools/check_modules.py --self-test
+Usage: tools/checks/check_modules.py [CRATE_SRC ...]   (default: every crate's src/)
+       tools/checks/check_modules.py --self-test
 Prints each circle as `crate folder: a -> b -> a`, each sibling import as
 `file: names ...`, each import against the layers as `folder: a -> b (layer
 ...)`, and exits 1 if any.
@@ -33,7 +33,7 @@ import re
 import sys
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parent.parent
+ROOT = Path(__file__).resolve().parents[2]
 CRATES = ["src", "cli/src", "evidence/src", "fmu/src", "fmu-pack/src"]
 IDENT = r"[A-Za-z_][A-Za-z0-9_]*"
 
