@@ -16,7 +16,6 @@
 
 pub mod massspring;
 pub mod math;
-#[allow(missing_docs)] // documented by the mpm restructuring
 pub mod mpm;
 pub mod pool;
 pub mod scene;
