@@ -6,6 +6,7 @@ use yarnsim::scene::{
     AttractorSpec, GridSpec, Integrator, Material, Obstacle, PinMotionKind, PinSpec, StepSize,
     TimeSpec, TransferScheme, TransferSpec, WallMode, Walls, YarnEnd, YarnScene, YarnSpec,
 };
+use yarnsim::testing::Capstan;
 use yarnsim::YarnSim;
 
 /// A small deterministic generator (xorshift64*), so tests need no `rand`.
@@ -333,4 +334,70 @@ pub fn capstan_threshold(r: f64, l1: f64, l2: f64) -> f64 {
         }
     }
     0.5 * (lo + hi)
+}
+
+/// The capstan oracles' material, that of every built-in scene
+/// (`reference_material`) without its bending: k = 1000, gamma = 500,
+/// E = 1000, fibre friction 0.05, plasticity on; at the test resolution
+/// 128^2, dt 1e-4, and g = 2 m/s^2 as for the string: the elastic stretch
+/// of the wrapped arc under g = 9.8 (T pi R / k = 9e-4 m at l2 = 0.3) is
+/// 0.9 % of l1, and its undamped oscillation alone reads as a slip
+/// (measured: R 0.1, l2 / l1 = 2 then crosses at +18 %, the other five
+/// cases at +9.4 %).
+pub const CAPSTAN_BUILTIN: Capstan = Capstan {
+    res: 128,
+    dt: 1e-4,
+    g: 2.0,
+    gamma: 500.0,
+    youngs_modulus: 1000.0,
+    friction: 0.05,
+    bending: 0.0,
+    plasticity: true,
+};
+
+/// [`CAPSTAN_BUILTIN`] at the resolution of the built-in scenes, 256^2,
+/// dt 4e-5.
+pub const CAPSTAN_BUILTIN_256: Capstan = Capstan {
+    res: 256,
+    dt: 4e-5,
+    ..CAPSTAN_BUILTIN
+};
+
+/// Time the capstan runs load before the slip is measured: the yarn starts
+/// unstretched at rest, and until the tension wave has loaded it (a few
+/// 0.01 s) the friction that needs that tension is missing and it slips
+/// by up to about 1e-3 m even far above the threshold.
+pub const CAPSTAN_LOAD: f64 = 0.2;
+
+/// Runs a capstan scene's `sim` for [`CAPSTAN_LOAD`] and then up to 1 s
+/// more; returns whether it slid in that second (a free end of hanging
+/// length `l1` or `l2` moved vertically by more than 0.5 % of it; the
+/// lateral pendulum swing of the hanging strands that the loading excites
+/// is not a slip) and the largest relative vertical end displacement.
+/// Stops as soon as it slid. Every 5 ms (and at the end) `at_check` sees
+/// the simulation, before the slip test.
+pub fn capstan_slip(
+    sim: &mut YarnSim,
+    l1: f64,
+    l2: f64,
+    mut at_check: impl FnMut(&YarnSim),
+) -> (bool, f64) {
+    sim.advance(CAPSTAN_LOAD).unwrap();
+    let (a0, b0) = sim.yarn_endpoints(0);
+    let steps = (1.0 / sim.dt()).round() as u64;
+    let check = (5e-3 / sim.dt()).round().max(1.0) as u64;
+    let mut worst: f64 = 0.0;
+    for k in 0..steps {
+        sim.step().unwrap();
+        if k % check == check - 1 || k + 1 == steps {
+            let (a, b) = sim.yarn_endpoints(0);
+            let rel = ((a.y - a0.y).abs() / l1).max((b.y - b0.y).abs() / l2);
+            worst = worst.max(rel);
+            at_check(sim);
+            if rel > 0.005 {
+                return (true, rel);
+            }
+        }
+    }
+    (false, worst)
 }
