@@ -4,7 +4,7 @@
 
 mod common;
 
-use common::{straight, SceneBuilder};
+use common::straight_yarn_sim;
 use yarnsim::massspring::{scenes, Integrator, IntegratorOptions, MassSpringError, Simulation};
 use yarnsim::math::{Mat2, Vec2};
 use yarnsim::mpm::laws::constitutive::{frame_gradient, YarnEnergy};
@@ -82,10 +82,7 @@ fn total_energy(sim: &YarnSim) -> f64 {
 
 #[test]
 fn yarn_stretched_to_three_times_its_length_snaps_back() {
-    let sc = SceneBuilder::bare()
-        .yarn(straight([0.4, 0.5], [0.6, 0.5], 30))
-        .build();
-    let mut sim = YarnSim::new(&sc).unwrap();
+    let mut sim = straight_yarn_sim([0.4, 0.5], [0.6, 0.5], 30);
     let l_rest: f64 = sim.stretches().iter().sum::<f64>();
     {
         let p = yarnsim::testing::particles_mut(&mut sim);

@@ -389,15 +389,8 @@ fn free_fall_beside_obstacles_and_walls_is_exact() {
         .build();
     let dt = 1e-3;
     let mut sim = YarnSim::new(&with_integrator(s, Integrator::Implicit, dt)).unwrap();
-    let c0 = sim.diagnostics().center_of_mass;
-    let n = 150u64;
-    sim.steps_n(n).unwrap();
-    let (expected, v) = common::grid_free_fall(c0, Vec2::new(0.5, -9.8), dt, n);
-    let d = sim.diagnostics();
-    // tolerance 1e-12 m, 1e-11 m/s (round-off over 150 substeps)
-    let err = (d.center_of_mass - expected).norm();
-    assert!(err < 1e-12, "centre of mass off by {err:.3e} m");
-    assert!((d.momentum / d.total_mass - v).norm() < 1e-11);
+    // round-off over 150 substeps
+    common::assert_grid_free_fall(&mut sim, Vec2::new(0.5, -9.8), dt, 150, None);
 }
 
 // ---- driven pin ------------------------------------------------------------

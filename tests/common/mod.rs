@@ -148,6 +148,17 @@ pub fn pin_vertex(yarn: u32, vertex: u32, count: u32) -> PinSpec {
     }
 }
 
+/// A simulation of the bare scene ([`SceneBuilder::bare`]) with one
+/// straight yarn.
+pub fn straight_yarn_sim(start: [f64; 2], end: [f64; 2], vertices: u32) -> YarnSim {
+    YarnSim::new(
+        &SceneBuilder::bare()
+            .yarn(straight(start, end, vertices))
+            .build(),
+    )
+    .unwrap()
+}
+
 /// Test scenes without TOML text: [`SceneBuilder::bare`] and the settings
 /// tests vary; [`SceneBuilder::build`] validates like the scene loader.
 #[derive(Clone, Debug)]
@@ -296,6 +307,31 @@ pub fn grid_free_fall(c0: Vec2, g: Vec2, dt: f64, n: u64) -> (Vec2, Vec2) {
         c0 + g * (dt * dt * (n * (n + 1)) as f64 / 2.0),
         g * (n as f64 * dt),
     )
+}
+
+/// Steps `sim`, at rest, `n` substeps of `dt` under `g` and asserts the
+/// grid scheme's free fall ([`grid_free_fall`]) to round-off: the centre of
+/// mass within 1e-12 m, the mean velocity within 1e-11 m/s, and with
+/// `stretch_tol` every stretch within it of 1.
+pub fn assert_grid_free_fall(
+    sim: &mut YarnSim,
+    g: Vec2,
+    dt: f64,
+    n: u64,
+    stretch_tol: Option<f64>,
+) {
+    let c0 = sim.diagnostics().center_of_mass;
+    sim.steps_n(n).unwrap();
+    let (expected, v) = grid_free_fall(c0, g, dt, n);
+    let d = sim.diagnostics();
+    let err = (d.center_of_mass - expected).norm();
+    assert!(err < 1e-12, "centre of mass off by {err:.3e} m");
+    assert!((d.momentum / d.total_mass - v).norm() < 1e-11);
+    if let Some(tol) = stretch_tol {
+        for st in sim.stretches() {
+            assert!((st - 1.0).abs() < tol, "stretch {st}");
+        }
+    }
 }
 
 /// Heavy-rope capstan: tension at the heavy end of the wrapped half circle
