@@ -1,6 +1,7 @@
 //! Shared helpers of the integration tests.
 #![allow(dead_code)]
 
+use yarnsim::massspring::{Integrator as MassSpringIntegrator, IntegratorOptions};
 use yarnsim::math::Vec2;
 use yarnsim::scene::{
     AttractorSpec, GridSpec, Integrator, Material, Obstacle, PinMotionKind, PinSpec, StepSize,
@@ -436,4 +437,25 @@ pub fn capstan_slip(
         }
     }
     (false, worst)
+}
+
+/// Mass-spring integrator options that solve each step to `cg_tolerance`
+/// at the fixed step `h`; Chebyshev-Jacobi gets `chebyshev_iterations`
+/// iterations at rho 0.9, so that its minimisation converges too.
+pub fn solved_options(
+    integ: MassSpringIntegrator,
+    h: f64,
+    cg_tolerance: f64,
+    chebyshev_iterations: usize,
+) -> IntegratorOptions {
+    let mut o = IntegratorOptions {
+        dt: Some(h),
+        cg_tolerance,
+        ..Default::default()
+    };
+    if integ == MassSpringIntegrator::ChebyshevJacobi {
+        o.iterations = chebyshev_iterations;
+        o.rho = 0.9;
+    }
+    o
 }
