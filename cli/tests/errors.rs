@@ -6,7 +6,7 @@
 
 mod common;
 
-use common::{small_scene, stderr, stdout, tmp, yarnsim};
+use common::{on_small_scene, small_scene, stderr, stdout, tmp, yarnsim};
 use yarnsim::scene::{Scene, YarnScene};
 use yarnsim::YarnSim;
 
@@ -144,14 +144,7 @@ fn a_fixed_dt_a_little_above_the_bound_is_warned_about() {
     };
     let bound = YarnSim::new(&s).unwrap().stable_dt();
     assert!((dt / bound - 1.3).abs() < 1e-9, "{}", dt / bound);
-    let out = yarnsim(&[
-        "run",
-        small_scene().to_str().unwrap(),
-        "-d",
-        "2ms",
-        "--set",
-        &set,
-    ]);
+    let out = on_small_scene("run", &["-d", "2ms", "--set", &set]);
     assert!(out.status.success(), "{}", stderr(&out));
     assert_eq!(
         stderr(&out),
