@@ -116,10 +116,6 @@ fn grid_forces_are_minus_the_energy_gradient() {
     );
 }
 
-fn com(sim: &YarnSim) -> Vec2 {
-    sim.diagnostics().center_of_mass
-}
-
 #[test]
 fn free_fall_follows_the_schemes_trajectory() {
     let scene = SceneBuilder::bare()
@@ -136,39 +132,9 @@ fn free_fall_follows_the_schemes_trajectory() {
 
 #[test]
 fn linear_momentum_is_conserved_and_angular_drift_is_small() {
-    let scene = SceneBuilder::bare()
-        .yarn(bundle([0.3, 0.5], [0.7, 0.52], 80, 3, [0.0, 0.012]))
-        .yarn(straight([0.48, 0.3], [0.52, 0.7], 80))
-        .build();
-    let mut sim = YarnSim::new(&scene).unwrap();
-    // spin the bundle rigidly about its centre of mass (velocity gradient
-    // C = omega [[0, -1], [1, 0]]), and add a drift
-    let c = com(&sim);
-    let omega = 4.0;
-    let spin = Mat2::new(0.0, -omega, omega, 0.0);
-    {
-        let p = yarnsim::testing::particles_mut(&mut sim);
-        for ((x, v), cm) in p
-            .vert
-            .x
-            .iter()
-            .zip(p.vert.v.iter_mut())
-            .zip(p.vert.c.iter_mut())
-        {
-            *v = perp(x - c) * omega + Vec2::new(0.3, -0.2);
-            *cm = spin;
-        }
-        for ((x, v), cm) in p
-            .quad
-            .x
-            .iter()
-            .zip(p.quad.v.iter_mut())
-            .zip(p.quad.c.iter_mut())
-        {
-            *v = perp(x - c) * omega + Vec2::new(0.3, -0.2);
-            *cm = spin;
-        }
-    }
+    // the bundle spun rigidly about its centre of mass (velocity gradient
+    // C = omega [[0, -1], [1, 0]]) with a drift
+    let mut sim = common::spinning_bundle(4.0, Vec2::new(0.3, -0.2));
     let d0 = sim.diagnostics();
     let scale = momentum_scale(&sim);
     sim.steps_n(1000).unwrap();

@@ -7,7 +7,7 @@
 mod common;
 
 use common::{capstan_slip, capstan_threshold, scene, CAPSTAN_BUILTIN, CAPSTAN_BUILTIN_256};
-use yarnsim::math::{perp, Mat2, Vec2};
+use yarnsim::math::Vec2;
 use yarnsim::scene::{SceneError, TransferScheme, WallMode, YarnScene};
 use yarnsim::testing::{
     cantilever_setup, cantilever_toml, capstan_toml, hanging_chain_period, hanging_chain_toml,
@@ -367,40 +367,6 @@ fn hanging_chain(dt: &str) -> u64 {
 
 // ---- conservation -----------------------------------------------------------
 
-/// A bundle of 3 + 1 crossing yarns on 64^2 without gravity, walls or
-/// obstacles (the scene of `mpm_physics`), turned rigidly at `omega` about
-/// its centre of mass (v = omega perp(x - c), C = [[0, -omega], [omega, 0]])
-/// plus a drift `drift`.
-fn spinning_bundle(omega: f64, drift: Vec2) -> YarnSim {
-    let s = common::bare_scene(
-        r#"
-[[yarns]]
-start = [0.3, 0.5]
-end = [0.7, 0.52]
-vertices = 80
-count = 3
-spacing = [0.0, 0.012]
-[[yarns]]
-start = [0.48, 0.3]
-end = [0.52, 0.7]
-vertices = 80
-"#,
-    );
-    let mut sim = YarnSim::new(&s).unwrap();
-    let c = sim.diagnostics().center_of_mass;
-    let spin = Mat2::new(0.0, -omega, omega, 0.0);
-    let p = yarnsim::testing::particles_mut(&mut sim);
-    for k in 0..p.vert.x.len() {
-        p.vert.v[k] = perp(p.vert.x[k] - c) * omega + drift;
-        p.vert.c[k] = spin;
-    }
-    for k in 0..p.quad.x.len() {
-        p.quad.v[k] = perp(p.quad.x[k] - c) * omega + drift;
-        p.quad.c[k] = spin;
-    }
-    sim
-}
-
 #[test]
 #[cfg_attr(debug_assertions, ignore = "release-mode test (cargo test --release)")]
 fn momenta_are_kept_under_flip() {
@@ -408,7 +374,7 @@ fn momenta_are_kept_under_flip() {
     // (centre of mass to 1e-12 m after 1500 substeps). Here: linear momentum
     // of a deforming bundle with internal forces only, and the angular
     // momentum of a rigidly spinning one, under the default FLIP (ratio 1).
-    let mut sim = spinning_bundle(4.0, Vec2::new(0.3, -0.2));
+    let mut sim = common::spinning_bundle(4.0, Vec2::new(0.3, -0.2));
     assert_eq!(sim.transfer(), yarnsim::mpm::Transfer::Flip { ratio: 1.0 });
     let d0 = sim.diagnostics();
     let scale = common::momentum_scale(&sim);

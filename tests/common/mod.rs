@@ -2,7 +2,7 @@
 #![allow(dead_code)]
 
 use yarnsim::massspring::{Integrator as MassSpringIntegrator, IntegratorOptions};
-use yarnsim::math::Vec2;
+use yarnsim::math::{perp, Mat2, Vec2};
 use yarnsim::scene::{
     AttractorSpec, GridSpec, Integrator, Material, Obstacle, PinMotionKind, PinSpec, StepSize,
     TimeSpec, TransferScheme, TransferSpec, WallMode, Walls, YarnEnd, YarnScene, YarnSpec,
@@ -308,6 +308,30 @@ pub fn grid_free_fall(c0: Vec2, g: Vec2, dt: f64, n: u64) -> (Vec2, Vec2) {
         c0 + g * (dt * dt * (n * (n + 1)) as f64 / 2.0),
         g * (n as f64 * dt),
     )
+}
+
+/// A bundle of 3 + 1 crossing yarns on the bare scene (64^2, without
+/// gravity, walls or obstacles), turned rigidly at `omega` about its centre
+/// of mass (v = omega perp(x - c), C = [[0, -omega], [omega, 0]]) plus a
+/// drift `drift`.
+pub fn spinning_bundle(omega: f64, drift: Vec2) -> YarnSim {
+    let s = SceneBuilder::bare()
+        .yarn(bundle([0.3, 0.5], [0.7, 0.52], 80, 3, [0.0, 0.012]))
+        .yarn(straight([0.48, 0.3], [0.52, 0.7], 80))
+        .build();
+    let mut sim = YarnSim::new(&s).unwrap();
+    let c = sim.diagnostics().center_of_mass;
+    let spin = Mat2::new(0.0, -omega, omega, 0.0);
+    let p = yarnsim::testing::particles_mut(&mut sim);
+    for k in 0..p.vert.x.len() {
+        p.vert.v[k] = perp(p.vert.x[k] - c) * omega + drift;
+        p.vert.c[k] = spin;
+    }
+    for k in 0..p.quad.x.len() {
+        p.quad.v[k] = perp(p.quad.x[k] - c) * omega + drift;
+        p.quad.c[k] = spin;
+    }
+    sim
 }
 
 /// Steps `sim`, at rest, `n` substeps of `dt` under `g` and asserts the
