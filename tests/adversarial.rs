@@ -4,7 +4,7 @@
 
 mod common;
 
-use common::{straight, SceneBuilder};
+use common::straight_yarn_sim;
 use yarnsim::massspring::{scenes, Integrator, IntegratorOptions, MassSpringError, Simulation};
 use yarnsim::math::{Mat2, Vec2};
 use yarnsim::mpm::laws::constitutive::{frame_gradient, YarnEnergy};
@@ -82,10 +82,7 @@ fn total_energy(sim: &YarnSim) -> f64 {
 
 #[test]
 fn yarn_stretched_to_three_times_its_length_snaps_back() {
-    let sc = SceneBuilder::bare()
-        .yarn(straight([0.4, 0.5], [0.6, 0.5], 30))
-        .build();
-    let mut sim = YarnSim::new(&sc).unwrap();
+    let mut sim = straight_yarn_sim([0.4, 0.5], [0.6, 0.5], 30);
     let l_rest: f64 = sim.stretches().iter().sum::<f64>();
     {
         let p = yarnsim::testing::particles_mut(&mut sim);
@@ -372,28 +369,25 @@ fn cloth_stretched_ten_times_and_released(integ: Integrator) {
     }
 }
 
-#[test]
-fn cloth_stretched_ten_times_backward_euler() {
-    cloth_stretched_ten_times_and_released(Integrator::BackwardEuler);
+/// One test per integrator, each [`cloth_stretched_ten_times_and_released`]
+/// (`name: Integrator variant;`, attributes before the name).
+macro_rules! cloth_stretched_ten_times_tests {
+    ($($(#[$attr:meta])* $name:ident: $integ:ident;)*) => {
+        $(
+            #[test]
+            $(#[$attr])*
+            fn $name() {
+                cloth_stretched_ten_times_and_released(Integrator::$integ);
+            }
+        )*
+    };
 }
 
-#[test]
-fn cloth_stretched_ten_times_chebyshev_jacobi() {
-    cloth_stretched_ten_times_and_released(Integrator::ChebyshevJacobi);
-}
-
-#[test]
-fn cloth_stretched_ten_times_symplectic_euler() {
-    cloth_stretched_ten_times_and_released(Integrator::SymplecticEuler);
-}
-
-#[test]
-fn cloth_stretched_ten_times_pbd() {
-    cloth_stretched_ten_times_and_released(Integrator::Pbd);
-}
-
-#[test]
-#[ignore = "massspring (reported): trapezoidal at the cloth's h = 1/30 s gains energy on a 10x-stretched cloth (6.38e7 -> 6.90e7 J after 30 frames, +8%) and reports success; the stress study finds it stable on the cloth only up to dt ~ 0.020 s"]
-fn cloth_stretched_ten_times_trapezoidal() {
-    cloth_stretched_ten_times_and_released(Integrator::Trapezoidal);
+cloth_stretched_ten_times_tests! {
+    cloth_stretched_ten_times_backward_euler: BackwardEuler;
+    cloth_stretched_ten_times_chebyshev_jacobi: ChebyshevJacobi;
+    cloth_stretched_ten_times_symplectic_euler: SymplecticEuler;
+    cloth_stretched_ten_times_pbd: Pbd;
+    #[ignore = "massspring (reported): trapezoidal at the cloth's h = 1/30 s gains energy on a 10x-stretched cloth (6.38e7 -> 6.90e7 J after 30 frames, +8%) and reports success; the stress study finds it stable on the cloth only up to dt ~ 0.020 s"]
+    cloth_stretched_ten_times_trapezoidal: Trapezoidal;
 }

@@ -9,24 +9,11 @@
 
 mod common;
 
-use common::{capstan_threshold, scene};
+use common::{capstan_threshold, scene, CAPSTAN_BUILTIN_256};
 use yarnsim::math::Vec2;
 use yarnsim::scene::{StepSize, TransferScheme};
 use yarnsim::testing::{capstan_drop_toml, Capstan};
 use yarnsim::YarnSim;
-
-/// The built-in scenes' material without bending at 256^2, dt 4e-5, g 2
-/// (as `BUILTIN_256` of `tests/yarn_oracles.rs`).
-const BUILTIN_256: Capstan = Capstan {
-    res: 256,
-    dt: 4e-5,
-    g: 2.0,
-    gamma: 500.0,
-    youngs_modulus: 1000.0,
-    friction: 0.05,
-    bending: 0.0,
-    plasticity: true,
-};
 
 /// A pure string (no cross-section energy, no plasticity) at 256^2.
 const STRING_256: Capstan = Capstan {
@@ -34,7 +21,7 @@ const STRING_256: Capstan = Capstan {
     youngs_modulus: 0.0,
     friction: 0.0,
     plasticity: false,
-    ..BUILTIN_256
+    ..CAPSTAN_BUILTIN_256
 };
 
 /// One dropped-capstan run.
@@ -262,7 +249,7 @@ fn case(r: f64, ratio: f64, drop: f64, setup: Capstan, scheme: TransferScheme) -
 fn dropped_builtin_yarn_holds_above_and_slides_below_the_threshold() {
     let cases: Vec<Case> = [0.0, 3e-3, 10e-3]
         .iter()
-        .map(|&d| case(0.1, 3.0, d, BUILTIN_256, TransferScheme::Flip))
+        .map(|&d| case(0.1, 3.0, d, CAPSTAN_BUILTIN_256, TransferScheme::Flip))
         .collect();
     hold_and_slide(&cases);
 }
@@ -276,9 +263,9 @@ fn dropped_builtin_yarn_holds_above_and_slides_below_the_threshold() {
 fn dropped_yarn_holds_for_both_materials_radii_ratios_and_transfers() {
     hold_and_slide(&[
         case(0.05, 5.0, 3e-3, STRING_256, TransferScheme::Flip),
-        case(0.05, 3.0, 10e-3, BUILTIN_256, TransferScheme::Apic),
+        case(0.05, 3.0, 10e-3, CAPSTAN_BUILTIN_256, TransferScheme::Apic),
         case(0.1, 5.0, 10e-3, STRING_256, TransferScheme::Apic),
-        case(0.1, 3.0, 3e-3, BUILTIN_256, TransferScheme::Apic),
+        case(0.1, 3.0, 3e-3, CAPSTAN_BUILTIN_256, TransferScheme::Apic),
     ]);
 }
 
@@ -287,7 +274,7 @@ fn dropped_yarn_holds_for_both_materials_radii_ratios_and_transfers() {
 #[test]
 #[cfg_attr(debug_assertions, ignore = "release-mode test (cargo test --release)")]
 fn dropped_yarn_holds_from_the_stable_bound_to_an_eighth_of_it_and_at_512() {
-    let base = case(0.1, 3.0, 3e-3, BUILTIN_256, TransferScheme::Flip);
+    let base = case(0.1, 3.0, 3e-3, CAPSTAN_BUILTIN_256, TransferScheme::Flip);
     hold_and_slide(&[
         Case {
             of_bound: Some(1.0),
@@ -301,7 +288,7 @@ fn dropped_yarn_holds_from_the_stable_bound_to_an_eighth_of_it_and_at_512() {
             setup: Capstan {
                 res: 512,
                 dt: 2e-5,
-                ..BUILTIN_256
+                ..CAPSTAN_BUILTIN_256
             },
             ..base
         },
@@ -316,20 +303,32 @@ fn dropped_yarn_holds_from_the_stable_bound_to_an_eighth_of_it_and_at_512() {
 #[ignore = "sweep, run by hand: cargo test --release --test capstan_impact sweep -- --ignored --nocapture"]
 fn sweep() {
     let mut cases = Vec::new();
-    for setup in [BUILTIN_256, STRING_256] {
+    for setup in [CAPSTAN_BUILTIN_256, STRING_256] {
         for drop in [0.0, 1e-3, 2e-3, 3e-3, 5e-3, 10e-3] {
             cases.push(case(0.1, 3.0, drop, setup, TransferScheme::Flip));
         }
     }
     for drop in [0.0, 3e-3, 10e-3] {
-        cases.push(case(0.1, 3.0, drop, BUILTIN_256, TransferScheme::Apic));
+        cases.push(case(
+            0.1,
+            3.0,
+            drop,
+            CAPSTAN_BUILTIN_256,
+            TransferScheme::Apic,
+        ));
     }
     for drop in [3e-3, 10e-3] {
-        cases.push(case(0.05, 5.0, drop, BUILTIN_256, TransferScheme::Flip));
+        cases.push(case(
+            0.05,
+            5.0,
+            drop,
+            CAPSTAN_BUILTIN_256,
+            TransferScheme::Flip,
+        ));
     }
     cases.push(Case {
         kick: 0.05,
-        ..case(0.1, 3.0, 0.0, BUILTIN_256, TransferScheme::Flip)
+        ..case(0.1, 3.0, 0.0, CAPSTAN_BUILTIN_256, TransferScheme::Flip)
     });
     let mut all = Vec::new();
     for c in &cases {

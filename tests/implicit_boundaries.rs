@@ -13,7 +13,7 @@ mod common;
 
 use std::time::Instant;
 
-use common::{capstan_threshold, pin_end, straight, SceneBuilder};
+use common::{capstan_slip, capstan_threshold, pin_end, straight, SceneBuilder};
 use yarnsim::math::Vec2;
 use yarnsim::scene::{
     Integrator, Material, PinMotionKind, StepSize, TransferScheme, WallMode, YarnEnd, YarnScene,
@@ -45,16 +45,10 @@ fn iterations(sim: &YarnSim) -> (f64, f64) {
 
 // ---- capstan ---------------------------------------------------------------
 
-/// Load time before the slip is measured (as the explicit capstan oracle,
-/// tests/yarn_oracles.rs).
-const CAPSTAN_LOAD: f64 = 0.2;
-
 /// The capstan scene (`capstan_toml`) with the integrator and `setup.dt`;
-/// runs it for `CAPSTAN_LOAD` and up to 1 s more and returns whether it
-/// slid (a free end moved vertically by more than 0.5 % of its hanging
-/// length, the explicit oracle's criterion), the largest relative end
-/// displacement, the deepest particle inside the circle (m) and the wall
-/// time per substep.
+/// runs it as the explicit oracle does ([`common::capstan_slip`]) and
+/// returns whether it slid, the largest relative end displacement, the
+/// deepest particle inside the circle (m) and the wall time per substep.
 fn capstan_run(
     r: f64,
     l1: f64,
@@ -68,28 +62,13 @@ fn capstan_run(
     let mut sim = YarnSim::new(&s).unwrap();
     let c = Vec2::from(s.obstacles[0].center);
     let t0 = Instant::now();
-    sim.advance(CAPSTAN_LOAD).unwrap();
-    let (a0, b0) = sim.yarn_endpoints(0);
-    let steps = (1.0 / sim.dt()).round() as u64;
-    let check = (5e-3 / sim.dt()).round().max(1.0) as u64;
-    let (mut worst, mut depth): (f64, f64) = (0.0, 0.0);
-    let mut slid = false;
-    for k in 0..steps {
-        sim.step().unwrap();
-        if k % check == check - 1 || k + 1 == steps {
-            let (a, b) = sim.yarn_endpoints(0);
-            let rel = ((a.y - a0.y).abs() / l1).max((b.y - b0.y).abs() / l2);
-            worst = worst.max(rel);
-            let p = sim.particles();
-            for x in p.vert.x.iter().chain(&p.quad.x) {
-                depth = depth.max(r - (x - c).norm());
-            }
-            if rel > 0.005 {
-                slid = true;
-                break;
-            }
+    let mut depth: f64 = 0.0;
+    let (slid, worst) = capstan_slip(&mut sim, l1, l2, |sim| {
+        let p = sim.particles();
+        for x in p.vert.x.iter().chain(&p.quad.x) {
+            depth = depth.max(r - (x - c).norm());
         }
-    }
+    });
     let per_step = t0.elapsed().as_secs_f64() / sim.steps() as f64;
     (slid, worst, depth, per_step, iterations(&sim))
 }
@@ -410,15 +389,8 @@ fn free_fall_beside_obstacles_and_walls_is_exact() {
         .build();
     let dt = 1e-3;
     let mut sim = YarnSim::new(&with_integrator(s, Integrator::Implicit, dt)).unwrap();
-    let c0 = sim.diagnostics().center_of_mass;
-    let n = 150u64;
-    sim.steps_n(n).unwrap();
-    let (expected, v) = common::grid_free_fall(c0, Vec2::new(0.5, -9.8), dt, n);
-    let d = sim.diagnostics();
-    // tolerance 1e-12 m, 1e-11 m/s (round-off over 150 substeps)
-    let err = (d.center_of_mass - expected).norm();
-    assert!(err < 1e-12, "centre of mass off by {err:.3e} m");
-    assert!((d.momentum / d.total_mass - v).norm() < 1e-11);
+    // round-off over 150 substeps
+    common::assert_grid_free_fall(&mut sim, Vec2::new(0.5, -9.8), dt, 150, None);
 }
 
 // ---- driven pin ------------------------------------------------------------

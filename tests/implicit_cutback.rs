@@ -28,6 +28,23 @@ fn bits(sim: &YarnSim) -> String {
     format!("{:?}", sim.particles())
 }
 
+/// Asserts what the step control of `sim` did so far:
+/// `(cutbacks, undone, deepest_cut)`.
+fn assert_cuts(sim: &YarnSim, expected: (u64, u64, u32)) {
+    let st = sim.implicit_stats();
+    assert_eq!((st.cutbacks, st.undone, st.deepest_cut), expected, "{st:?}");
+}
+
+/// Steps `by_hand` (the state before `cut`'s cut substep) by two plain
+/// halves `step_dt(dt / 2)`, which must not cut, and asserts the same bits
+/// as `cut`.
+fn assert_equals_two_halves(cut: &YarnSim, by_hand: &mut YarnSim, dt: f64) {
+    by_hand.step_dt(0.5 * dt).unwrap();
+    by_hand.step_dt(0.5 * dt).unwrap();
+    assert_eq!(by_hand.implicit_stats().cutbacks, 0);
+    assert_eq!(bits(cut), bits(by_hand));
+}
+
 /// At dt 1e-2 the free-falling bundle passes one cell (dx / dt = 0.391
 /// m/s) in its 4th substep (v = 4 g dt = 0.392 m/s): that substep is cut
 /// once, into two of 5e-3 (limit 0.781 m/s), and its result is the same bits
@@ -45,20 +62,12 @@ fn the_substep_that_passes_a_cell_is_run_as_two_halves() {
     assert_eq!(cut.implicit_stats().cutbacks, 0);
 
     cut.step().unwrap();
-    let st = cut.implicit_stats();
     // cut before it was tried: (0.294 + 9.8 dt) dt = 3.92e-3 m > dx
-    assert_eq!(
-        (st.cutbacks, st.undone, st.deepest_cut),
-        (1, 0, 1),
-        "{st:?}"
-    );
+    assert_cuts(&cut, (1, 0, 1));
     assert_eq!(cut.steps(), k + 1, "two substeps for the cut one");
     assert!((cut.time() - 4e-2).abs() < 1e-15, "{}", cut.time());
 
-    by_hand.step_dt(0.5 * dt).unwrap();
-    by_hand.step_dt(0.5 * dt).unwrap();
-    assert_eq!(by_hand.implicit_stats().cutbacks, 0);
-    assert_eq!(bits(&cut), bits(&by_hand));
+    assert_equals_two_halves(&cut, &mut by_hand, dt);
     let vmax = cut
         .particles()
         .vert
@@ -87,17 +96,9 @@ fn a_substep_undone_after_a_vertex_passes_a_cell_equals_its_two_halves() {
     let mut cut = YarnSim::new(&s).unwrap();
     let mut by_hand = cut.clone();
     cut.step().unwrap();
-    let st = cut.implicit_stats();
-    assert_eq!(
-        (st.cutbacks, st.undone, st.deepest_cut),
-        (1, 1, 1),
-        "{st:?}"
-    );
+    assert_cuts(&cut, (1, 1, 1));
     assert_eq!((cut.steps(), cut.time()), (2, dt));
-    by_hand.step_dt(0.5 * dt).unwrap();
-    by_hand.step_dt(0.5 * dt).unwrap();
-    assert_eq!(by_hand.implicit_stats().cutbacks, 0);
-    assert_eq!(bits(&cut), bits(&by_hand));
+    assert_equals_two_halves(&cut, &mut by_hand, dt);
     assert_eq!(cut.pin_reactions(), by_hand.pin_reactions());
     let vmax = cut.max_speed();
     // past the full step's cell, within the halves'

@@ -1,6 +1,9 @@
 //! The cloth (Wang 2015; Müller et al. 2007; Provot 1995): sphere collision, strain limiting, pinned corners,
 //! free fall against each scheme's own analytic trajectory.
 
+mod common;
+
+use common::solved_options;
 use yarnsim::massspring::{
     scenes, Integrator, IntegratorOptions, MassSpringScene, Simulation, StrainSolver, V3,
 };
@@ -162,16 +165,8 @@ fn free_fall_matches_each_schemes_analytic_trajectory() {
     let (h, g, d) = (sys.time_step, 9.8, 0.99);
     let n = 20;
     for integ in Integrator::ALL {
-        let mut o = IntegratorOptions {
-            dt: Some(h),
-            cg_tolerance: 1e-13,
-            ..Default::default()
-        };
-        if integ == Integrator::ChebyshevJacobi {
-            // Solve the minimisation to convergence.
-            o.iterations = 3000;
-            o.rho = 0.9;
-        }
+        // Chebyshev-Jacobi: the minimisation solved to convergence.
+        let o = solved_options(integ, h, 1e-13, 3000);
         let mut sim = Simulation::new(&layout, integ, o).unwrap();
         for _ in 0..n {
             sim.step(h).unwrap();

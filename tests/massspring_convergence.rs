@@ -3,7 +3,10 @@
 //! schemes (forward, symplectic, backward, and backward Euler's
 //! minimisation form), 2 for the trapezoidal rule.
 
-use yarnsim::massspring::{scenes, Integrator, IntegratorOptions, MassSpringScene, Simulation, V3};
+mod common;
+
+use common::solved_options;
+use yarnsim::massspring::{scenes, Integrator, MassSpringScene, Simulation, V3};
 
 /// Baraff and Witkin 1998's three particles with damped springs (so the damping force
 /// and its Jacobian take part), in free flight under gravity.
@@ -17,17 +20,9 @@ fn damped_three_particle() -> MassSpringScene {
 
 /// Positions and velocities at `t_end` with step `h`.
 fn end_state(layout: &MassSpringScene, integ: Integrator, h: f64, t_end: f64) -> Vec<f64> {
-    let mut o = IntegratorOptions {
-        dt: Some(h),
-        cg_tolerance: 1e-14,
-        ..Default::default()
-    };
-    if integ == Integrator::ChebyshevJacobi {
-        // Solve each step's minimisation to round-off, so that the error
-        // is the scheme's and not the iteration's.
-        o.iterations = 4000;
-        o.rho = 0.9;
-    }
+    // Chebyshev-Jacobi: each step's minimisation solved to round-off, so
+    // that the error is the scheme's and not the iteration's.
+    let o = solved_options(integ, h, 1e-14, 4000);
     let mut sim = Simulation::new(layout, integ, o).unwrap();
     let n = sim.run_to(t_end).unwrap();
     assert!(

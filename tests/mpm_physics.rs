@@ -3,7 +3,9 @@
 
 mod common;
 
-use common::{bundle, momentum_scale, pin_end, polyline, straight, Rng, SceneBuilder};
+use common::{
+    bundle, momentum_scale, pin_end, polyline, straight, straight_yarn_sim, Rng, SceneBuilder,
+};
 use yarnsim::math::{perp, Mat2, Vec2};
 use yarnsim::testing::internals::{self as grid, quad_stress, scatter, Grid};
 
@@ -114,10 +116,6 @@ fn grid_forces_are_minus_the_energy_gradient() {
     );
 }
 
-fn com(sim: &YarnSim) -> Vec2 {
-    sim.diagnostics().center_of_mass
-}
-
 #[test]
 fn free_fall_follows_the_schemes_trajectory() {
     let scene = SceneBuilder::bare()
@@ -128,55 +126,15 @@ fn free_fall_follows_the_schemes_trajectory() {
     let mut sim = YarnSim::new(&scene).unwrap();
     let g = Vec2::from(scene.gravity);
     let dt = sim.dt();
-    let c0 = com(&sim);
-    let n = 1500u64;
-    sim.steps_n(n).unwrap();
     // symplectic Euler on the grid: v_n = n dt g, x_n = x_0 + dt^2 g n (n + 1) / 2
-    let (expected, v) = common::grid_free_fall(c0, g, dt, n);
-    let err = (com(&sim) - expected).norm();
-    assert!(err < 1e-12, "centre of mass off by {err:.3e} m");
-    let d = sim.diagnostics();
-    assert!((d.momentum / d.total_mass - v).norm() < 1e-11);
-    for s in sim.stretches() {
-        assert!((s - 1.0).abs() < 1e-5, "stretch {s}");
-    }
+    common::assert_grid_free_fall(&mut sim, g, dt, 1500, Some(1e-5));
 }
 
 #[test]
 fn linear_momentum_is_conserved_and_angular_drift_is_small() {
-    let scene = SceneBuilder::bare()
-        .yarn(bundle([0.3, 0.5], [0.7, 0.52], 80, 3, [0.0, 0.012]))
-        .yarn(straight([0.48, 0.3], [0.52, 0.7], 80))
-        .build();
-    let mut sim = YarnSim::new(&scene).unwrap();
-    // spin the bundle rigidly about its centre of mass (velocity gradient
-    // C = omega [[0, -1], [1, 0]]), and add a drift
-    let c = com(&sim);
-    let omega = 4.0;
-    let spin = Mat2::new(0.0, -omega, omega, 0.0);
-    {
-        let p = yarnsim::testing::particles_mut(&mut sim);
-        for ((x, v), cm) in p
-            .vert
-            .x
-            .iter()
-            .zip(p.vert.v.iter_mut())
-            .zip(p.vert.c.iter_mut())
-        {
-            *v = perp(x - c) * omega + Vec2::new(0.3, -0.2);
-            *cm = spin;
-        }
-        for ((x, v), cm) in p
-            .quad
-            .x
-            .iter()
-            .zip(p.quad.v.iter_mut())
-            .zip(p.quad.c.iter_mut())
-        {
-            *v = perp(x - c) * omega + Vec2::new(0.3, -0.2);
-            *cm = spin;
-        }
-    }
+    // the bundle spun rigidly about its centre of mass (velocity gradient
+    // C = omega [[0, -1], [1, 0]]) with a drift
+    let mut sim = common::spinning_bundle(4.0, Vec2::new(0.3, -0.2));
     let d0 = sim.diagnostics();
     let scale = momentum_scale(&sim);
     sim.steps_n(1000).unwrap();
@@ -269,10 +227,7 @@ fn two_runs_give_identical_bits() {
 
 #[test]
 fn state_round_trip_reproduces_the_run() {
-    let scene = SceneBuilder::bare()
-        .yarn(straight([0.2, 0.6], [0.8, 0.65], 60))
-        .build();
-    let mut sim = YarnSim::new(&scene).unwrap();
+    let mut sim = straight_yarn_sim([0.2, 0.6], [0.8, 0.65], 60);
     sim.set_gravity(Vec2::new(0.0, -9.8)).unwrap();
     sim.steps_n(100).unwrap();
     let saved = sim.save_state();
@@ -375,10 +330,7 @@ fn divergence_is_reported_with_its_step_and_blocks_further_steps() {
 
 #[test]
 fn bad_inputs_are_rejected() {
-    let scene = SceneBuilder::bare()
-        .yarn(straight([0.3, 0.5], [0.7, 0.5], 10))
-        .build();
-    let mut sim = YarnSim::new(&scene).unwrap();
+    let mut sim = straight_yarn_sim([0.3, 0.5], [0.7, 0.5], 10);
     assert!(sim.set_gravity(Vec2::new(f64::NAN, 0.0)).is_err());
     assert!(sim.set_gravity(Vec2::new(0.0, 1e9)).is_err());
     let a = sim.attractor();

@@ -6,8 +6,8 @@
 
 mod common;
 
-use common::{capstan_threshold, scene};
-use yarnsim::math::{perp, Mat2, Vec2};
+use common::{capstan_slip, capstan_threshold, scene, CAPSTAN_BUILTIN, CAPSTAN_BUILTIN_256};
+use yarnsim::math::Vec2;
 use yarnsim::scene::{SceneError, TransferScheme, WallMode, YarnScene};
 use yarnsim::testing::{
     cantilever_setup, cantilever_toml, capstan_toml, hanging_chain_period, hanging_chain_toml,
@@ -18,75 +18,26 @@ use yarnsim_evidence::small_yarn_scene;
 
 // ---- capstan ---------------------------------------------------------------
 
-/// The material of every built-in scene (`reference_material`) without its
-/// bending: k = 1000, gamma = 500, E = 1000, fibre friction 0.05,
-/// plasticity on; at the test resolution 128^2, dt 1e-4, and g = 2 m/s^2
-/// as for the string: the elastic stretch of the wrapped arc under g = 9.8
-/// (T pi R / k = 9e-4 m at l2 = 0.3) is 0.9 % of l1, and its undamped
-/// oscillation alone reads as a slip (measured: R 0.1, l2 / l1 = 2 then
-/// crosses at +18 %, the other five cases at +9.4 %).
-const BUILTIN: Capstan = Capstan {
-    res: 128,
-    dt: 1e-4,
-    g: 2.0,
-    gamma: 500.0,
-    youngs_modulus: 1000.0,
-    friction: 0.05,
-    bending: 0.0,
-    plasticity: true,
-};
-
-/// [`BUILTIN`] at the resolution of the built-in scenes, 256^2, dt 4e-5.
-const BUILTIN_256: Capstan = Capstan {
-    res: 256,
-    dt: 4e-5,
-    ..BUILTIN
-};
-
 /// The capstan scene of [`capstan_toml`] as a validated scene.
 fn capstan_scene(r: f64, l1: f64, l2: f64, mu: f64, c: &Capstan) -> YarnScene {
     scene(&capstan_toml(r, l1, l2, mu, c))
 }
 
-/// Time the capstan runs load before the slip is measured: the yarn starts
-/// unstretched at rest, and until the tension wave has loaded it (a few
-/// 0.01 s) the friction that needs that tension is missing and it slips
-/// by up to about 1e-3 m even far above the threshold.
-const CAPSTAN_LOAD: f64 = 0.2;
-
-/// Runs the capstan scene for `CAPSTAN_LOAD` and then up to 1 s more;
-/// returns whether it slid in that second (a free end moved vertically by
-/// more than 0.5 % of its hanging length; the lateral pendulum swing of the
-/// hanging strands that the loading excites is not a slip) and the largest
-/// relative vertical end displacement. Stops as soon as it slid.
+/// Runs the capstan scene as [`common::capstan_slip`] does; asserts at
+/// every check that no particle is deeper than dx / 2 in the circle.
 fn capstan_slides(r: f64, l1: f64, l2: f64, mu: f64, setup: &Capstan) -> (bool, f64) {
     let s = capstan_scene(r, l1, l2, mu, setup);
     let mut sim = YarnSim::new(&s).unwrap();
     let half_dx = 0.5 * s.dx();
     let c = Vec2::from(s.obstacles[0].center);
-    sim.advance(CAPSTAN_LOAD).unwrap();
-    let (a0, b0) = sim.yarn_endpoints(0);
-    let steps = (1.0 / sim.dt()).round() as u64;
-    let check = (5e-3 / sim.dt()).round().max(1.0) as u64;
-    let mut worst: f64 = 0.0;
-    for k in 0..steps {
-        sim.step().unwrap();
-        if k % check == check - 1 || k + 1 == steps {
-            let (a, b) = sim.yarn_endpoints(0);
-            let rel = ((a.y - a0.y).abs() / l1).max((b.y - b0.y).abs() / l2);
-            worst = worst.max(rel);
-            // non-penetration: no particle deeper than dx / 2 in the circle
-            let p = sim.particles();
-            for x in p.vert.x.iter().chain(&p.quad.x) {
-                let depth = r - (x - c).norm();
-                assert!(depth <= half_dx, "particle {x} is {depth} m inside");
-            }
-            if rel > 0.005 {
-                return (true, rel);
-            }
+    capstan_slip(&mut sim, l1, l2, |sim| {
+        // non-penetration: no particle deeper than dx / 2 in the circle
+        let p = sim.particles();
+        for x in p.vert.x.iter().chain(&p.quad.x) {
+            let depth = r - (x - c).norm();
+            assert!(depth <= half_dx, "particle {x} is {depth} m inside");
         }
-    }
-    (false, worst)
+    })
 }
 
 #[test]
@@ -186,7 +137,7 @@ fn capstan_yarn_slides_below_and_holds_above_the_heavy_rope_threshold() {
 #[test]
 #[cfg_attr(debug_assertions, ignore = "release-mode test (cargo test --release)")]
 fn capstan_oracle_holds_for_the_builtin_yarn_material() {
-    capstan_suite(&BUILTIN, &CAPSTAN_ALL);
+    capstan_suite(&CAPSTAN_BUILTIN, &CAPSTAN_ALL);
 }
 
 /// The built-in material at the built-in scenes' 256^2, dt 4e-5: hold and
@@ -199,7 +150,7 @@ fn capstan_oracle_holds_for_the_builtin_yarn_material_at_256() {
     for c in cases.iter_mut() {
         c.2 = c.0 == 0.1 && c.1 == 3.0;
     }
-    capstan_suite(&BUILTIN_256, &cases);
+    capstan_suite(&CAPSTAN_BUILTIN_256, &cases);
 }
 
 /// With the built-in scenes' bending stiffness B = 1e-3 N m (bending
@@ -212,7 +163,7 @@ fn capstan_oracle_holds_for_the_builtin_yarn_material_at_256() {
 fn capstan_oracle_holds_with_bending() {
     let setup = Capstan {
         bending: 1e-3,
-        ..BUILTIN
+        ..CAPSTAN_BUILTIN
     };
     capstan_suite(&setup, &CAPSTAN_ALL);
 }
@@ -228,10 +179,13 @@ fn capstan_oracle_holds_with_bending() {
 fn frictionless_drape_slides_at_the_rigid_string_rate() {
     let (r, l1, l2) = (0.1, 0.1, 0.3);
     for setup in [
-        Capstan { g: 9.8, ..BUILTIN },
         Capstan {
             g: 9.8,
-            ..BUILTIN_256
+            ..CAPSTAN_BUILTIN
+        },
+        Capstan {
+            g: 9.8,
+            ..CAPSTAN_BUILTIN_256
         },
     ] {
         let s = capstan_scene(r, l1, l2, 0.0, &setup);
@@ -413,40 +367,6 @@ fn hanging_chain(dt: &str) -> u64 {
 
 // ---- conservation -----------------------------------------------------------
 
-/// A bundle of 3 + 1 crossing yarns on 64^2 without gravity, walls or
-/// obstacles (the scene of `mpm_physics`), turned rigidly at `omega` about
-/// its centre of mass (v = omega perp(x - c), C = [[0, -omega], [omega, 0]])
-/// plus a drift `drift`.
-fn spinning_bundle(omega: f64, drift: Vec2) -> YarnSim {
-    let s = common::bare_scene(
-        r#"
-[[yarns]]
-start = [0.3, 0.5]
-end = [0.7, 0.52]
-vertices = 80
-count = 3
-spacing = [0.0, 0.012]
-[[yarns]]
-start = [0.48, 0.3]
-end = [0.52, 0.7]
-vertices = 80
-"#,
-    );
-    let mut sim = YarnSim::new(&s).unwrap();
-    let c = sim.diagnostics().center_of_mass;
-    let spin = Mat2::new(0.0, -omega, omega, 0.0);
-    let p = yarnsim::testing::particles_mut(&mut sim);
-    for k in 0..p.vert.x.len() {
-        p.vert.v[k] = perp(p.vert.x[k] - c) * omega + drift;
-        p.vert.c[k] = spin;
-    }
-    for k in 0..p.quad.x.len() {
-        p.quad.v[k] = perp(p.quad.x[k] - c) * omega + drift;
-        p.quad.c[k] = spin;
-    }
-    sim
-}
-
 #[test]
 #[cfg_attr(debug_assertions, ignore = "release-mode test (cargo test --release)")]
 fn momenta_are_kept_under_flip() {
@@ -454,7 +374,7 @@ fn momenta_are_kept_under_flip() {
     // (centre of mass to 1e-12 m after 1500 substeps). Here: linear momentum
     // of a deforming bundle with internal forces only, and the angular
     // momentum of a rigidly spinning one, under the default FLIP (ratio 1).
-    let mut sim = spinning_bundle(4.0, Vec2::new(0.3, -0.2));
+    let mut sim = common::spinning_bundle(4.0, Vec2::new(0.3, -0.2));
     assert_eq!(sim.transfer(), yarnsim::mpm::Transfer::Flip { ratio: 1.0 });
     let d0 = sim.diagnostics();
     let scale = common::momentum_scale(&sim);

@@ -15,7 +15,7 @@ use rerun::StoreKind;
 mod common;
 
 use common::rrd::{all_values, decode_store};
-use common::{record_ok, small_scene, tmp, yarnsim_ok};
+use common::{fresh_tmp, record_ok, small_scene, yarnsim_ok};
 
 /// One view of the blueprint.
 #[derive(Debug)]
@@ -144,8 +144,7 @@ fn check_plots(rrd: &Path, duration: f64) -> Vec<ViewInfo> {
 
 #[test]
 fn yarn_plots_are_named_legend_free_and_span_the_run() {
-    let rrd = tmp("blueprint-yarn.rrd");
-    let _ = std::fs::remove_file(&rrd);
+    let rrd = fresh_tmp("blueprint-yarn.rrd");
     record_ok(&small_scene(), "2ms", &rrd);
     let views = check_plots(&rrd, 0.002);
 
@@ -174,8 +173,7 @@ fn yarn_plots_are_named_legend_free_and_span_the_run() {
 
 #[test]
 fn mass_spring_plots_are_named_legend_free_and_span_the_run() {
-    let rrd = tmp("blueprint-wire.rrd");
-    let _ = std::fs::remove_file(&rrd);
+    let rrd = fresh_tmp("blueprint-wire.rrd");
     yarnsim_ok(&["record", "wire", "-d", "0.1", "-o", rrd.to_str().unwrap()]);
     let views = check_plots(&rrd, 0.1);
     let angular = views

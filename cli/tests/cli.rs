@@ -7,7 +7,7 @@ use std::process::Output;
 
 mod common;
 
-use common::{record_ok, small_scene, stderr, stdout, tmp, yarnsim};
+use common::{on_small_scene, record_ok, small_scene, stderr, stdout, tmp, yarnsim};
 
 /// `yarnsim run SCENE --duration 2ms --csv CSV` (CSV named `csv` in the
 /// test folder), which must succeed: its output and the CSV text.
@@ -28,14 +28,7 @@ fn run_2ms_with_csv(scene: &Path, csv: &str) -> (Output, String) {
 /// `yarnsim bench` of the small scene, 5 steps after 1 of warm-up, which
 /// must succeed: its stdout.
 fn bench_small() -> String {
-    let out = yarnsim(&[
-        "bench",
-        small_scene().to_str().unwrap(),
-        "--steps",
-        "5",
-        "--warmup",
-        "1",
-    ]);
+    let out = on_small_scene("bench", &["--steps", "5", "--warmup", "1"]);
     assert!(out.status.success(), "{}", stderr(&out));
     stdout(&out)
 }
@@ -347,14 +340,7 @@ fn clamped_and_invalid_steps_say_so_briefly() {
 
 #[test]
 fn output_errors_state_their_cause_once() {
-    let out = yarnsim(&[
-        "record",
-        small_scene().to_str().unwrap(),
-        "-d",
-        "1ms",
-        "-o",
-        "/nonexistent-dir/x.rrd",
-    ]);
+    let out = on_small_scene("record", &["-d", "1ms", "-o", "/nonexistent-dir/x.rrd"]);
     assert_eq!(out.status.code(), Some(4));
     let err = stderr(&out);
     assert_eq!(err.matches("No such file or directory").count(), 1, "{err}");

@@ -6,7 +6,7 @@
 
 mod common;
 
-use common::{small_scene, stderr, stdout, tmp, yarnsim};
+use common::{on_small_scene, small_scene, stderr, stdout, tmp, yarnsim};
 use yarnsim::scene::{Scene, YarnScene};
 use yarnsim::YarnSim;
 
@@ -27,6 +27,18 @@ fn stiff_bound() -> f64 {
     YarnSim::new(&s).unwrap().stable_dt()
 }
 
+/// `record yarn-drape -d 0.01 -o <rrd>`.
+fn record_drape(rrd: &std::path::Path) -> Vec<&str> {
+    vec![
+        "record",
+        "yarn-drape",
+        "-d",
+        "0.01",
+        "-o",
+        rrd.to_str().unwrap(),
+    ]
+}
+
 fn args<'a>(head: &[&'a str], tail: &[&'a str]) -> Vec<&'a str> {
     head.iter().chain(tail).copied().collect()
 }
@@ -44,14 +56,7 @@ fn a_fixed_dt_far_above_the_bound_is_refused_naming_the_bound() {
     );
     for cmd in [
         vec!["run", "yarn-drape", "-d", "0.01"],
-        vec![
-            "record",
-            "yarn-drape",
-            "-d",
-            "0.01",
-            "-o",
-            rrd.to_str().unwrap(),
-        ],
+        record_drape(&rrd),
         vec!["bench", "yarn-drape", "--steps", "5"],
     ] {
         let out = yarnsim(&args(&cmd, &STIFF));
@@ -98,14 +103,7 @@ fn forced_it_diverges_and_the_divergence_says_why() {
     // `record` and `bench` report the same divergence.
     let rrd = tmp("forced.rrd");
     for cmd in [
-        vec![
-            "record",
-            "yarn-drape",
-            "-d",
-            "0.01",
-            "-o",
-            rrd.to_str().unwrap(),
-        ],
+        record_drape(&rrd),
         vec!["bench", "yarn-drape", "--steps", "20", "--warmup", "0"],
     ] {
         let out = yarnsim(&args(&args(&cmd, &["--allow-unstable"]), &STIFF));
@@ -146,14 +144,7 @@ fn a_fixed_dt_a_little_above_the_bound_is_warned_about() {
     };
     let bound = YarnSim::new(&s).unwrap().stable_dt();
     assert!((dt / bound - 1.3).abs() < 1e-9, "{}", dt / bound);
-    let out = yarnsim(&[
-        "run",
-        small_scene().to_str().unwrap(),
-        "-d",
-        "2ms",
-        "--set",
-        &set,
-    ]);
+    let out = on_small_scene("run", &["-d", "2ms", "--set", &set]);
     assert!(out.status.success(), "{}", stderr(&out));
     assert_eq!(
         stderr(&out),

@@ -21,7 +21,7 @@ const SCENE: &str = include_str!("data/small.toml");
 mod common;
 
 use common::rrd::{all_values, decode_store};
-use common::{record_ok, tmp, yarnsim_ok as yarnsim};
+use common::{fresh_tmp, record_ok, tmp, yarnsim_ok as yarnsim};
 
 /// The recording's data chunks (blueprint store left out), by entity path.
 fn decode(path: &Path) -> BTreeMap<String, Vec<Chunk>> {
@@ -55,8 +55,7 @@ fn timelines(chunks: &BTreeMap<String, Vec<Chunk>>) -> BTreeSet<String> {
 #[test]
 fn yarn_recording_holds_the_library_state_at_every_frame() {
     let scene_file = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/small.toml");
-    let rrd = tmp("record-test.rrd");
-    let _ = std::fs::remove_file(&rrd);
+    let rrd = fresh_tmp("record-test.rrd");
     // 2 ms = 50 substeps of 40 us = 5 frames of 10 substeps, plus frame 0.
     let out = record_ok(&scene_file, "2ms", &rrd);
     let stdout = String::from_utf8_lossy(&out.stdout);
@@ -142,8 +141,7 @@ fn yarn_recording_holds_the_library_state_at_every_frame() {
 
 #[test]
 fn massspring_recording_holds_the_library_state_at_every_frame() {
-    let rrd = tmp("record-wire.rrd");
-    let _ = std::fs::remove_file(&rrd);
+    let rrd = fresh_tmp("record-wire.rrd");
     // 0.15 s = 3 frames of 0.05 s.
     yarnsim(&[
         "record",
@@ -202,8 +200,7 @@ fn massspring_recording_holds_the_library_state_at_every_frame() {
 /// checks exit code 130 and a decodable file with contiguous frames.
 #[cfg(unix)]
 fn signal_finishes_the_recording_cleanly(signal: &str) {
-    let rrd = tmp(&format!("record-interrupted-{signal}.rrd"));
-    let _ = std::fs::remove_file(&rrd);
+    let rrd = fresh_tmp(&format!("record-interrupted-{signal}.rrd"));
     let scene_file = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/small.toml");
     let child = Command::new(env!("CARGO_BIN_EXE_yarnsim"))
         .args(["record", scene_file.to_str().unwrap(), "--duration", "1000"])
@@ -293,8 +290,7 @@ fn dash_o_dash_writes_the_recording_to_stdout() {
 
 #[test]
 fn save_is_an_alias_of_output() {
-    let rrd = tmp("record-save.rrd");
-    let _ = std::fs::remove_file(&rrd);
+    let rrd = fresh_tmp("record-save.rrd");
     yarnsim(&[
         "record",
         &small_scene(),
@@ -308,8 +304,7 @@ fn save_is_an_alias_of_output() {
 
 #[test]
 fn every_n_logs_every_nth_frame_and_the_last() {
-    let rrd = tmp("record-every.rrd");
-    let _ = std::fs::remove_file(&rrd);
+    let rrd = fresh_tmp("record-every.rrd");
     let out = yarnsim(&[
         "record",
         &small_scene(),
@@ -436,8 +431,7 @@ fn recordings_read_at_a_glance() {
     // quadrature points coloured by their stretch; a legend stating the
     // scale; every plot's series in distinct colours; total energy, mean
     // stretch and centre of mass logged.
-    let rrd = tmp("record-look.rrd");
-    let _ = std::fs::remove_file(&rrd);
+    let rrd = fresh_tmp("record-look.rrd");
     record_ok(&common::small_scene(), "2ms", &rrd);
     let chunks = decode(&rrd);
     let strips = by_frame::<rerun::components::LineStrip2D>(
@@ -533,8 +527,7 @@ fn recordings_read_at_a_glance() {
     assert!(legend[0].as_str().contains("grid 64x64"), "{:?}", legend);
 
     // Mass-spring scene: Y-up view coordinates at the 3D view's origin.
-    let rrd = tmp("record-look-wire.rrd");
-    let _ = std::fs::remove_file(&rrd);
+    let rrd = fresh_tmp("record-look-wire.rrd");
     yarnsim(&["record", "wire", "-d", "0.1", "-o", rrd.to_str().unwrap()]);
     let chunks = decode(&rrd);
     let vc = all_values::<ViewCoordinates>(&chunks["world"]);
@@ -601,8 +594,7 @@ fn read_server(
 #[test]
 fn serve_serves_the_recording_until_sigterm() {
     use std::io::BufRead;
-    let rrd = tmp("record-serve.rrd");
-    let _ = std::fs::remove_file(&rrd);
+    let rrd = fresh_tmp("record-serve.rrd");
     let port = {
         let free = std::net::TcpListener::bind("127.0.0.1:0").unwrap();
         free.local_addr().unwrap().port().to_string()

@@ -14,33 +14,27 @@
 use std::time::Instant;
 
 use yarnsim::math::{perp, Vec2};
-use yarnsim::scene::{Integrator, StepSize, YarnScene};
+use yarnsim::scene::builtin::yarn_reference;
+use yarnsim::scene::{Integrator, StepSize, WallMode, YarnScene, YarnSpec};
 use yarnsim::testing::cantilever_toml;
 use yarnsim::YarnSim;
 
-const TWO_YARNS: &str = r#"
-gravity = [0.0, -9.8]
-[grid]
-resolution = 64
-[time]
-dt = 1e-4
-[material]
-k = 1000.0
-gamma = 500.0
-youngs_modulus = 1000.0
-friction = 0.05
-bending = 1e-3
-density = 1.0
-plasticity = true
-[walls]
-mode = "none"
-[[yarns]]
-start = [0.3, 0.5]
-end = [0.7, 0.5]
-vertices = 60
-count = 2
-spacing = [0.0, 0.01]
-"#;
+/// The built-in material (the reference scene's) on two straight yarns of
+/// 60 vertices, 1 cm apart, on 64^2 at dt 1e-4 with gravity, without walls,
+/// obstacles or pins.
+fn two_yarns() -> YarnScene {
+    let mut s = yarn_reference();
+    s.grid.resolution = 64;
+    s.time.dt = StepSize::Fixed(1e-4);
+    s.walls.mode = WallMode::None;
+    s.obstacles.clear();
+    s.yarns = vec![YarnSpec {
+        count: 2,
+        spacing: [0.0, 0.01],
+        ..YarnSpec::straight([0.3, 0.5], [0.7, 0.5], 60)
+    }];
+    s
+}
 
 /// One run of `duration` simulated seconds: (wall s per substep, Newton
 /// and CG per substep).
@@ -84,12 +78,7 @@ fn main() {
             0.1,
             false,
         ),
-        (
-            "built-in material, two yarns",
-            YarnScene::from_toml_str(TWO_YARNS).unwrap(),
-            0.1,
-            true,
-        ),
+        ("built-in material, two yarns", two_yarns(), 0.1, true),
     ];
     for (name, scene, duration, press) in scenes {
         let modes = [None, Some(1e-4), Some(1e-3)];

@@ -224,9 +224,7 @@ fn get_fmu_state_reuses_an_existing_state() {
 #[test]
 fn corrupt_or_truncated_state_is_rejected() {
     let (scene, fmu) = small_fmu_after(2);
-    let s = fmu.get_state();
-    let bytes = fmu.serialize(s);
-    fmu.free_state(s);
+    let bytes = fmu.state_bytes();
     let mut cases: Vec<(&str, Vec<u8>)> = vec![
         ("empty", Vec::new()),
         ("header only", bytes[..20].to_vec()),

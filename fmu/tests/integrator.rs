@@ -80,9 +80,7 @@ fn integrator_parameter_runs_the_implicit_chain_with_the_library_bits() {
     let scene = chain();
     let explicit = Fmu::initialized(&scene);
     assert_eq!(explicit.get_string(VR_INTEGRATOR), "explicit");
-    let f = Fmu::new(&scene);
-    assert_eq!(f.set_string(VR_INTEGRATOR, "implicit"), fmi2OK);
-    f.init();
+    let f = Fmu::initialized_with(&scene, VR_INTEGRATOR, "implicit");
     assert_eq!(f.get_string(VR_INTEGRATOR), "implicit");
     let mut lib = scene.clone();
     lib.time.integrator = Integrator::Implicit;
@@ -122,9 +120,7 @@ fn integrator_parameter_runs_the_implicit_chain_with_the_library_bits() {
 fn integrator_changes_no_output_at_initialization() {
     let scene = chain();
     let a = Fmu::initialized(&scene);
-    let b = Fmu::new(&scene);
-    assert_eq!(b.set_string(VR_INTEGRATOR, "implicit"), fmi2OK);
-    b.init();
+    let b = Fmu::initialized_with(&scene, VR_INTEGRATOR, "implicit");
     let vrs = [VR_KINETIC_ENERGY, VR_ELASTIC_ENERGY, VR_MAX_STRETCH];
     assert_eq!(a.get_real(&vrs).unwrap(), b.get_real(&vrs).unwrap());
     assert_eq!(a.outputs(), b.outputs());
@@ -180,9 +176,7 @@ fn gridless_integrators_give_the_library_bits_and_refuse_out_of_scope_scenes() {
         ("midpoint-vertices", Integrator::MidpointVertices),
     ] {
         let scene = chain();
-        let f = Fmu::new(&scene);
-        assert_eq!(f.set_string(VR_INTEGRATOR, name), fmi2OK);
-        f.init();
+        let f = Fmu::initialized_with(&scene, VR_INTEGRATOR, name);
         assert_eq!(f.get_string(VR_INTEGRATOR), name);
         let mut lib = scene.clone();
         lib.time.integrator = integ;
@@ -307,16 +301,10 @@ fn fmi3_integrator_parameter() {
 #[test]
 fn integrator_travels_in_the_serialized_state() {
     let scene = chain();
-    let f = Fmu::new(&scene);
-    assert_eq!(f.set_string(VR_INTEGRATOR, "implicit"), fmi2OK);
-    f.init();
+    let f = Fmu::initialized_with(&scene, VR_INTEGRATOR, "implicit");
     f.steps_ok(0..5, 0.01);
-    let s = f.get_state();
-    let bytes = f.serialize(s);
-    f.free_state(s);
-    let g = Fmu::initialized(&scene);
-    let t = g.set_state_from(&bytes);
-    g.free_state(t);
+    let bytes = f.state_bytes();
+    let g = Fmu::initialized_from(&scene, &bytes);
     assert_eq!(g.get_string(VR_INTEGRATOR), "implicit");
     assert_eq!(f.output_bits(5..10, 0.01), g.output_bits(5..10, 0.01));
 }

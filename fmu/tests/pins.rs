@@ -117,19 +117,13 @@ fn bad_transfer_values_are_refused_with_a_log_line() {
 #[test]
 fn transfer_parameters_travel_in_the_fmu_state() {
     let scene = small_scene();
-    let f = Fmu::new(&scene);
-    assert_eq!(f.set_string(VR_TRANSFER_SCHEME, "apic"), fmi2OK);
-    f.init();
+    let f = Fmu::initialized_with(&scene, VR_TRANSFER_SCHEME, "apic");
     f.steps_ok(0..3, H);
-    let s = f.get_state();
-    let bytes = f.serialize(s);
-    f.free_state(s);
+    let bytes = f.state_bytes();
     f.steps_ok(3..6, H);
     let end = f.outputs();
     // A fresh instance with the default scheme takes the state's.
-    let g = Fmu::initialized(&scene);
-    let d = g.set_state_from(&bytes);
-    g.free_state(d);
+    let g = Fmu::initialized_from(&scene, &bytes);
     assert_eq!(g.get_string(VR_TRANSFER_SCHEME), "apic");
     g.steps_ok(3..6, H);
     assert_eq!(bits(&g.outputs()), bits(&end));
@@ -316,9 +310,7 @@ fn driven_pin_state_round_trip_gives_identical_bits() {
         }
         out
     };
-    let f = Fmu::new(&s);
-    assert_eq!(f.set_string(VR_TRANSFER_SCHEME, "flip"), fmi2OK);
-    f.init();
+    let f = Fmu::initialized_with(&s, VR_TRANSFER_SCHEME, "flip");
     drive(&f, 0, 4);
     let st = f.get_state();
     let bytes = f.serialize(st);
@@ -327,9 +319,7 @@ fn driven_pin_state_round_trip_gives_identical_bits() {
     assert_eq!(drive(&f, 4, 6), first);
     f.free_state(st);
 
-    let g = Fmu::initialized(&s);
-    let d = g.set_state_from(&bytes);
-    g.free_state(d);
+    let g = Fmu::initialized_from(&s, &bytes);
     assert_eq!(g.get_string(VR_TRANSFER_SCHEME), "flip");
     assert_eq!(drive(&g, 4, 6), first);
 }

@@ -1,11 +1,13 @@
 //! Shared helpers of the integration tests.
 #![allow(dead_code)]
 
-use yarnsim::math::Vec2;
+use yarnsim::massspring::{Integrator as MassSpringIntegrator, IntegratorOptions};
+use yarnsim::math::{perp, Mat2, Vec2};
 use yarnsim::scene::{
     AttractorSpec, GridSpec, Integrator, Material, Obstacle, PinMotionKind, PinSpec, StepSize,
     TimeSpec, TransferScheme, TransferSpec, WallMode, Walls, YarnEnd, YarnScene, YarnSpec,
 };
+use yarnsim::testing::Capstan;
 use yarnsim::YarnSim;
 
 /// A small deterministic generator (xorshift64*), so tests need no `rand`.
@@ -145,6 +147,17 @@ pub fn pin_vertex(yarn: u32, vertex: u32, count: u32) -> PinSpec {
         vertex: Some(vertex),
         ..pin_end(yarn, YarnEnd::Start, count)
     }
+}
+
+/// A simulation of the bare scene ([`SceneBuilder::bare`]) with one
+/// straight yarn.
+pub fn straight_yarn_sim(start: [f64; 2], end: [f64; 2], vertices: u32) -> YarnSim {
+    YarnSim::new(
+        &SceneBuilder::bare()
+            .yarn(straight(start, end, vertices))
+            .build(),
+    )
+    .unwrap()
 }
 
 /// Test scenes without TOML text: [`SceneBuilder::bare`] and the settings
@@ -297,6 +310,55 @@ pub fn grid_free_fall(c0: Vec2, g: Vec2, dt: f64, n: u64) -> (Vec2, Vec2) {
     )
 }
 
+/// A bundle of 3 + 1 crossing yarns on the bare scene (64^2, without
+/// gravity, walls or obstacles), turned rigidly at `omega` about its centre
+/// of mass (v = omega perp(x - c), C = [[0, -omega], [omega, 0]]) plus a
+/// drift `drift`.
+pub fn spinning_bundle(omega: f64, drift: Vec2) -> YarnSim {
+    let s = SceneBuilder::bare()
+        .yarn(bundle([0.3, 0.5], [0.7, 0.52], 80, 3, [0.0, 0.012]))
+        .yarn(straight([0.48, 0.3], [0.52, 0.7], 80))
+        .build();
+    let mut sim = YarnSim::new(&s).unwrap();
+    let c = sim.diagnostics().center_of_mass;
+    let spin = Mat2::new(0.0, -omega, omega, 0.0);
+    let p = yarnsim::testing::particles_mut(&mut sim);
+    for k in 0..p.vert.x.len() {
+        p.vert.v[k] = perp(p.vert.x[k] - c) * omega + drift;
+        p.vert.c[k] = spin;
+    }
+    for k in 0..p.quad.x.len() {
+        p.quad.v[k] = perp(p.quad.x[k] - c) * omega + drift;
+        p.quad.c[k] = spin;
+    }
+    sim
+}
+
+/// Steps `sim`, at rest, `n` substeps of `dt` under `g` and asserts the
+/// grid scheme's free fall ([`grid_free_fall`]) to round-off: the centre of
+/// mass within 1e-12 m, the mean velocity within 1e-11 m/s, and with
+/// `stretch_tol` every stretch within it of 1.
+pub fn assert_grid_free_fall(
+    sim: &mut YarnSim,
+    g: Vec2,
+    dt: f64,
+    n: u64,
+    stretch_tol: Option<f64>,
+) {
+    let c0 = sim.diagnostics().center_of_mass;
+    sim.steps_n(n).unwrap();
+    let (expected, v) = grid_free_fall(c0, g, dt, n);
+    let d = sim.diagnostics();
+    let err = (d.center_of_mass - expected).norm();
+    assert!(err < 1e-12, "centre of mass off by {err:.3e} m");
+    assert!((d.momentum / d.total_mass - v).norm() < 1e-11);
+    if let Some(tol) = stretch_tol {
+        for st in sim.stretches() {
+            assert!((st - 1.0).abs() < tol, "stretch {st}");
+        }
+    }
+}
+
 /// Heavy-rope capstan: tension at the heavy end of the wrapped half circle
 /// for friction `mu`, from dT/ds = mu T / R + w (mu sin psi - cos psi),
 /// psi = pi - s / R, T(0) = w l1 (RK4 in 2000 steps).
@@ -333,4 +395,91 @@ pub fn capstan_threshold(r: f64, l1: f64, l2: f64) -> f64 {
         }
     }
     0.5 * (lo + hi)
+}
+
+/// The capstan oracles' material, that of every built-in scene
+/// (`reference_material`) without its bending: k = 1000, gamma = 500,
+/// E = 1000, fibre friction 0.05, plasticity on; at the test resolution
+/// 128^2, dt 1e-4, and g = 2 m/s^2 as for the string: the elastic stretch
+/// of the wrapped arc under g = 9.8 (T pi R / k = 9e-4 m at l2 = 0.3) is
+/// 0.9 % of l1, and its undamped oscillation alone reads as a slip
+/// (measured: R 0.1, l2 / l1 = 2 then crosses at +18 %, the other five
+/// cases at +9.4 %).
+pub const CAPSTAN_BUILTIN: Capstan = Capstan {
+    res: 128,
+    dt: 1e-4,
+    g: 2.0,
+    gamma: 500.0,
+    youngs_modulus: 1000.0,
+    friction: 0.05,
+    bending: 0.0,
+    plasticity: true,
+};
+
+/// [`CAPSTAN_BUILTIN`] at the resolution of the built-in scenes, 256^2,
+/// dt 4e-5.
+pub const CAPSTAN_BUILTIN_256: Capstan = Capstan {
+    res: 256,
+    dt: 4e-5,
+    ..CAPSTAN_BUILTIN
+};
+
+/// Time the capstan runs load before the slip is measured: the yarn starts
+/// unstretched at rest, and until the tension wave has loaded it (a few
+/// 0.01 s) the friction that needs that tension is missing and it slips
+/// by up to about 1e-3 m even far above the threshold.
+pub const CAPSTAN_LOAD: f64 = 0.2;
+
+/// Runs a capstan scene's `sim` for [`CAPSTAN_LOAD`] and then up to 1 s
+/// more; returns whether it slid in that second (a free end of hanging
+/// length `l1` or `l2` moved vertically by more than 0.5 % of it; the
+/// lateral pendulum swing of the hanging strands that the loading excites
+/// is not a slip) and the largest relative vertical end displacement.
+/// Stops as soon as it slid. Every 5 ms (and at the end) `at_check` sees
+/// the simulation, before the slip test.
+pub fn capstan_slip(
+    sim: &mut YarnSim,
+    l1: f64,
+    l2: f64,
+    mut at_check: impl FnMut(&YarnSim),
+) -> (bool, f64) {
+    sim.advance(CAPSTAN_LOAD).unwrap();
+    let (a0, b0) = sim.yarn_endpoints(0);
+    let steps = (1.0 / sim.dt()).round() as u64;
+    let check = (5e-3 / sim.dt()).round().max(1.0) as u64;
+    let mut worst: f64 = 0.0;
+    for k in 0..steps {
+        sim.step().unwrap();
+        if k % check == check - 1 || k + 1 == steps {
+            let (a, b) = sim.yarn_endpoints(0);
+            let rel = ((a.y - a0.y).abs() / l1).max((b.y - b0.y).abs() / l2);
+            worst = worst.max(rel);
+            at_check(sim);
+            if rel > 0.005 {
+                return (true, rel);
+            }
+        }
+    }
+    (false, worst)
+}
+
+/// Mass-spring integrator options that solve each step to `cg_tolerance`
+/// at the fixed step `h`; Chebyshev-Jacobi gets `chebyshev_iterations`
+/// iterations at rho 0.9, so that its minimisation converges too.
+pub fn solved_options(
+    integ: MassSpringIntegrator,
+    h: f64,
+    cg_tolerance: f64,
+    chebyshev_iterations: usize,
+) -> IntegratorOptions {
+    let mut o = IntegratorOptions {
+        dt: Some(h),
+        cg_tolerance,
+        ..Default::default()
+    };
+    if integ == MassSpringIntegrator::ChebyshevJacobi {
+        o.iterations = chebyshev_iterations;
+        o.rho = 0.9;
+    }
+    o
 }

@@ -41,6 +41,13 @@ pub fn record_ok(scene: &Path, duration: &str, rrd: &Path) -> Output {
     ])
 }
 
+/// `yarnsim COMMAND <the test scene> ARGS...` ([`small_scene`]).
+pub fn on_small_scene(command: &str, args: &[&str]) -> Output {
+    let scene = small_scene();
+    let head = [command, scene.to_str().unwrap()];
+    yarnsim(&head.iter().chain(args).copied().collect::<Vec<_>>())
+}
+
 pub fn stdout(out: &Output) -> String {
     String::from_utf8(out.stdout.clone()).expect("utf-8 stdout")
 }
@@ -59,4 +66,11 @@ pub fn small_scene() -> PathBuf {
 /// `name` in the test target's scratch folder.
 pub fn tmp(name: &str) -> PathBuf {
     Path::new(env!("CARGO_TARGET_TMPDIR")).join(name)
+}
+
+/// [`tmp`] with no file left there by an earlier run.
+pub fn fresh_tmp(name: &str) -> PathBuf {
+    let path = tmp(name);
+    let _ = std::fs::remove_file(&path);
+    path
 }

@@ -198,6 +198,24 @@ impl Fmu {
         f
     }
 
+    /// [`Self::new`] with the string parameter `vr` set to `value` (fmi2OK)
+    /// before initialization ([`Self::init`]).
+    pub fn initialized_with(scene: &YarnScene, vr: u32, value: &str) -> Fmu {
+        let f = Fmu::new(scene);
+        assert_eq!(f.set_string(vr, value), fmi2OK);
+        f.init();
+        f
+    }
+
+    /// [`Self::initialized`] and set to the serialized state `bytes` (the
+    /// state made from them is freed).
+    pub fn initialized_from(scene: &YarnScene, bytes: &[u8]) -> Fmu {
+        let f = Fmu::initialized(scene);
+        let d = f.set_state_from(bytes);
+        f.free_state(d);
+        f
+    }
+
     pub fn try_new(scene: &YarnScene, guid: &str, name: &str) -> Result<Fmu, Vec<Line>> {
         Self::try_with(&scene.to_toml_string(), num_yarns(scene), guid, name)
     }
@@ -434,6 +452,14 @@ impl Fmu {
             fmi2OK
         );
         buf
+    }
+
+    /// The instance's state now, serialized (the state taken is freed).
+    pub fn state_bytes(&self) -> Vec<u8> {
+        let s = self.get_state();
+        let bytes = self.serialize(s);
+        self.free_state(s);
+        bytes
     }
 
     /// Deserializes into a new state; the status and the state (null on failure).
