@@ -157,81 +157,63 @@ pub fn status_name(api: Api, s: Status) -> &'static str {
     }
 }
 
-/// What an instance does for a call, whatever the FMI version that calls
-/// it: the key of the state table. The getters and setters are by value
-/// type (`Float` is FMI 2.0 Real and FMI 3.0 Float64, `Integer` is Integer
-/// and Int32); `SetupExperiment` is FMI 2.0's function and the arguments of
-/// `fmi3EnterInitializationMode`.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Operation {
-    SetDebugLogging,
-    FreeInstance,
-    SetupExperiment,
-    EnterInitializationMode,
-    ExitInitializationMode,
-    EnterStepMode,
-    Terminate,
-    Reset,
-    GetFloat,
-    GetInteger,
-    GetBoolean,
-    GetString,
-    SetFloat,
-    SetInteger,
-    SetBoolean,
-    SetString,
-    GetNumberOfVariableDependencies,
-    GetVariableDependencies,
-    GetFmuState,
-    SetFmuState,
-    SerializedFmuStateSize,
-    SerializeFmuState,
-    DeserializeFmuState,
-    DoStep,
-    GetStatus,
-    GetRealStatus,
-    GetIntegerStatus,
-    GetBooleanStatus,
-    GetStringStatus,
+/// Declares [`Operation`] with its variants and [`Operation::ALL`], the
+/// same list in the same order.
+macro_rules! operations {
+    ($(#[$meta:meta])* pub enum $name:ident { $($op:ident,)* }) => {
+        $(#[$meta])*
+        pub enum $name {
+            $($op,)*
+        }
+
+        impl $name {
+            /// Every operation, in the order of [`Operation`].
+            pub const ALL: [$name; [$($name::$op),*].len()] = [$($name::$op),*];
+        }
+    };
+}
+
+operations! {
+    /// What an instance does for a call, whatever the FMI version that calls
+    /// it: the key of the state table. The getters and setters are by value
+    /// type (`Float` is FMI 2.0 Real and FMI 3.0 Float64, `Integer` is Integer
+    /// and Int32); `SetupExperiment` is FMI 2.0's function and the arguments of
+    /// `fmi3EnterInitializationMode`.
+    #[derive(Clone, Copy, Debug, PartialEq, Eq)]
+    pub enum Operation {
+        SetDebugLogging,
+        FreeInstance,
+        SetupExperiment,
+        EnterInitializationMode,
+        ExitInitializationMode,
+        EnterStepMode,
+        Terminate,
+        Reset,
+        GetFloat,
+        GetInteger,
+        GetBoolean,
+        GetString,
+        SetFloat,
+        SetInteger,
+        SetBoolean,
+        SetString,
+        GetNumberOfVariableDependencies,
+        GetVariableDependencies,
+        GetFmuState,
+        SetFmuState,
+        SerializedFmuStateSize,
+        SerializeFmuState,
+        DeserializeFmuState,
+        DoStep,
+        GetStatus,
+        GetRealStatus,
+        GetIntegerStatus,
+        GetBooleanStatus,
+        GetStringStatus,
+    }
 }
 
 impl Operation {
-    /// Every operation, in the order of [`Operation`].
-    pub const ALL: [Operation; 29] = {
-        use Operation::*;
-        [
-            SetDebugLogging,
-            FreeInstance,
-            SetupExperiment,
-            EnterInitializationMode,
-            ExitInitializationMode,
-            EnterStepMode,
-            Terminate,
-            Reset,
-            GetFloat,
-            GetInteger,
-            GetBoolean,
-            GetString,
-            SetFloat,
-            SetInteger,
-            SetBoolean,
-            SetString,
-            GetNumberOfVariableDependencies,
-            GetVariableDependencies,
-            GetFmuState,
-            SetFmuState,
-            SerializedFmuStateSize,
-            SerializeFmuState,
-            DeserializeFmuState,
-            DoStep,
-            GetStatus,
-            GetRealStatus,
-            GetIntegerStatus,
-            GetBooleanStatus,
-            GetStringStatus,
-        ]
-    };
-
     /// The names of the function that calls the operation in FMI 2.0 and in
     /// FMI 3.0 (`None`: the version has no such function).
     pub const fn names(self) -> (Option<&'static str>, Option<&'static str>) {

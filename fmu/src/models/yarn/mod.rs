@@ -98,6 +98,33 @@ fn read_scene(path: &Path) -> Result<YarnScene, String> {
     YarnScene::from_toml_str(&text).map_err(|e| format!("scene file {}: {e}", path.display()))
 }
 
+/// The value of a String parameter `name` that picks one of a table's
+/// values (`what`, as in "a transfer scheme"): refused when null or unknown.
+fn refuse_unknown<T: Copy>(
+    name: &str,
+    v: &Option<String>,
+    table: &[(&str, T)],
+    what: &str,
+) -> ModelResult<T> {
+    let Some(v) = v else {
+        return refuse(format!("{name} is a null pointer"));
+    };
+    match parse_choice(table, v) {
+        Some(t) => Ok(t),
+        None => refuse(format!(
+            "{name} = {v:?} is not {what}: use {}",
+            choice_list(table)
+        )),
+    }
+}
+
+/// Sets `slot` to `Some(new)`; true when that changed it.
+fn replace<T: PartialEq>(slot: &mut Option<T>, new: T) -> bool {
+    let changed = slot.as_ref() != Some(&new);
+    *slot = Some(new);
+    changed
+}
+
 /// The yarn bundle of one FMU instance.
 #[derive(Clone, Debug)]
 pub struct YarnModel {
@@ -194,29 +221,13 @@ impl YarnModel {
             }
             param_ok(name_of(vr))?;
             if vr == VR_INTEGRATOR {
-                let Some(v) = v else {
-                    return refuse("integrator is a null pointer");
-                };
-                let Some(i) = parse_integrator(v) else {
-                    return refuse(format!(
-                        "integrator = {v:?} is not an integrator: use \"explicit\", \"implicit\", \"implicit-vertices\" or \"midpoint-vertices\""
-                    ));
-                };
-                changed |= self.config.integrator != Some(i);
-                self.config.integrator = Some(i);
+                let i = refuse_unknown("integrator", v, &INTEGRATORS, "an integrator")?;
+                changed |= replace(&mut self.config.integrator, i);
                 continue;
             }
             if vr == VR_TRANSFER_SCHEME {
-                let Some(v) = v else {
-                    return refuse("transfer.scheme is a null pointer");
-                };
-                let Some(scheme) = parse_scheme(v) else {
-                    return refuse(format!(
-                        "transfer.scheme = {v:?} is not a transfer scheme: use \"flip\" or \"apic\""
-                    ));
-                };
-                changed |= self.config.scheme != Some(scheme);
-                self.config.scheme = Some(scheme);
+                let scheme = refuse_unknown("transfer.scheme", v, &SCHEMES, "a transfer scheme")?;
+                changed |= replace(&mut self.config.scheme, scheme);
                 continue;
             }
             let Some(v) = v else {
@@ -449,10 +460,12 @@ impl FmuModel for YarnModel {
     fn get_string(&self, vr: u32) -> Option<&str> {
         match vr {
             VR_SCENE => Some(self.config.scene_path.as_str()),
-            VR_TRANSFER_SCHEME => Some(scheme_name(
+            VR_TRANSFER_SCHEME => Some(choice_name(
+                &SCHEMES,
                 self.config.scheme.unwrap_or(self.base.transfer.scheme),
             )),
-            VR_INTEGRATOR => Some(integrator_name(
+            VR_INTEGRATOR => Some(choice_name(
+                &INTEGRATORS,
                 self.config.integrator.unwrap_or(self.base.time.integrator),
             )),
             _ => None,

@@ -72,41 +72,42 @@ const fn material(
     })
 }
 
-/// The name of a transfer scheme as the scene and `transfer.scheme` write it.
-pub fn scheme_name(s: TransferScheme) -> &'static str {
-    match s {
-        TransferScheme::Flip => "flip",
-        TransferScheme::Apic => "apic",
-    }
+/// The transfer schemes by their name as the scene and `transfer.scheme`
+/// write it.
+pub const SCHEMES: [(&str, TransferScheme); 2] = [
+    ("flip", TransferScheme::Flip),
+    ("apic", TransferScheme::Apic),
+];
+
+/// The integrators by their name as the scene and `integrator` write it.
+pub const INTEGRATORS: [(&str, Integrator); 4] = [
+    ("explicit", Integrator::Explicit),
+    ("implicit", Integrator::Implicit),
+    ("implicit-vertices", Integrator::ImplicitVertices),
+    ("midpoint-vertices", Integrator::MidpointVertices),
+];
+
+/// The name of `value` in a table of names ([`SCHEMES`], [`INTEGRATORS`]).
+pub fn choice_name<T: PartialEq>(table: &[(&'static str, T)], value: T) -> &'static str {
+    let (name, _) = table
+        .iter()
+        .find(|(_, v)| *v == value)
+        .expect("every value has a name");
+    name
 }
 
-/// The transfer scheme of a `transfer.scheme` value.
-pub fn parse_scheme(s: &str) -> Option<TransferScheme> {
-    match s {
-        "flip" => Some(TransferScheme::Flip),
-        "apic" => Some(TransferScheme::Apic),
-        _ => None,
-    }
+/// The value named `name` in a table of names.
+pub fn parse_choice<T: Copy>(table: &[(&str, T)], name: &str) -> Option<T> {
+    table.iter().find(|(n, _)| *n == name).map(|&(_, v)| v)
 }
 
-/// The name of an integrator as the scene and `integrator` write it.
-pub fn integrator_name(i: Integrator) -> &'static str {
-    match i {
-        Integrator::Explicit => "explicit",
-        Integrator::Implicit => "implicit",
-        Integrator::ImplicitVertices => "implicit-vertices",
-        Integrator::MidpointVertices => "midpoint-vertices",
-    }
-}
-
-/// The integrator of an `integrator` value.
-pub fn parse_integrator(s: &str) -> Option<Integrator> {
-    match s {
-        "explicit" => Some(Integrator::Explicit),
-        "implicit" => Some(Integrator::Implicit),
-        "implicit-vertices" => Some(Integrator::ImplicitVertices),
-        "midpoint-vertices" => Some(Integrator::MidpointVertices),
-        _ => None,
+/// The names of a table, quoted, as a refusal lists them: `"a", "b" or "c"`.
+pub fn choice_list<T>(table: &[(&str, T)]) -> String {
+    let quoted: Vec<String> = table.iter().map(|(n, _)| format!("{n:?}")).collect();
+    match quoted.split_last() {
+        Some((last, [])) => last.clone(),
+        Some((last, rest)) => format!("{} or {last}", rest.join(", ")),
+        None => String::new(),
     }
 }
 
@@ -142,9 +143,9 @@ pub static YARN_VARIABLES: [VarSpec<YarnScene>; 21] = [
     var(Parameter, "material.density", VR_DENSITY, Some("kg/m2"), material(|s| s.material.density, |s, v| s.material.density = v, true), "Line density (kg per m of yarn, per m of depth)"),
     var(Parameter, "dt", VR_DT, Some("s"), Start::Scene(SceneField { get: |s| s.time.dt.fixed().unwrap_or(0.0), set: set_dt, positive: false, max: 1e12 }), "Substep size; 0: adaptive (the scene's dt = \"auto\": each substep is the safety factor times the stability bound of the current state, the last one before a communication point shortened to land on it). A fixed dt runs an integer number of substeps per communication step"),
     var(Parameter, "material.plasticity", VR_PLASTICITY, None, Start::Bool(|s| s.material.plasticity), "Mohr-Coulomb return mapping on or off"),
-    var(Parameter, "transfer.scheme", VR_TRANSFER_SCHEME, None, Start::Name(|s| scheme_name(s.transfer.scheme)), "Particle velocity update of grid-to-particle: flip (FLIP/APIC blend by transfer.flip_ratio) or apic"),
+    var(Parameter, "transfer.scheme", VR_TRANSFER_SCHEME, None, Start::Name(|s| choice_name(&SCHEMES, s.transfer.scheme)), "Particle velocity update of grid-to-particle: flip (FLIP/APIC blend by transfer.flip_ratio) or apic"),
     var(Parameter, "transfer.flip_ratio", VR_FLIP_RATIO, None, Start::Scene(SceneField { get: |s| s.transfer.flip_ratio, set: |s, v| s.transfer.flip_ratio = v, positive: false, max: 1.0 }), "FLIP ratio in [0, 1] of the flip scheme (1: pure FLIP; ignored by apic)"),
-    var(Parameter, "integrator", VR_INTEGRATOR, None, Start::Name(|s| integrator_name(s.time.integrator)), "Time integrator (the scene's time.integrator): explicit (symplectic Euler), implicit (backward Euler, Newton on the grid velocities), implicit-vertices (backward Euler on the vertices of a single yarn without the grid) or midpoint-vertices (generalized midpoint there); the last two only for one yarn with gamma = youngs_modulus = 0 and no walls: another scene is refused with fmi2Error at the end of initialization, the log naming the scene field; a Newton solve that fails in a step gives fmi2Discard"),
+    var(Parameter, "integrator", VR_INTEGRATOR, None, Start::Name(|s| choice_name(&INTEGRATORS, s.time.integrator)), "Time integrator (the scene's time.integrator): explicit (symplectic Euler), implicit (backward Euler, Newton on the grid velocities), implicit-vertices (backward Euler on the vertices of a single yarn without the grid) or midpoint-vertices (generalized midpoint there); the last two only for one yarn with gamma = youngs_modulus = 0 and no walls: another scene is refused with fmi2Error at the end of initialization, the log naming the scene field; a Newton solve that fails in a step gives fmi2Discard"),
     var(Parameter, "scene", VR_SCENE, None, Start::Text(SCENE_FILE), "Scene file: a path relative to the FMU's resources folder, or absolute; it must create as many yarns as the bundled scene and have its pins (same number, same input pins)"),
     output("kinetic_energy", VR_KINETIC_ENERGY, Some("J/m"), "Kinetic energy (per m of depth)"),
     output("elastic_energy", VR_ELASTIC_ENERGY, Some("J/m"), "Elastic energy (per m of depth)"),
@@ -371,4 +372,23 @@ pub fn yarn_dependencies(scene: &YarnScene) -> Vec<Dependency> {
         }
     }
     d
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn choice_lists_are_the_refusals_words() {
+        assert_eq!(choice_list(&SCHEMES), "\"flip\" or \"apic\"");
+        assert_eq!(
+            choice_list(&INTEGRATORS),
+            "\"explicit\", \"implicit\", \"implicit-vertices\" or \"midpoint-vertices\""
+        );
+        for (name, i) in INTEGRATORS {
+            assert_eq!(parse_choice(&INTEGRATORS, name), Some(i));
+            assert_eq!(choice_name(&INTEGRATORS, i), name);
+        }
+        assert_eq!(parse_choice(&SCHEMES, "pic"), None);
+    }
 }
