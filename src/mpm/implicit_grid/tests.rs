@@ -139,6 +139,48 @@ fn rel(a: &[Vec2], b: &[Vec2]) -> f64 {
     dot(&d, &d).sqrt() / dot(b, b).sqrt()
 }
 
+/// The gradient of `p`'s energy at `v` by central differences, step `h`
+/// per component.
+fn fd_gradient(p: &Problem, v: &[Vec2], h: f64) -> Vec<Vec2> {
+    let mut fd = vec![Vec2::zeros(); v.len()];
+    for i in 0..v.len() {
+        for c in 0..2 {
+            let (mut a, mut b) = (v.to_vec(), v.to_vec());
+            a[i][c] += h;
+            b[i][c] -= h;
+            fd[i][c] = (p.energy(&a) - p.energy(&b)) / (2.0 * h);
+        }
+    }
+    fd
+}
+
+/// The Hessian-vector product `H d` of `p` at `v` by central differences
+/// of the gradient, step `h` along `d`.
+fn fd_hess_vec(p: &Problem, v: &[Vec2], d: &[Vec2], h: f64) -> Vec<Vec2> {
+    let a: Vec<Vec2> = v.iter().zip(d).map(|(v, d)| v + d * h).collect();
+    let b: Vec<Vec2> = v.iter().zip(d).map(|(v, d)| v - d * h).collect();
+    let (ga, gb) = (p.gradient(&a), p.gradient(&b));
+    ga.iter()
+        .zip(&gb)
+        .map(|(a, b)| (a - b) / (2.0 * h))
+        .collect()
+}
+
+/// Asserts that every entry of the 4x4 block `got` is within `tol` of
+/// `want`'s; `what` names the case in the message.
+fn assert_blocks_close(got: &[[f64; 4]; 4], want: &[[f64; 4]; 4], tol: f64, what: &str) {
+    for i in 0..4 {
+        for j in 0..4 {
+            assert!(
+                (got[i][j] - want[i][j]).abs() <= tol,
+                "{what} ({i}, {j}): {} vs {}",
+                got[i][j],
+                want[i][j]
+            );
+        }
+    }
+}
+
 #[test]
 fn stress_and_bending_gradient_are_the_explicit_force_laws() {
     let e = material();
@@ -233,15 +275,7 @@ fn gradient_matches_central_differences_of_the_energy() {
         let v = Rng::new(3).vec(p.len(), 2.0);
         let g = p.gradient(&v);
         let h = 1e-6;
-        let mut fd = vec![Vec2::zeros(); v.len()];
-        for i in 0..v.len() {
-            for c in 0..2 {
-                let (mut a, mut b) = (v.clone(), v.clone());
-                a[i][c] += h;
-                b[i][c] -= h;
-                fd[i][c] = (p.energy(&a) - p.energy(&b)) / (2.0 * h);
-            }
-        }
+        let fd = fd_gradient(&p, &v, h);
         // tolerance 1e-6 relative (central differences: O(h^2) plus round-off)
         let e = rel(&g, &fd);
         eprintln!("gradient vs central differences (attractor {attractor}): {e:.2e}");
@@ -270,15 +304,7 @@ fn hessian_vector_product_matches_central_differences_of_the_gradient() {
         "{r22:?}"
     );
     let d = r.vec(p.len(), 1.0);
-    let h = 1e-6;
-    let a: Vec<Vec2> = v.iter().zip(&d).map(|(v, d)| v + d * h).collect();
-    let b: Vec<Vec2> = v.iter().zip(&d).map(|(v, d)| v - d * h).collect();
-    let (ga, gb) = (p.gradient(&a), p.gradient(&b));
-    let fd: Vec<Vec2> = ga
-        .iter()
-        .zip(&gb)
-        .map(|(a, b)| (a - b) / (2.0 * h))
-        .collect();
+    let fd = fd_hess_vec(&p, &v, &d, 1e-6);
     let hd = p.hess_vec(&v, &d);
     // tolerance 1e-6 relative
     let e = rel(&hd, &fd);
@@ -458,16 +484,7 @@ fn spring_block_is_the_exact_and_the_projected_block() {
         for psd in [false, true] {
             let want = if psd { project_psd(&h) } else { h };
             let got = energy::spring_block(e.k, d, l0, vol, psd).unwrap();
-            for i in 0..4 {
-                for j in 0..4 {
-                    assert!(
-                        (got[i][j] - want[i][j]).abs() <= 1e-12 * scale,
-                        "psd {psd} ({i}, {j}): {} vs {}",
-                        got[i][j],
-                        want[i][j]
-                    );
-                }
-            }
+            assert_blocks_close(&got, &want, 1e-12 * scale, &format!("psd {psd}"));
         }
     }
     assert!(compressed > 50 && compressed < 150, "{compressed}");
@@ -511,16 +528,8 @@ fn closed_form_bending_projection_is_the_jacobi_projection() {
             project_psd(&h),
             project_bend(&h, e, bend_gradient_edges(e, b, k0, 1.0 / l0)),
         );
-        for i in 0..4 {
-            for j in 0..4 {
-                assert!(
-                    (got[i][j] - want[i][j]).abs() <= 1e-11 * scale,
-                    "joint {k} ({i}, {j}): {} vs {} (scale {scale:.3e})",
-                    got[i][j],
-                    want[i][j]
-                );
-            }
-        }
+        let what = format!("joint {k} (scale {scale:.3e})");
+        assert_blocks_close(&got, &want, 1e-11 * scale, &what);
     }
     eprintln!("{indefinite} of 100 joints far from rest with two negative eigenvalues");
     assert!(indefinite == 100, "{indefinite} of 100");
@@ -555,25 +564,11 @@ fn contact_terms_are_the_explicit_normal_law() {
     assert!(active > 1 && active < contacts.len(), "{active}");
     let g = p.gradient(&v);
     let h = 1e-6;
-    let mut fd = vec![Vec2::zeros(); v.len()];
-    for i in 0..v.len() {
-        for c in 0..2 {
-            let (mut a, mut b) = (v.clone(), v.clone());
-            a[i][c] += h;
-            b[i][c] -= h;
-            fd[i][c] = (p.energy(&a) - p.energy(&b)) / (2.0 * h);
-        }
-    }
+    let fd = fd_gradient(&p, &v, h);
     // tolerance 1e-6 relative, as for the elements
     assert!(rel(&g, &fd) < 1e-6, "{:.3e}", rel(&g, &fd));
     let d = r.vec(p.len(), 1.0);
-    let step = |s: f64| -> Vec<Vec2> { v.iter().zip(&d).map(|(v, d)| v + d * s).collect() };
-    let (ga, gb) = (p.gradient(&step(h)), p.gradient(&step(-h)));
-    let fd: Vec<Vec2> = ga
-        .iter()
-        .zip(&gb)
-        .map(|(a, b)| (a - b) / (2.0 * h))
-        .collect();
+    let fd = fd_hess_vec(&p, &v, &d, h);
     let hd = p.hess_vec(&v, &d);
     assert!(rel(&hd, &fd) < 1e-6, "{:.3e}", rel(&hd, &fd));
     // nodes without elements: the minimiser is the law, node by node
