@@ -4,6 +4,7 @@
 //! sheared and compressed (`r22 < 1`) quadrature particles, bent vertices
 //! and the attractor.
 
+use super::problem::Elements;
 use super::*;
 use crate::math::dual::jacobian;
 use crate::math::psd::{eigen_sym, project_psd, symmetrize};
@@ -96,11 +97,16 @@ fn problem(pinned: bool, attractor: bool) -> Problem {
             end: bend_terms.len() as u32,
         });
     }
-    let attractor = attractor.then(|| AttractorTerm {
-        position: Vec2::new(0.5, 0.5),
-        strength: 30.0,
-        x: (0..nn).map(|_| Vec2::new(r.unit(), r.unit())).collect(),
-    });
+    let model = Model {
+        energy: material(),
+        bending: 1e-3,
+        attractor: attractor.then_some((Vec2::new(0.5, 0.5), 30.0)),
+    };
+    let node_x = if attractor {
+        (0..nn).map(|_| Vec2::new(r.unit(), r.unit())).collect()
+    } else {
+        Vec::new()
+    };
     let rows = if pinned {
         let mut w = Weights {
             node: [NONE; 9],
@@ -114,23 +120,15 @@ fn problem(pinned: bool, attractor: bool) -> Problem {
     } else {
         Vec::new()
     };
-    let mut p = Problem {
-        nodes: (0..nn).collect(),
-        mass: (0..nn).map(|_| 1e-3 * (0.5 + r.unit())).collect(),
-        vstar: r.vec(nn, 1.0),
-        dt,
-        energy: material(),
-        bending: 1e-3,
+    let mass = (0..nn).map(|_| 1e-3 * (0.5 + r.unit())).collect();
+    let elements = Elements {
         quads,
         quad_terms,
         bends,
         bend_terms,
-        attractor,
-        contacts: Vec::new(),
-        rows,
-        chol: Default::default(),
     };
-    p.factor();
+    let mut p = Problem::assemble((0..nn).collect(), mass, dt, &model, node_x, elements, rows);
+    p.vstar = r.vec(nn, 1.0);
     p
 }
 
