@@ -11,8 +11,49 @@
 
 pub use yarnsim_oracles::{bessel_j0, extensible_chain_omega, J0_FIRST_ZERO};
 
+use proptest::prelude::Rng as _;
+use proptest::test_runner::{RngAlgorithm, TestRng};
+
+use crate::math::Vec2;
+
 use crate::scene::builtin::yarn_reference;
 use crate::scene::{Integrator, Material, Obstacle, StepSize, YarnScene, YarnSpec};
+
+/// The one seeded generator of the tests (the library's unit tests and
+/// the integration tests): proptest's ChaCha [`TestRng`], whose draws are
+/// the same on every system and proptest 1 version, seeded with `seed`.
+pub struct Rng(TestRng);
+
+impl Rng {
+    /// The generator seeded with `seed` (its little-endian bytes, then zeros).
+    pub fn new(seed: u64) -> Self {
+        let mut bytes = [0u8; 32];
+        bytes[..8].copy_from_slice(&seed.to_le_bytes());
+        Rng(TestRng::from_seed(RngAlgorithm::ChaCha, &bytes))
+    }
+    /// The next 64 random bits.
+    pub fn next_u64(&mut self) -> u64 {
+        self.0.next_u64()
+    }
+    /// Uniform in [0, 1) (53 bits).
+    pub fn unit(&mut self) -> f64 {
+        (self.next_u64() >> 11) as f64 / (1u64 << 53) as f64
+    }
+    /// Uniform in [lo, hi).
+    pub fn uniform(&mut self, lo: f64, hi: f64) -> f64 {
+        lo + (hi - lo) * self.unit()
+    }
+    /// Uniform in [-s/2, s/2).
+    pub fn sym(&mut self, s: f64) -> f64 {
+        s * (self.unit() - 0.5)
+    }
+    /// `n` vectors of components uniform in [-s/2, s/2).
+    pub fn vec(&mut self, n: usize, s: f64) -> Vec<Vec2> {
+        (0..n)
+            .map(|_| Vec2::new(self.sym(s), self.sym(s)))
+            .collect()
+    }
+}
 
 /// The material of the reference scene (`yarn-reference`).
 pub fn reference_material() -> Material {

@@ -54,6 +54,23 @@ pub enum SceneError {
     },
 }
 
+/// The rest of a scene error's message: ` at line L` and `` in field `K` ``
+/// where known, then `: message`.
+fn write_place(
+    f: &mut fmt::Formatter<'_>,
+    line: Option<usize>,
+    field: Option<&str>,
+    message: &str,
+) -> fmt::Result {
+    if let Some(l) = line {
+        write!(f, " at line {l}")?;
+    }
+    if let Some(k) = field {
+        write!(f, " in field `{k}`")?;
+    }
+    write!(f, ": {message}")
+}
+
 impl fmt::Display for SceneError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
@@ -66,13 +83,7 @@ impl fmt::Display for SceneError {
                 message,
             } => {
                 write!(f, "scene error")?;
-                if let Some(l) = line {
-                    write!(f, " at line {l}")?;
-                }
-                if let Some(k) = field {
-                    write!(f, " in field `{k}`")?;
-                }
-                write!(f, ": {message}")
+                write_place(f, *line, field.as_deref(), message)
             }
             SceneError::Invalid {
                 field,
@@ -80,10 +91,7 @@ impl fmt::Display for SceneError {
                 message,
             } => {
                 write!(f, "scene error")?;
-                if let Some(l) = line {
-                    write!(f, " at line {l}")?;
-                }
-                write!(f, " in field `{field}`: {message}")
+                write_place(f, *line, Some(field), message)
             }
             SceneError::Override {
                 argument,
@@ -92,10 +100,7 @@ impl fmt::Display for SceneError {
                 message,
             } => {
                 write!(f, "scene error in --set argument {argument} (`{text}`)")?;
-                if let Some(k) = field {
-                    write!(f, " in field `{k}`")?;
-                }
-                write!(f, ": {message}")
+                write_place(f, None, field.as_deref(), message)
             }
             SceneError::UnknownScene { name, known } => {
                 write!(

@@ -10,26 +10,9 @@ use yarnsim::scene::{
 use yarnsim::testing::Capstan;
 use yarnsim::YarnSim;
 
-/// A small deterministic generator (xorshift64*), so tests need no `rand`.
-pub struct Rng(u64);
-
-impl Rng {
-    pub fn new(seed: u64) -> Self {
-        Rng(seed.wrapping_mul(0x9E3779B97F4A7C15) | 1)
-    }
-    pub fn next_u64(&mut self) -> u64 {
-        let mut x = self.0;
-        x ^= x >> 12;
-        x ^= x << 25;
-        x ^= x >> 27;
-        self.0 = x;
-        x.wrapping_mul(0x2545F4914F6CDD1D)
-    }
-    /// Uniform in [lo, hi).
-    pub fn uniform(&mut self, lo: f64, hi: f64) -> f64 {
-        lo + (hi - lo) * ((self.next_u64() >> 11) as f64 / (1u64 << 53) as f64)
-    }
-}
+/// The seeded generator of the tests (proptest's ChaCha `TestRng`).
+#[allow(unused_imports)] // not every test uses it
+pub use yarnsim::testing::Rng;
 
 /// The scale of momentum errors: `sum m |v|` over every particle.
 pub fn momentum_scale(sim: &YarnSim) -> f64 {

@@ -17,6 +17,8 @@
 //! (unchanged: normal law, pooled Coulomb friction, walls) returns them
 //! and pools its friction over the normal impulse the solve delivered.
 
+use super::stats::Passes;
+use super::substep::grid_forces;
 use super::{SimError, YarnSim};
 use crate::math::Vec2;
 use crate::mpm::explicit::grid_update::{self, GridForces};
@@ -24,7 +26,6 @@ use crate::mpm::implicit_grid::{self, ContactTerm, Model, Problem};
 use crate::mpm::laws::contact::normal_share;
 use crate::mpm::laws::pins::PinEntry;
 use crate::mpm::machinery::grid::{Grid, BLOCK};
-use crate::scene::Obstacle;
 
 /// Cost of the implicit substeps (`[time] integrator = "implicit"`) since
 /// the start, the attempts that a cutback undid included
@@ -139,32 +140,14 @@ impl YarnSim {
         dt: f64,
         flip: bool,
         pin_entries: &[PinEntry],
+        passes: Passes,
     ) -> Result<(), SimError> {
-        let passes = self.passes();
-        let obstacles: &[Obstacle] = if passes.obstacles {
-            &self.scene.obstacles
-        } else {
-            &[]
-        };
-        let bending = if passes.bending {
-            self.scene.material.bending
-        } else {
-            0.0
-        };
         // the attractor is a term of the solve, not a force of the update
-        let ext = GridForces {
-            gravity: self.gravity,
-            attractor: None,
-            obstacles,
-            walls: self.scene.walls.mode,
-            wall_cells: self.scene.walls.cells as usize,
-        };
+        let ext = grid_forces(&self.scene, passes, self.gravity, None);
         let model = Model {
             energy: self.energy,
-            bending,
-            attractor: passes
-                .attractor
-                .then_some((self.attractor.position, self.attractor.strength)),
+            bending: self.active_bending(passes),
+            attractor: self.active_attractor(passes),
         };
         let mut problems = self.implicit_problems(&model, dt, pin_entries);
         // v* without obstacles and walls; they act on the solved velocities

@@ -19,11 +19,12 @@
 
 use std::time::Instant;
 
+use super::substep::active_obstacles;
 use super::{SimError, YarnSim};
 use crate::math::{Mat2, Vec2};
 use crate::mpm::implicit_vertex::{self, Rod, Settings};
 use crate::mpm::laws::contact::project_out;
-use crate::scene::{Integrator, Obstacle};
+use crate::scene::Integrator;
 
 /// The `theta` of `"midpoint-vertices"`.
 pub const THETA: f64 = 0.55;
@@ -47,15 +48,9 @@ impl YarnSim {
             vstar: p.vert.v.iter().map(|v| v + self.gravity * dt).collect(),
             dt,
             segments,
-            bending: if passes.bending {
-                self.scene.material.bending
-            } else {
-                0.0
-            },
+            bending: self.active_bending(passes),
             bend: p.vert.bend.clone(),
-            attractor: passes
-                .attractor
-                .then_some((self.attractor.position, self.attractor.strength)),
+            attractor: self.active_attractor(passes),
         }
     }
 
@@ -76,12 +71,7 @@ impl YarnSim {
                 fixed[i] = Some((x - rod.x[i]) / dt);
             }
         }
-        let empty: [Obstacle; 0] = [];
-        let obstacles: &[Obstacle] = if self.passes().obstacles {
-            &self.scene.obstacles
-        } else {
-            &empty
-        };
+        let obstacles = active_obstacles(&self.scene, self.passes());
         let settings = Settings::default();
         let out = match implicit_vertex::step(&rod, &fixed, obstacles, dt, &settings) {
             Ok(out) => out,

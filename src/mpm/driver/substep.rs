@@ -8,17 +8,63 @@
 
 use std::time::Instant;
 
+use super::stats::Passes;
 use super::{SimError, YarnSim};
+use crate::math::Vec2;
 use crate::mpm::explicit::grid_to_particle::{self, VertexGather};
 use crate::mpm::explicit::grid_update::{self, GridForces};
 use crate::mpm::explicit::particle_to_grid;
 use crate::mpm::laws::pins::{self, PinEntry};
 use crate::mpm::machinery::spin;
-use crate::scene::{Integrator, Obstacle};
+use crate::scene::{Integrator, Obstacle, YarnScene};
+
+/// The scene's obstacles when their pass runs, none otherwise.
+pub(super) fn active_obstacles(scene: &YarnScene, passes: Passes) -> &[Obstacle] {
+    if passes.obstacles {
+        &scene.obstacles
+    } else {
+        &[]
+    }
+}
+
+/// The grid update's external forces: gravity, `attractor`, the active
+/// obstacles and the walls.
+pub(super) fn grid_forces(
+    scene: &YarnScene,
+    passes: Passes,
+    gravity: Vec2,
+    attractor: Option<(Vec2, f64)>,
+) -> GridForces<'_> {
+    GridForces {
+        gravity,
+        attractor,
+        obstacles: active_obstacles(scene, passes),
+        walls: scene.walls.mode,
+        wall_cells: scene.walls.cells as usize,
+    }
+}
+
+impl YarnSim {
+    /// The bending stiffness when its pass runs, 0 otherwise.
+    pub(super) fn active_bending(&self, passes: Passes) -> f64 {
+        if passes.bending {
+            self.scene.material.bending
+        } else {
+            0.0
+        }
+    }
+
+    /// `(position, strength)` of the attractor when its pass runs.
+    pub(super) fn active_attractor(&self, passes: Passes) -> Option<(Vec2, f64)> {
+        passes
+            .attractor
+            .then_some((self.attractor.position, self.attractor.strength))
+    }
+}
 
 /// The grid velocities of a grid integrator's substep, between the scatter
-/// and the field contact: `(sim, dt, flip, pin entries)`.
-type GridVelocities = fn(&mut YarnSim, f64, bool, &[PinEntry]) -> Result<(), SimError>;
+/// and the field contact: `(sim, dt, flip, pin entries, passes)`.
+type GridVelocities = fn(&mut YarnSim, f64, bool, &[PinEntry], Passes) -> Result<(), SimError>;
 
 impl YarnSim {
     /// One substep of `dt` (finite, > 0; not failed before) by the scene's
@@ -46,22 +92,10 @@ impl YarnSim {
         dt: f64,
         flip: bool,
         pin_entries: &[PinEntry],
+        passes: Passes,
     ) -> Result<(), SimError> {
-        let passes = self.passes();
-        let obstacles: &[Obstacle] = if passes.obstacles {
-            &self.scene.obstacles
-        } else {
-            &[]
-        };
-        let ext = GridForces {
-            gravity: self.gravity,
-            attractor: passes
-                .attractor
-                .then_some((self.attractor.position, self.attractor.strength)),
-            obstacles,
-            walls: self.scene.walls.mode,
-            wall_cells: self.scene.walls.cells as usize,
-        };
+        let attractor = self.active_attractor(passes);
+        let ext = grid_forces(&self.scene, passes, self.gravity, attractor);
         if let Some(f) = &mut self.fields {
             f.record_masses(&self.grid);
             grid_update::grid_update(&mut f.grid, dt, &ext, flip);
@@ -89,11 +123,7 @@ impl YarnSim {
         grid_velocities: GridVelocities,
     ) -> Result<(), SimError> {
         let passes = self.passes();
-        let bending = if passes.bending {
-            self.scene.material.bending
-        } else {
-            0.0
-        };
+        let bending = self.active_bending(passes);
         let transfer = self.transfer;
         let flip = transfer.needs_delta();
         let t0 = Instant::now();
@@ -113,11 +143,7 @@ impl YarnSim {
             held,
             dt,
             bending,
-            if passes.obstacles {
-                &self.scene.obstacles
-            } else {
-                &[]
-            },
+            active_obstacles(&self.scene, passes),
             scatter_forces,
         );
         let t2 = Instant::now();
@@ -127,7 +153,7 @@ impl YarnSim {
             let held = self.fields.as_ref().map_or(&self.grid, |f| &f.grid);
             pins::stencil_masses(&self.pins, &self.particles.vert, held, self.time + dt)
         };
-        grid_velocities(self, dt, flip, &pin_entries)?;
+        grid_velocities(self, dt, flip, &pin_entries, passes)?;
         if let Some(f) = &mut self.fields {
             let mu = self.scene.material.friction;
             f.contact(
@@ -138,11 +164,7 @@ impl YarnSim {
                 &mut self.pin_reactions,
             );
         }
-        let obstacles: &[Obstacle] = if passes.obstacles {
-            &self.scene.obstacles
-        } else {
-            &[]
-        };
+        let obstacles = active_obstacles(&self.scene, passes);
         let held = self
             .fields
             .as_ref()

@@ -214,13 +214,13 @@ fn solve_band(l: &[f64], n: usize, bw: usize, w: usize, b: &mut [f64]) {
 
 #[cfg(test)]
 mod tests {
-    use super::super::tests::Lcg;
     use super::*;
+    use crate::testing::Rng;
 
     /// `groups` yarns of `per` segments each over `nodes` nodes; segment
     /// `s` of a yarn touches the nodes `offset + 2 s .. + 6` (neighbours
     /// share nodes, as on the grid), yarn `g` starts at `g * shift`.
-    fn rows(r: &mut Lcg, groups: usize, per: usize, shift: usize) -> (Vec<StiffRow>, usize) {
+    fn rows(r: &mut Rng, groups: usize, per: usize, shift: usize) -> (Vec<StiffRow>, usize) {
         let mut out = Vec::new();
         let mut nodes = 0;
         for g in 0..groups {
@@ -229,13 +229,13 @@ mod tests {
                     .map(|k| {
                         let i = g * shift + 2 * s + k;
                         nodes = nodes.max(i + 1);
-                        (i as u32, Vec2::new(r.next() - 0.5, r.next() - 0.5))
+                        (i as u32, Vec2::new(r.unit() - 0.5, r.unit() - 0.5))
                     })
                     .collect();
                 out.push(StiffRow {
                     group: g as u32,
                     entries,
-                    c: 10f64.powf(4.0 * r.next()),
+                    c: 10f64.powf(4.0 * r.unit()),
                 });
             }
         }
@@ -275,10 +275,10 @@ mod tests {
     }
 
     fn setup(seed: u64, groups: usize, shift: usize) -> (Vec<Vec2>, Vec<StiffRow>) {
-        let mut r = Lcg(seed);
+        let mut r = Rng::new(seed);
         let (rows, nodes) = rows(&mut r, groups, 12, shift);
         let d = (0..nodes)
-            .map(|_| Vec2::new(0.1 + r.next(), 0.1 + r.next()))
+            .map(|_| Vec2::new(0.1 + r.unit(), 0.1 + r.unit()))
             .collect();
         (d, rows)
     }
@@ -290,9 +290,9 @@ mod tests {
         let (d, rows) = setup(3, 1, 0);
         let p = StiffPrecond::new(&d, &rows);
         let a = dense(&d, &rows);
-        let mut r = Lcg(9);
+        let mut r = Rng::new(9);
         let x: Vec<Vec2> = (0..d.len())
-            .map(|_| Vec2::new(r.next() - 0.5, r.next() - 0.5))
+            .map(|_| Vec2::new(r.unit() - 0.5, r.unit() - 0.5))
             .collect();
         let ax = mat_vec(&a, &x);
         let mut z = vec![Vec2::zeros(); d.len()];
@@ -313,11 +313,11 @@ mod tests {
     fn symmetric_positive_definite_with_shared_nodes() {
         let (d, rows) = setup(5, 3, 3);
         let p = StiffPrecond::new(&d, &rows);
-        let mut r = Lcg(11);
+        let mut r = Rng::new(11);
         let mut vecs = Vec::new();
         for _ in 0..20 {
             let x: Vec<Vec2> = (0..d.len())
-                .map(|_| Vec2::new(r.next() - 0.5, r.next() - 0.5))
+                .map(|_| Vec2::new(r.unit() - 0.5, r.unit() - 0.5))
                 .collect();
             let mut z = vec![Vec2::zeros(); d.len()];
             p.apply(&x, &mut z);

@@ -94,6 +94,15 @@ pub struct ContactTerm {
     pub w: f64,
 }
 
+/// A problem's elements: the quadrature particles' and the bent vertices',
+/// each with its node terms.
+pub(super) struct Elements {
+    pub(super) quads: Vec<QuadElem>,
+    pub(super) quad_terms: Vec<QuadTerm>,
+    pub(super) bends: Vec<BendElem>,
+    pub(super) bend_terms: Vec<BendTerm>,
+}
+
 /// The energy the implicit step minimises, as the substep passes it.
 #[derive(Clone, Copy, Debug)]
 pub struct Model {
@@ -281,12 +290,39 @@ impl Problem {
                 (w, e.target, e.pin)
             })
             .collect();
+        let elements = Elements {
+            quads,
+            quad_terms,
+            bends,
+            bend_terms,
+        };
+        Problem::assemble(nodes, mass, dt, model, node_x, elements, rows)
+    }
+
+    /// The problem of `elements` on `nodes` (masses `mass`, node positions
+    /// `node_x` for the attractor), `v*` zero until it is read, no
+    /// contacts, its pin rows factored.
+    pub(super) fn assemble(
+        nodes: Vec<usize>,
+        mass: Vec<f64>,
+        dt: f64,
+        model: &Model,
+        node_x: Vec<Vec2>,
+        elements: Elements,
+        rows: Vec<(Weights, Vec2, usize)>,
+    ) -> Self {
         let attractor = model.attractor.map(|(position, strength)| AttractorTerm {
             position,
             strength,
             x: node_x,
         });
         let vstar = vec![Vec2::zeros(); nodes.len()];
+        let Elements {
+            quads,
+            quad_terms,
+            bends,
+            bend_terms,
+        } = elements;
         let mut prob = Problem {
             nodes,
             mass,

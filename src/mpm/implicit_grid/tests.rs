@@ -4,6 +4,7 @@
 //! sheared and compressed (`r22 < 1`) quadrature particles, bent vertices
 //! and the attractor.
 
+use super::problem::Elements;
 use super::*;
 use crate::math::dual::jacobian;
 use crate::math::psd::{eigen_sym, project_psd, symmetrize};
@@ -13,26 +14,7 @@ use crate::mpm::laws::bending::{bend_gradient, bend_gradient_edges, project_bend
 use crate::mpm::laws::constitutive::frame_gradient;
 use crate::mpm::laws::constitutive::{quad_gradient, stress};
 use crate::mpm::machinery::particles::NONE;
-
-/// A small deterministic generator (LCG) of numbers in [0, 1).
-pub(super) struct Lcg(pub u64);
-impl Lcg {
-    pub(super) fn next(&mut self) -> f64 {
-        self.0 = self
-            .0
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        (self.0 >> 11) as f64 / (1u64 << 53) as f64
-    }
-    fn sym(&mut self, s: f64) -> f64 {
-        s * (self.next() - 0.5)
-    }
-    fn vec(&mut self, n: usize, s: f64) -> Vec<Vec2> {
-        (0..n)
-            .map(|_| Vec2::new(self.sym(s), self.sym(s)))
-            .collect()
-    }
-}
+use crate::testing::Rng;
 
 /// The built-in material's constants.
 fn material() -> YarnEnergy {
@@ -55,7 +37,7 @@ fn frame(a: f64, r11: f64, r12: f64, r22: f64) -> Mat2 {
 /// pin on the first quadrature particle's terms when `pinned`; every
 /// element's terms on random nodes.
 fn problem(pinned: bool, attractor: bool) -> Problem {
-    let mut r = Lcg(7);
+    let mut r = Rng::new(7);
     let nn = 30;
     let (l0, dt) = (0.05, 1e-2);
     let states = [
@@ -115,11 +97,16 @@ fn problem(pinned: bool, attractor: bool) -> Problem {
             end: bend_terms.len() as u32,
         });
     }
-    let attractor = attractor.then(|| AttractorTerm {
-        position: Vec2::new(0.5, 0.5),
-        strength: 30.0,
-        x: (0..nn).map(|_| Vec2::new(r.next(), r.next())).collect(),
-    });
+    let model = Model {
+        energy: material(),
+        bending: 1e-3,
+        attractor: attractor.then_some((Vec2::new(0.5, 0.5), 30.0)),
+    };
+    let node_x = if attractor {
+        (0..nn).map(|_| Vec2::new(r.unit(), r.unit())).collect()
+    } else {
+        Vec::new()
+    };
     let rows = if pinned {
         let mut w = Weights {
             node: [NONE; 9],
@@ -133,23 +120,15 @@ fn problem(pinned: bool, attractor: bool) -> Problem {
     } else {
         Vec::new()
     };
-    let mut p = Problem {
-        nodes: (0..nn).collect(),
-        mass: (0..nn).map(|_| 1e-3 * (0.5 + r.next())).collect(),
-        vstar: r.vec(nn, 1.0),
-        dt,
-        energy: material(),
-        bending: 1e-3,
+    let mass = (0..nn).map(|_| 1e-3 * (0.5 + r.unit())).collect();
+    let elements = Elements {
         quads,
         quad_terms,
         bends,
         bend_terms,
-        attractor,
-        contacts: Vec::new(),
-        rows,
-        chol: Default::default(),
     };
-    p.factor();
+    let mut p = Problem::assemble((0..nn).collect(), mass, dt, &model, node_x, elements, rows);
+    p.vstar = r.vec(nn, 1.0);
     p
 }
 
@@ -158,10 +137,52 @@ fn rel(a: &[Vec2], b: &[Vec2]) -> f64 {
     dot(&d, &d).sqrt() / dot(b, b).sqrt()
 }
 
+/// The gradient of `p`'s energy at `v` by central differences, step `h`
+/// per component.
+fn fd_gradient(p: &Problem, v: &[Vec2], h: f64) -> Vec<Vec2> {
+    let mut fd = vec![Vec2::zeros(); v.len()];
+    for i in 0..v.len() {
+        for c in 0..2 {
+            let (mut a, mut b) = (v.to_vec(), v.to_vec());
+            a[i][c] += h;
+            b[i][c] -= h;
+            fd[i][c] = (p.energy(&a) - p.energy(&b)) / (2.0 * h);
+        }
+    }
+    fd
+}
+
+/// The Hessian-vector product `H d` of `p` at `v` by central differences
+/// of the gradient, step `h` along `d`.
+fn fd_hess_vec(p: &Problem, v: &[Vec2], d: &[Vec2], h: f64) -> Vec<Vec2> {
+    let a: Vec<Vec2> = v.iter().zip(d).map(|(v, d)| v + d * h).collect();
+    let b: Vec<Vec2> = v.iter().zip(d).map(|(v, d)| v - d * h).collect();
+    let (ga, gb) = (p.gradient(&a), p.gradient(&b));
+    ga.iter()
+        .zip(&gb)
+        .map(|(a, b)| (a - b) / (2.0 * h))
+        .collect()
+}
+
+/// Asserts that every entry of the 4x4 block `got` is within `tol` of
+/// `want`'s; `what` names the case in the message.
+fn assert_blocks_close(got: &[[f64; 4]; 4], want: &[[f64; 4]; 4], tol: f64, what: &str) {
+    for i in 0..4 {
+        for j in 0..4 {
+            assert!(
+                (got[i][j] - want[i][j]).abs() <= tol,
+                "{what} ({i}, {j}): {} vs {}",
+                got[i][j],
+                want[i][j]
+            );
+        }
+    }
+}
+
 #[test]
 fn stress_and_bending_gradient_are_the_explicit_force_laws() {
     let e = material();
-    let mut r = Lcg(1);
+    let mut r = Rng::new(1);
     let mut worst: f64 = 0.0;
     let mut compressed = 0;
     for k in 0..2000 {
@@ -170,15 +191,15 @@ fn stress_and_bending_gradient_are_the_explicit_force_laws() {
         let g = if k % 2 == 0 {
             frame(
                 r.sym(7.0),
-                0.5 + r.next(),
+                0.5 + r.unit(),
                 r.sym(1.0),
-                1.2 * r.next() - 0.05,
+                1.2 * r.unit() - 0.05,
             )
         } else {
             Mat2::new(r.sym(3.0), r.sym(3.0), r.sym(3.0), r.sym(3.0))
         };
         compressed += (qr(&g).r22 < 1.0) as usize;
-        let (l0, vol) = (0.01 + r.next(), 0.1 + r.next());
+        let (l0, vol) = (0.01 + r.unit(), 0.1 + r.unit());
         let d = g * l0;
         let (t1, t2) = frame_gradient(&e, &d, l0, vol);
         let t = quad_gradient(&e, [d[(0, 0)], d[(1, 0)], d[(0, 1)], d[(1, 1)]], l0, vol);
@@ -249,18 +270,10 @@ fn stress_and_bending_gradient_are_the_explicit_force_laws() {
 fn gradient_matches_central_differences_of_the_energy() {
     for attractor in [false, true] {
         let p = problem(false, attractor);
-        let v = Lcg(3).vec(p.len(), 2.0);
+        let v = Rng::new(3).vec(p.len(), 2.0);
         let g = p.gradient(&v);
         let h = 1e-6;
-        let mut fd = vec![Vec2::zeros(); v.len()];
-        for i in 0..v.len() {
-            for c in 0..2 {
-                let (mut a, mut b) = (v.clone(), v.clone());
-                a[i][c] += h;
-                b[i][c] -= h;
-                fd[i][c] = (p.energy(&a) - p.energy(&b)) / (2.0 * h);
-            }
-        }
+        let fd = fd_gradient(&p, &v, h);
         // tolerance 1e-6 relative (central differences: O(h^2) plus round-off)
         let e = rel(&g, &fd);
         eprintln!("gradient vs central differences (attractor {attractor}): {e:.2e}");
@@ -276,7 +289,7 @@ fn gradient_matches_central_differences_of_the_energy() {
 #[test]
 fn hessian_vector_product_matches_central_differences_of_the_gradient() {
     let p = problem(false, true);
-    let mut r = Lcg(5);
+    let mut r = Rng::new(5);
     let v = r.vec(p.len(), 2.0);
     // every kind of state is present at v
     let fr = p.frames(&v);
@@ -289,15 +302,7 @@ fn hessian_vector_product_matches_central_differences_of_the_gradient() {
         "{r22:?}"
     );
     let d = r.vec(p.len(), 1.0);
-    let h = 1e-6;
-    let a: Vec<Vec2> = v.iter().zip(&d).map(|(v, d)| v + d * h).collect();
-    let b: Vec<Vec2> = v.iter().zip(&d).map(|(v, d)| v - d * h).collect();
-    let (ga, gb) = (p.gradient(&a), p.gradient(&b));
-    let fd: Vec<Vec2> = ga
-        .iter()
-        .zip(&gb)
-        .map(|(a, b)| (a - b) / (2.0 * h))
-        .collect();
+    let fd = fd_hess_vec(&p, &v, &d, 1e-6);
     let hd = p.hess_vec(&v, &d);
     // tolerance 1e-6 relative
     let e = rel(&hd, &fd);
@@ -337,14 +342,14 @@ fn hessian_vector_product_matches_central_differences_of_the_gradient() {
 #[test]
 fn psd_projection_keeps_pd_blocks_and_removes_negative_curvature() {
     let e = material();
-    let mut r = Lcg(9);
+    let mut r = Rng::new(9);
     let (mut pd, mut indefinite) = (0, 0);
     for k in 0..400 {
         let g = frame(
             r.sym(7.0),
-            0.8 + 0.4 * r.next(),
+            0.8 + 0.4 * r.unit(),
             r.sym(0.6),
-            0.8 + 0.3 * r.next(),
+            0.8 + 0.3 * r.unit(),
         );
         let l0 = 0.05;
         let d = g * l0;
@@ -411,7 +416,7 @@ fn pin_projection_keeps_the_pins_and_solve_reaches_the_constrained_minimum() {
     ];
     for (psd, precond) in cases {
         let p = problem(true, true);
-        let mut r = Lcg(11);
+        let mut r = Rng::new(11);
         let mut x = r.vec(p.len(), 1.0);
         p.project(&mut x);
         // A Pi x = 0 to round-off
@@ -439,7 +444,7 @@ fn pin_projection_keeps_the_pins_and_solve_reaches_the_constrained_minimum() {
         // no feasible neighbour is lower
         let e = p.energy(&sol.v);
         for k in 0..20 {
-            let mut d = Lcg(100 + k).vec(p.len(), 1e-3);
+            let mut d = Rng::new(100 + k).vec(p.len(), 1e-3);
             p.project(&mut d);
             let t: Vec<Vec2> = sol.v.iter().zip(&d).map(|(v, d)| v + d).collect();
             assert!(p.energy(&t) >= e, "a feasible neighbour is lower");
@@ -463,12 +468,12 @@ fn spring_block_is_the_exact_and_the_projected_block() {
         normal: 0.0,
         friction: 0.0,
     };
-    let mut r = Lcg(5);
+    let mut r = Rng::new(5);
     let (l0, vol) = (0.01, 1e-4);
     let mut compressed = 0;
     for _ in 0..200 {
         let a = r.sym(7.0);
-        let len = l0 * (0.5 + r.next());
+        let len = l0 * (0.5 + r.unit());
         compressed += (len < l0) as usize;
         let d = [len * a.cos(), len * a.sin(), r.sym(0.02), r.sym(0.02)];
         let mut h = jacobian(d, |d| quad_gradient(&e, d, l0, vol));
@@ -477,16 +482,7 @@ fn spring_block_is_the_exact_and_the_projected_block() {
         for psd in [false, true] {
             let want = if psd { project_psd(&h) } else { h };
             let got = energy::spring_block(e.k, d, l0, vol, psd).unwrap();
-            for i in 0..4 {
-                for j in 0..4 {
-                    assert!(
-                        (got[i][j] - want[i][j]).abs() <= 1e-12 * scale,
-                        "psd {psd} ({i}, {j}): {} vs {}",
-                        got[i][j],
-                        want[i][j]
-                    );
-                }
-            }
+            assert_blocks_close(&got, &want, 1e-12 * scale, &format!("psd {psd}"));
         }
     }
     assert!(compressed > 50 && compressed < 150, "{compressed}");
@@ -500,12 +496,12 @@ fn spring_block_is_the_exact_and_the_projected_block() {
 /// eigenvalues (one per invariant plane).
 #[test]
 fn closed_form_bending_projection_is_the_jacobi_projection() {
-    let mut r = Lcg(13);
+    let mut r = Rng::new(13);
     let (b, l0) = (1e-3, 0.02);
     let mut indefinite = 0;
     for k in 0..300 {
         let (a, turn) = (r.sym(7.0), r.sym(4.0));
-        let (n1, n2) = (l0 * (0.5 + r.next()), l0 * (0.5 + r.next()));
+        let (n1, n2) = (l0 * (0.5 + r.unit()), l0 * (0.5 + r.unit()));
         let e = [
             n1 * a.cos(),
             n1 * a.sin(),
@@ -530,16 +526,8 @@ fn closed_form_bending_projection_is_the_jacobi_projection() {
             project_psd(&h),
             project_bend(&h, e, bend_gradient_edges(e, b, k0, 1.0 / l0)),
         );
-        for i in 0..4 {
-            for j in 0..4 {
-                assert!(
-                    (got[i][j] - want[i][j]).abs() <= 1e-11 * scale,
-                    "joint {k} ({i}, {j}): {} vs {} (scale {scale:.3e})",
-                    got[i][j],
-                    want[i][j]
-                );
-            }
-        }
+        let what = format!("joint {k} (scale {scale:.3e})");
+        assert_blocks_close(&got, &want, 1e-11 * scale, &what);
     }
     eprintln!("{indefinite} of 100 joints far from rest with two negative eigenvalues");
     assert!(indefinite == 100, "{indefinite} of 100");
@@ -553,15 +541,15 @@ fn closed_form_bending_projection_is_the_jacobi_projection() {
 #[test]
 fn contact_terms_are_the_explicit_normal_law() {
     let mut p = problem(false, false);
-    let mut r = Lcg(11);
+    let mut r = Rng::new(11);
     let contacts: Vec<ContactTerm> = (0..p.len())
         .step_by(3)
         .map(|i| {
-            let a = 6.0 * r.next();
+            let a = 6.0 * r.unit();
             ContactTerm {
                 node: i as u32,
                 n: Vec2::new(a.cos(), a.sin()),
-                w: 5.0 * r.next() * p.mass[i],
+                w: 5.0 * r.unit() * p.mass[i],
             }
         })
         .collect();
@@ -574,25 +562,11 @@ fn contact_terms_are_the_explicit_normal_law() {
     assert!(active > 1 && active < contacts.len(), "{active}");
     let g = p.gradient(&v);
     let h = 1e-6;
-    let mut fd = vec![Vec2::zeros(); v.len()];
-    for i in 0..v.len() {
-        for c in 0..2 {
-            let (mut a, mut b) = (v.clone(), v.clone());
-            a[i][c] += h;
-            b[i][c] -= h;
-            fd[i][c] = (p.energy(&a) - p.energy(&b)) / (2.0 * h);
-        }
-    }
+    let fd = fd_gradient(&p, &v, h);
     // tolerance 1e-6 relative, as for the elements
     assert!(rel(&g, &fd) < 1e-6, "{:.3e}", rel(&g, &fd));
     let d = r.vec(p.len(), 1.0);
-    let step = |s: f64| -> Vec<Vec2> { v.iter().zip(&d).map(|(v, d)| v + d * s).collect() };
-    let (ga, gb) = (p.gradient(&step(h)), p.gradient(&step(-h)));
-    let fd: Vec<Vec2> = ga
-        .iter()
-        .zip(&gb)
-        .map(|(a, b)| (a - b) / (2.0 * h))
-        .collect();
+    let fd = fd_hess_vec(&p, &v, &d, h);
     let hd = p.hess_vec(&v, &d);
     assert!(rel(&hd, &fd) < 1e-6, "{:.3e}", rel(&hd, &fd));
     // nodes without elements: the minimiser is the law, node by node

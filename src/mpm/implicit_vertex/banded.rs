@@ -110,6 +110,7 @@ impl Banded {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::testing::Rng;
 
     /// A random SPD band matrix (diagonally dominant) solved against its
     /// own product: the residual to 1e-12 relative.
@@ -117,13 +118,8 @@ mod tests {
     fn factor_and_solve_reproduce_the_right_hand_side() {
         let (n, w) = (37, 5);
         let mut a = Banded::zeros(n, w);
-        let mut seed = 12345u64;
-        let mut rnd = || {
-            seed = seed
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            ((seed >> 11) as f64 / (1u64 << 53) as f64) - 0.5
-        };
+        let mut r = Rng::new(12345);
+        let mut rnd = || r.unit() - 0.5;
         for i in 0..n {
             for j in i.saturating_sub(w)..i {
                 a.add(i, j, rnd());

@@ -5,6 +5,7 @@
 //! its `[[yarns]]` entry and that entry's line), the point of the yarn
 //! nearest the obstacle's center in m, and the distance.
 
+use super::validate::short_to;
 use super::YarnScene;
 use crate::math::Vec2;
 use crate::scene::error::{table_line, SceneError};
@@ -41,13 +42,7 @@ fn nearest_on_curve(curve: &[Vec2], c: Vec2) -> Option<(Vec2, f64, usize)> {
 
 /// A coordinate in m for a message: 4 decimals without trailing zeros.
 fn short(x: f64) -> String {
-    let s = format!("{x:.4}");
-    let s = s.trim_end_matches('0').trim_end_matches('.');
-    if s == "-0" {
-        "0".into()
-    } else {
-        s.into()
-    }
+    short_to(x, 4)
 }
 
 /// Refuses a yarn scene in which a yarn passes through an obstacle at the

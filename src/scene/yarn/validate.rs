@@ -308,7 +308,13 @@ impl YarnScene {
 /// A coordinate in m for a message: at most 6 decimals, without trailing
 /// zeros (`0.29`, not `0.29000000000000004`).
 fn short(x: f64) -> String {
-    let s = format!("{x:.6}");
+    short_to(x, 6)
+}
+
+/// `x` with at most `places` decimals, without trailing zeros (`-0`
+/// written `0`).
+pub(super) fn short_to(x: f64, places: usize) -> String {
+    let s = format!("{x:.places$}");
     let s = s.trim_end_matches('0').trim_end_matches('.');
     if s == "-0" {
         "0".into()
