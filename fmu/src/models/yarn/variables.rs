@@ -79,12 +79,13 @@ pub const SCHEMES: [(&str, TransferScheme); 2] = [
     ("apic", TransferScheme::Apic),
 ];
 
-/// The integrators by their name as the scene and `integrator` write it.
+/// The integrators by their name as the scene and `integrator` write it
+/// (the scene's spelling, [`Integrator::NAMES`]).
 pub const INTEGRATORS: [(&str, Integrator); 4] = [
-    ("explicit", Integrator::Explicit),
-    ("implicit", Integrator::Implicit),
-    ("implicit-vertices", Integrator::ImplicitVertices),
-    ("midpoint-vertices", Integrator::MidpointVertices),
+    (Integrator::NAMES[0], Integrator::Explicit),
+    (Integrator::NAMES[1], Integrator::Implicit),
+    (Integrator::NAMES[2], Integrator::ImplicitVertices),
+    (Integrator::NAMES[3], Integrator::MidpointVertices),
 ];
 
 /// The name of `value` in a table of names ([`SCHEMES`], [`INTEGRATORS`]).
@@ -388,6 +389,7 @@ mod tests {
         for (name, i) in INTEGRATORS {
             assert_eq!(parse_choice(&INTEGRATORS, name), Some(i));
             assert_eq!(choice_name(&INTEGRATORS, i), name);
+            assert_eq!(i.name(), name);
         }
         assert_eq!(parse_choice(&SCHEMES, "pic"), None);
     }
