@@ -181,7 +181,7 @@ impl YarnSim {
     /// Mutable particles, to set up initial conditions in tests and tools
     /// (`crate::testing::particles_mut`). The cached frame factorisations
     /// are recomputed at the next step.
-    #[cfg_attr(not(feature = "testing"), allow(dead_code))]
+    #[cfg(feature = "testing")]
     pub(crate) fn particles_mut(&mut self) -> &mut Particles {
         self.frames_stale = true;
         &mut self.particles

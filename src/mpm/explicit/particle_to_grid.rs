@@ -132,13 +132,13 @@ fn split_chunks<T>(v: &mut [T], n: usize) -> Vec<&mut [T]> {
 /// [`crate::mpm::explicit::grid_to_particle::quad_stress`]). `flip` keeps the impulse
 /// alone too (in lanes that only FLIP reads); `obstacles` are the ones
 /// whose contact mass is marked.
-#[cfg_attr(not(feature = "testing"), allow(dead_code))]
+#[cfg(feature = "testing")]
 pub fn scatter(p: &mut Particles, grid: &mut Grid, dt: f64, bending: f64, obstacles: &[Obstacle]) {
     scatter_fields(p, grid, None, dt, bending, obstacles, true)
 }
 
-/// [`scatter`] with two fields: the particles `held` names go into its
-/// grid instead (same window, same chunks). `with_forces = false`: mass and
+/// The scatter of one field or two (with `held`: the particles it names go into its
+/// grid instead, same window, same chunks). `with_forces = false`: mass and
 /// momentum only (no vertex, bending or normal force; the vertex forces
 /// `p.vert.f` are left zero), for the implicit step, whose solve adds them.
 pub fn scatter_fields(

@@ -40,12 +40,12 @@ fn widest_from_env() -> u8 {
 /// Limits every simulation in the process to kernels no wider than `k`
 /// (default: [`Kernels::Avx512`], i.e. the widest the CPU has). Results are
 /// bitwise the same for every choice; this exists to test exactly that.
-#[cfg_attr(not(feature = "testing"), allow(dead_code))]
+#[cfg(feature = "testing")]
 pub fn set_widest_kernels(k: Kernels) {
     WIDEST.store(k as u8, Ordering::Relaxed);
 }
 
-/// The kernels this CPU runs, within the limit of [`set_widest_kernels`]
+/// The kernels this CPU runs, within the limit of `set_widest_kernels`
 /// (features detected once by std, cached).
 #[inline(always)]
 pub fn kernels() -> Kernels {
@@ -119,7 +119,7 @@ pub(crate) fn chunk_range(n: usize, k: usize) -> std::ops::Range<usize> {
 }
 
 /// The scatter's chunks of `n` items (for tests and the roofline counts).
-#[cfg_attr(not(feature = "testing"), allow(dead_code))]
+#[cfg(feature = "testing")]
 pub fn chunk_bounds(n: usize) -> Vec<std::ops::Range<usize>> {
     (0..CHUNKS).map(|k| chunk_range(n, k)).collect()
 }
