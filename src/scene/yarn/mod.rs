@@ -88,6 +88,19 @@ pub enum TransferScheme {
     Apic,
 }
 
+impl TransferScheme {
+    /// Every value of `[transfer] scheme`, as a scene file writes it.
+    pub const NAMES: [&'static str; 2] = ["flip", "apic"];
+
+    /// The value as a scene file writes it (one of [`TransferScheme::NAMES`]).
+    pub fn name(&self) -> &'static str {
+        match self {
+            TransferScheme::Flip => Self::NAMES[0],
+            TransferScheme::Apic => Self::NAMES[1],
+        }
+    }
+}
+
 /// Which end of a yarn a pin starts from.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
@@ -647,4 +660,47 @@ fn vertex_count<'de, D: Deserializer<'de>>(d: D) -> Result<u32, D::Error> {
 }
 fn copy_count<'de, D: Deserializer<'de>>(d: D) -> Result<u32, D::Error> {
     bounded_u32(d, 1, 100_000)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The name tables agree with `name()` and with the spelling serde
+    /// reads and writes (exact).
+    #[test]
+    fn name_tables_are_the_scene_files_spelling() {
+        #[derive(Serialize, Deserialize)]
+        struct Value<T> {
+            v: T,
+        }
+        fn check<T>(values: &[T], names: &[&str], name: fn(&T) -> &'static str)
+        where
+            T: Serialize + serde::de::DeserializeOwned + PartialEq + std::fmt::Debug,
+        {
+            assert_eq!(values.len(), names.len());
+            for (v, n) in values.iter().zip(names) {
+                assert_eq!(name(v), *n);
+                let text = toml::to_string(&Value { v }).unwrap();
+                assert_eq!(text.trim(), format!("v = {n:?}"));
+                let back: Value<T> = toml::from_str(&text).unwrap();
+                assert_eq!(&back.v, v);
+            }
+        }
+        check(
+            &[TransferScheme::Flip, TransferScheme::Apic],
+            &TransferScheme::NAMES,
+            TransferScheme::name,
+        );
+        check(
+            &[
+                Integrator::Explicit,
+                Integrator::Implicit,
+                Integrator::ImplicitVertices,
+                Integrator::MidpointVertices,
+            ],
+            &Integrator::NAMES,
+            Integrator::name,
+        );
+    }
 }

@@ -73,10 +73,10 @@ const fn material(
 }
 
 /// The transfer schemes by their name as the scene and `transfer.scheme`
-/// write it.
+/// write it (the scene's spelling, [`TransferScheme::NAMES`]).
 pub const SCHEMES: [(&str, TransferScheme); 2] = [
-    ("flip", TransferScheme::Flip),
-    ("apic", TransferScheme::Apic),
+    (TransferScheme::NAMES[0], TransferScheme::Flip),
+    (TransferScheme::NAMES[1], TransferScheme::Apic),
 ];
 
 /// The integrators by their name as the scene and `integrator` write it
@@ -390,6 +390,11 @@ mod tests {
             assert_eq!(parse_choice(&INTEGRATORS, name), Some(i));
             assert_eq!(choice_name(&INTEGRATORS, i), name);
             assert_eq!(i.name(), name);
+        }
+        for (name, s) in SCHEMES {
+            assert_eq!(parse_choice(&SCHEMES, name), Some(s));
+            assert_eq!(choice_name(&SCHEMES, s), name);
+            assert_eq!(s.name(), name);
         }
         assert_eq!(parse_choice(&SCHEMES, "pic"), None);
     }
