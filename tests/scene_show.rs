@@ -168,8 +168,8 @@ fn scenes() -> Vec<(String, Scene)> {
 
 fn fields_of(scene: &Scene) -> &'static [FieldDoc] {
     match scene {
-        Scene::Yarn(_) => YARN_FIELDS,
-        Scene::MassSpring(_) => MASS_SPRING_FIELDS,
+        Scene::Yarn(_) => &YARN_FIELDS[..],
+        Scene::MassSpring(_) => &MASS_SPRING_FIELDS[..],
     }
 }
 
@@ -273,7 +273,7 @@ fn arrays_are_inline_and_every_field_states_its_unit_and_range() {
 
 #[test]
 fn unit_table_covers_every_field_once() {
-    for fields in [YARN_FIELDS, MASS_SPRING_FIELDS] {
+    for fields in [&YARN_FIELDS[..], &MASS_SPRING_FIELDS[..]] {
         for (i, f) in fields.iter().enumerate() {
             assert!(
                 fields[..i].iter().all(|g| g.key != f.key),
@@ -285,10 +285,10 @@ fn unit_table_covers_every_field_once() {
     // Every key the rich scenes write is in the table (the table is not
     // larger than the scenes either: each entry is written by one of them).
     for (scene, fields) in [
-        (Scene::from_toml_str(RICH_YARN).unwrap(), YARN_FIELDS),
+        (Scene::from_toml_str(RICH_YARN).unwrap(), &YARN_FIELDS[..]),
         (
             Scene::from_toml_str(RICH_MASS_SPRING).unwrap(),
-            MASS_SPRING_FIELDS,
+            &MASS_SPRING_FIELDS[..],
         ),
     ] {
         let written: Vec<String> = field_lines(&scene.to_toml_string())
@@ -360,9 +360,9 @@ fn unit_table_agrees_with_the_scene_file_reference() {
     assert!(rows.len() > 60, "{rows:?}");
     for (kind, key, unit) in &rows {
         let fields = if *kind == "yarn" {
-            YARN_FIELDS
+            &YARN_FIELDS[..]
         } else {
-            MASS_SPRING_FIELDS
+            &MASS_SPRING_FIELDS[..]
         };
         let doc = field_doc(fields, key).unwrap_or_else(|| {
             panic!("docs/scene-files.md names {kind} field {key}, the code does not")
@@ -376,7 +376,7 @@ fn unit_table_agrees_with_the_scene_file_reference() {
     // Every field the code knows is documented (in a row of its own or
     // named in another row's cell, as `[[pins]] motion` names `velocity`).
     let text = include_str!("../docs/scene-files.md");
-    for f in YARN_FIELDS.iter().chain(MASS_SPRING_FIELDS) {
+    for f in YARN_FIELDS.iter().chain(MASS_SPRING_FIELDS.iter()) {
         let field = f.key.rsplit('.').next().unwrap();
         assert!(
             text.contains(&format!("`{field}`")) || text.contains(&format!("{field}`")),

@@ -23,8 +23,8 @@ impl Scene {
     /// back to the same scene.
     pub fn to_commented_toml(&self) -> String {
         let (text, fields) = match self {
-            Scene::Yarn(s) => (toml::to_string(s), YARN_FIELDS),
-            Scene::MassSpring(s) => (toml::to_string(s), MASS_SPRING_FIELDS),
+            Scene::Yarn(s) => (toml::to_string(s), &YARN_FIELDS[..]),
+            Scene::MassSpring(s) => (toml::to_string(s), &MASS_SPRING_FIELDS[..]),
         };
         // The scene types are plain structs of numbers, strings, arrays and
         // tables: serialization has nothing that can fail.
@@ -131,8 +131,8 @@ mod tests {
         for (name, _) in builtin_names() {
             let scene = Scene::resolve(name).unwrap();
             let fields = match scene {
-                Scene::Yarn(_) => YARN_FIELDS,
-                Scene::MassSpring(_) => MASS_SPRING_FIELDS,
+                Scene::Yarn(_) => &YARN_FIELDS[..],
+                Scene::MassSpring(_) => &MASS_SPRING_FIELDS[..],
             };
             let plain = scene.to_toml_string();
             for key in keys_written(&plain) {
