@@ -17,39 +17,29 @@ struct Builtin {
     text: &'static str,
 }
 
+/// The table of built-ins from `dir / name: summary` rows, each row's
+/// text the file `scenes/<dir>/<name>.toml` (a macro: `include_str!` takes
+/// a literal path only).
+macro_rules! builtins {
+    ($($dir:literal / $name:literal: $summary:literal,)*) => {
+        [$(Builtin {
+            name: $name,
+            summary: $summary,
+            text: include_str!(concat!("../../scenes/", $dir, "/", $name, ".toml")),
+        },)*]
+    };
+}
+
 /// Every built-in scene, in the order `yarnsim scenes` lists them.
-const BUILTINS: [Builtin; 6] = [
-    Builtin {
-        name: "yarn-reference",
-        summary: "Jiang et al. 2017 reference: 12 yarns x 200 vertices fall onto three circles (256^2 grid, dt 4e-5)",
-        text: include_str!("../../scenes/yarn/yarn-reference.toml"),
-    },
-    Builtin {
-        name: "yarn-vertical",
-        summary: "the reference bundle turned upright: 12 vertical yarns drop onto the circles",
-        text: include_str!("../../scenes/yarn/yarn-vertical.toml"),
-    },
-    Builtin {
-        name: "yarn-drape",
-        summary: "one diagonal yarn of 400 vertices drapes over a single circle",
-        text: include_str!("../../scenes/yarn/yarn-drape.toml"),
-    },
-    Builtin {
-        name: "wire",
-        summary: "course notes: 11-particle wire (mass 1, length 1), top end driven on a circle, 100 frames of 0.05 s",
-        text: include_str!("../../scenes/massspring/wire.toml"),
-    },
-    Builtin {
-        name: "three-particle",
-        summary: "Baraff-Witkin 1998: three particles joined by two springs, the 9x9 backward-Euler system",
-        text: include_str!("../../scenes/massspring/three-particle.toml"),
-    },
-    Builtin {
-        name: "cloth",
-        summary: "Wang 2015, Provot 1995: 21x21 sheet (10x10 m, k 8000) pinned at two corners falls onto a sphere",
-        text: include_str!("../../scenes/massspring/cloth.toml"),
-    },
-];
+#[rustfmt::skip]
+const BUILTINS: [Builtin; 6] = builtins! {
+    "yarn" / "yarn-reference": "Jiang et al. 2017 reference: 12 yarns x 200 vertices fall onto three circles (256^2 grid, dt 4e-5)",
+    "yarn" / "yarn-vertical": "the reference bundle turned upright: 12 vertical yarns drop onto the circles",
+    "yarn" / "yarn-drape": "one diagonal yarn of 400 vertices drapes over a single circle",
+    "massspring" / "wire": "course notes: 11-particle wire (mass 1, length 1), top end driven on a circle, 100 frames of 0.05 s",
+    "massspring" / "three-particle": "Baraff-Witkin 1998: three particles joined by two springs, the 9x9 backward-Euler system",
+    "massspring" / "cloth": "Wang 2015, Provot 1995: 21x21 sheet (10x10 m, k 8000) pinned at two corners falls onto a sphere",
+};
 
 /// Other names of built-ins: `(alias, name)`.
 const ALIASES: [(&str, &str); 2] = [
