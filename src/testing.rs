@@ -19,6 +19,41 @@ use crate::math::Vec2;
 use crate::scene::builtin::yarn_reference;
 use crate::scene::{Integrator, Material, Obstacle, StepSize, YarnScene, YarnSpec};
 
+/// The grid, substep and material lines of the small yarn test scenes, as
+/// a string literal for `concat!`: a 64^2 grid, dt 1e-4, k 1000, gamma
+/// 500, E 1000, friction 0.05, every other field of these tables
+/// defaulted. Nine lines: `tests/scene_errors.rs` counts them in the line
+/// numbers it asserts.
+#[macro_export]
+macro_rules! small_yarn_tables {
+    () => {
+        "[grid]
+resolution = 64
+[time]
+dt = 1e-4
+[material]
+k = 1000.0
+gamma = 500.0
+youngs_modulus = 1000.0
+friction = 0.05
+"
+    };
+}
+
+/// The smallest complete yarn scene file: [`small_yarn_tables`] (every
+/// other field defaulted) and one straight yarn of 20 vertices from
+/// (0.2, 0.5) along +x, 0.5 m long.
+pub const MINIMAL_TOML: &str = concat!(
+    "\nname = \"t\"\n",
+    small_yarn_tables!(),
+    "[[yarns]]
+start = [0.2, 0.5]
+direction = [1.0, 0.0]
+length = 0.5
+vertices = 20
+"
+);
+
 /// The one seeded generator of the tests (the library's unit tests and
 /// the integration tests): proptest's ChaCha [`TestRng`], whose draws are
 /// the same on every system and proptest 1 version, seeded with `seed`.

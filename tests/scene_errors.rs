@@ -8,17 +8,10 @@ use yarnsim::scene::{Integrator, Scene, TimeSpec, YarnScene};
 
 /// A yarn scene with two obstacles, two `[[yarns]]` entries (the second
 /// with three copies) and two pins; line numbers in the comments.
-const SCENE: &str = r#"kind = "yarn"
-[grid]
-resolution = 64
-[time]
-dt = 1e-4
-[material]
-k = 1000.0
-gamma = 500.0
-youngs_modulus = 1000.0
-friction = 0.05
-
+const SCENE: &str = concat!(
+    "kind = \"yarn\"\n",
+    yarnsim::small_yarn_tables!(), // lines 2 to 10
+    r#"
 [[obstacles]]
 center = [0.5, 0.2]
 radius = 0.05
@@ -46,7 +39,8 @@ end = "start"
 [[pins]]  # line 36
 yarn = 1
 end = "start"
-"#;
+"#
+);
 
 /// The error message of `text` with `from` replaced by `to` (which must
 /// change it).

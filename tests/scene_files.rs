@@ -4,10 +4,8 @@ use yarnsim::scene::{
     builtin, builtin_names, builtin_toml, Integrator, Scene, SceneError, YarnScene,
 };
 
-mod common;
-
 /// The smallest complete yarn scene file.
-const GOOD: &str = common::MINIMAL_TOML;
+const GOOD: &str = yarnsim::testing::MINIMAL_TOML;
 
 fn err(text: &str) -> SceneError {
     YarnScene::from_toml_str(text).expect_err("must be rejected")

@@ -523,7 +523,7 @@ fn bad_pins_name_their_field() {
     // a pin at the end of the 20-vertex yarn, then the pin under test
     let base = format!(
         "{}[[pins]]\nyarn = 0\nend = \"end\"\n",
-        common::MINIMAL_TOML
+        yarnsim::testing::MINIMAL_TOML
     );
     let cases = [
         ("[[pins]]\nyarn = 3\nend = \"start\"\n", "does not exist"),

@@ -166,24 +166,6 @@ fn scene_field(fmu_name: &str) -> Option<(&'static str, Option<usize>)> {
     })
 }
 
-/// A scene that gives only the required fields (`docs/scene-files.md`):
-/// every other field takes its default.
-const MINIMAL_SCENE: &str = r#"
-[grid]
-resolution = 32
-[time]
-dt = 1e-4
-[material]
-k = 1000.0
-gamma = 500.0
-youngs_modulus = 1000.0
-friction = 0.1
-[[yarns]]
-start = [0.3, 0.5]
-end = [0.7, 0.5]
-vertices = 10
-"#;
-
 #[test]
 fn fmu_units_and_starts_match_the_scene_file_reference() {
     let reference: Vec<(String, String, String)> = table_after(SCENE_FILES_MD, "## Yarn scenes")
@@ -202,7 +184,7 @@ fn fmu_units_and_starts_match_the_scene_file_reference() {
             .find(|(f, _, _)| f == field)
             .unwrap_or_else(|| panic!("docs/scene-files.md has no row `{field}`"))
     };
-    let minimal = YarnScene::from_toml_str(MINIMAL_SCENE).unwrap();
+    let minimal = YarnScene::from_toml_str(yarnsim::testing::MINIMAL_TOML).unwrap();
     let vars = variables(&minimal);
     let mut compared = 0;
     for v in &vars {

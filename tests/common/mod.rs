@@ -262,27 +262,6 @@ impl SceneBuilder {
     }
 }
 
-/// The smallest complete yarn scene file: a 64^2 grid, dt 1e-4, k 1000,
-/// gamma 500, E 1000, friction 0.05 (every other field defaulted), one
-/// straight yarn of 20 vertices from (0.2, 0.5) along +x, 0.5 m long.
-pub const MINIMAL_TOML: &str = r#"
-name = "t"
-[grid]
-resolution = 64
-[time]
-dt = 1e-4
-[material]
-k = 1000
-gamma = 500.0
-youngs_modulus = 1000.0
-friction = 0.05
-[[yarns]]
-start = [0.2, 0.5]
-direction = [1.0, 0.0]
-length = 0.5
-vertices = 20
-"#;
-
 /// Free fall of the grid scheme from rest after `n` substeps of `dt` under
 /// `g` (symplectic or backward Euler on the grid, no elastic force): the
 /// centre of mass `c0 + dt^2 g n (n + 1) / 2` and the velocity `n dt g`.
