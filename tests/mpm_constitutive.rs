@@ -65,32 +65,42 @@ fn check_stress(g: &Mat2, tol: f64) {
     );
 }
 
+/// Ranges of the factor entries `r11`, `r12`, `r22` of a random `G`
+/// ([`random_g`]).
+type FactorRanges = ((f64, f64), (f64, f64), (f64, f64));
+
+/// `n` rounds of [`check_stress`] (relative tolerance 1e-6) on a random
+/// `G` from each of `ranges`, drawn in that order.
+fn check_random_stresses(rng: &mut Rng, n: usize, ranges: &[FactorRanges]) {
+    for _ in 0..n {
+        for &(r11, r12, r22) in ranges {
+            let g = random_g(rng, r11, r12, r22);
+            check_stress(&g, 1e-6);
+        }
+    }
+}
+
 #[test]
 fn stress_matches_finite_differences_of_psi() {
     let mut rng = Rng::new(1);
-    for _ in 0..2000 {
-        let g = random_g(&mut rng, (0.3, 1.8), (-1.0, 1.0), (0.2, 0.99));
-        check_stress(&g, 1e-6);
-    }
+    check_random_stresses(&mut rng, 2000, &[((0.3, 1.8), (-1.0, 1.0), (0.2, 0.99))]);
     // cross-section in tension (r22 > 1: no normal energy)
-    for _ in 0..500 {
-        let g = random_g(&mut rng, (0.3, 1.8), (-1.0, 1.0), (1.01, 2.0));
-        check_stress(&g, 1e-6);
-    }
+    check_random_stresses(&mut rng, 500, &[((0.3, 1.8), (-1.0, 1.0), (1.01, 2.0))]);
 }
 
 #[test]
 fn stress_matches_finite_differences_near_degenerate() {
     let mut rng = Rng::new(2);
     // nearly crushed cross-section, nearly collapsed fiber, large shear
-    for _ in 0..500 {
-        let g = random_g(&mut rng, (0.5, 1.5), (-0.5, 0.5), (0.01, 0.05));
-        check_stress(&g, 1e-6);
-        let g = random_g(&mut rng, (0.02, 0.1), (-0.05, 0.05), (0.3, 0.9));
-        check_stress(&g, 1e-6);
-        let g = random_g(&mut rng, (0.8, 1.2), (-5.0, 5.0), (0.5, 0.95));
-        check_stress(&g, 1e-6);
-    }
+    check_random_stresses(
+        &mut rng,
+        500,
+        &[
+            ((0.5, 1.5), (-0.5, 0.5), (0.01, 0.05)),
+            ((0.02, 0.1), (-0.05, 0.05), (0.3, 0.9)),
+            ((0.8, 1.2), (-5.0, 5.0), (0.5, 0.95)),
+        ],
+    );
     // r22 just above the clamp
     let g = rotation(0.7) * Mat2::new(1.1, 0.3, 0.0, 3.0 * R22_MIN);
     check_stress(&g, 1e-6);
