@@ -20,8 +20,8 @@
 
 mod common;
 
-use common::{momentum_scale, on_threads, scene};
-use yarnsim::scene::TransferScheme;
+use common::{momentum_scale, on_threads, pin_end, scene, straight, yarns_and_pins_toml};
+use yarnsim::scene::{TransferScheme, YarnEnd};
 use yarnsim::YarnSim;
 
 /// Gravity of the incline scenes.
@@ -48,22 +48,13 @@ fn incline_stepped(theta: f64, c_f: f64, scheme: TransferScheme, time: &str) -> 
     let dx = 1.0 / res as f64;
     let bed_n = (0.8 / (0.5 * dx)).round() as u32 + 1;
     let top_n = (0.3 / (0.5 * dx)).round() as u32 + 1;
-    let yarns = format!(
-        r#"
-[[yarns]]
-start = [0.1, 0.4]
-end = [0.9, 0.4]
-vertices = {bed_n}
-[[yarns]]
-start = [0.3, {y}]
-end = [0.6, {y}]
-vertices = {top_n}
-[[pins]]
-yarn = 0
-end = "start"
-count = {bed_n}
-"#,
-        y = 0.4 + dx
+    let y = 0.4 + dx;
+    let yarns = yarns_and_pins_toml(
+        &[
+            straight([0.1, 0.4], [0.9, 0.4], bed_n),
+            straight([0.3, y], [0.6, y], top_n),
+        ],
+        &[pin_end(0, YarnEnd::Start, bed_n)],
     );
     let gravity = [G * theta.sin(), -G * theta.cos()];
     YarnSim::new(&yarn_scene_stepped(gravity, res, scheme, c_f, &yarns, time)).unwrap()
@@ -91,10 +82,7 @@ fn yarn_scene_stepped(
     yarns: &str,
     time: &str,
 ) -> yarnsim::YarnScene {
-    let scheme = match scheme {
-        TransferScheme::Flip => "flip",
-        TransferScheme::Apic => "apic",
-    };
+    let scheme = scheme.name();
     scene(&format!(
         r#"
 gravity = [{}, {}]
@@ -284,26 +272,15 @@ fn two_fields_are_bit_identical_for_one_and_two_threads_and_the_pin_carries_the_
 fn two_field_contact_conserves_momentum_on_a_held_tightrope() {
     // the rope: 0.6 m, 77 vertices, pinned 3 at each end; the yarn: 0.2 m,
     // 26 vertices, 20 mm (1.28 cells) above its middle
-    let yarns = r#"
-[[yarns]]
-start = [0.2, 0.5]
-end = [0.8, 0.5]
-vertices = 77
-[[yarns]]
-start = [0.4, 0.52]
-end = [0.6, 0.52]
-vertices = 26
-[[pins]]
-yarn = 0
-end = "start"
-count = 3
-[[pins]]
-yarn = 0
-end = "end"
-count = 3
-"#;
+    let yarns = yarns_and_pins_toml(
+        &[
+            straight([0.2, 0.5], [0.8, 0.5], 77),
+            straight([0.4, 0.52], [0.6, 0.52], 26),
+        ],
+        &[pin_end(0, YarnEnd::Start, 3), pin_end(0, YarnEnd::End, 3)],
+    );
     for scheme in [TransferScheme::Flip, TransferScheme::Apic] {
-        let s = yarn_scene([1.0, -9.8], 64, scheme, 0.2, yarns);
+        let s = yarn_scene([1.0, -9.8], 64, scheme, 0.2, &yarns);
         let mut sim = YarnSim::new(&s).unwrap();
         assert!(sim.has_two_fields());
         let (dt, g) = (sim.dt(), sim.gravity());

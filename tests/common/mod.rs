@@ -109,6 +109,17 @@ pub fn bundle(
     }
 }
 
+/// `[[yarns]]` and `[[pins]]` tables as scene-file text (the scene
+/// loader's own spelling), for test scenes written as TOML text.
+pub fn yarns_and_pins_toml(yarns: &[YarnSpec], pins: &[PinSpec]) -> String {
+    #[derive(serde::Serialize)]
+    struct Tables<'a> {
+        yarns: &'a [YarnSpec],
+        pins: &'a [PinSpec],
+    }
+    toml::to_string(&Tables { yarns, pins }).expect("yarns and pins serialize")
+}
+
 /// A fixed pin of `count` vertices of yarn `yarn` from its `end`.
 pub fn pin_end(yarn: u32, end: YarnEnd, count: u32) -> PinSpec {
     PinSpec {
