@@ -39,3 +39,11 @@ pub use driver::{
 pub use laws::pins::{Pin, PinMotion};
 pub use machinery::grid::GridGeom;
 pub use machinery::transfer::Transfer;
+
+/// The scatter's layout, which the roofline counts of `yarnsim-evidence`
+/// (`yarnsim bench roofline`) read: the grid's block size, the scatter's
+/// lanes per node and its fixed chunks.
+pub mod scatter_layout {
+    pub use super::machinery::grid::{BLOCK, P2G_LANES};
+    pub use super::machinery::simd::chunk_bounds;
+}

@@ -4,8 +4,8 @@
 use std::collections::{HashMap, HashSet};
 
 use yarnsim::math::bspline::Stencil;
+use yarnsim::mpm::scatter_layout::{chunk_bounds, BLOCK};
 use yarnsim::mpm::YarnSim;
-use yarnsim::testing::internals::{chunk_bounds, BLOCK};
 
 /// One term of a kernel's count, per particle (or per grid node).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -43,7 +43,7 @@ const fn per_obstacle(what: &'static str, source: &'static str, flops: u64) -> T
 }
 
 /// Lanes of a scatter node `[px, py, m, mc, fx, fy]`.
-pub const P2G_LANES: u64 = yarnsim::testing::internals::P2G_LANES as u64;
+pub const P2G_LANES: u64 = yarnsim::mpm::scatter_layout::P2G_LANES as u64;
 /// Bytes of a scatter node.
 pub const P2G_NODE_BYTES: u64 = 8 * P2G_LANES;
 /// Bytes of a grid node `[vx, vy, dvx, dvy]`.

@@ -119,7 +119,6 @@ pub(crate) fn chunk_range(n: usize, k: usize) -> std::ops::Range<usize> {
 }
 
 /// The scatter's chunks of `n` items (for tests and the roofline counts).
-#[cfg(feature = "testing")]
 pub fn chunk_bounds(n: usize) -> Vec<std::ops::Range<usize>> {
     (0..CHUNKS).map(|k| chunk_range(n, k)).collect()
 }
