@@ -11,6 +11,34 @@
 //! * [`Integrator::Pbd`]: Müller et al. 2007's position-based model (inertia, gravity
 //!   and strain limiting, no spring forces).
 
+/// `Display` (the value's `name()`) and `FromStr` of a choice named on the
+/// command line: any case, `_` for `-`, each value's spellings as listed;
+/// an unknown name is refused naming `what` and every canonical name
+/// (`ALL`). A macro: it writes the two trait impls of each type.
+macro_rules! named_choice {
+    ($ty:ident, $what:literal, { $($($spelling:literal)|+ => $value:ident,)+ }) => {
+        impl fmt::Display for $ty {
+            fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+                f.write_str(self.name())
+            }
+        }
+
+        impl FromStr for $ty {
+            type Err = String;
+            fn from_str(s: &str) -> Result<Self, String> {
+                match s.to_ascii_lowercase().replace('_', "-").as_str() {
+                    $($($spelling)|+ => Ok($ty::$value),)+
+                    _ => Err(format!(
+                        concat!("unknown ", $what, " {:?}; known: {}"),
+                        s,
+                        $ty::ALL.map(|v| v.name()).join(", ")
+                    )),
+                }
+            }
+        }
+    };
+}
+
 pub(crate) mod chebyshev;
 pub(crate) mod explicit;
 pub(crate) mod implicit;
@@ -133,34 +161,14 @@ impl Integrator {
     }
 }
 
-impl fmt::Display for Integrator {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.name())
-    }
-}
-
-impl FromStr for Integrator {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
-        let k = s.to_ascii_lowercase().replace('_', "-");
-        Ok(match k.as_str() {
-            "forward-euler" | "fe" | "explicit-euler" | "euler" => Integrator::ForwardEuler,
-            "symplectic-euler" | "se" | "semi-implicit-euler" => Integrator::SymplecticEuler,
-            "trapezoidal" | "trap" | "trapezoid" => Integrator::Trapezoidal,
-            "backward-euler" | "be" | "implicit-euler" => Integrator::BackwardEuler,
-            "chebyshev-jacobi" | "chebyshev" | "jacobi" | "optimization" | "optimisation" => {
-                Integrator::ChebyshevJacobi
-            }
-            "pbd" | "position-based" | "strain-limiting" => Integrator::Pbd,
-            _ => {
-                return Err(format!(
-                    "unknown integrator {s:?}; known: {}",
-                    Integrator::ALL.map(|i| i.name()).join(", ")
-                ))
-            }
-        })
-    }
-}
+named_choice!(Integrator, "integrator", {
+    "forward-euler" | "fe" | "explicit-euler" | "euler" => ForwardEuler,
+    "symplectic-euler" | "se" | "semi-implicit-euler" => SymplecticEuler,
+    "trapezoidal" | "trap" | "trapezoid" => Trapezoidal,
+    "backward-euler" | "be" | "implicit-euler" => BackwardEuler,
+    "chebyshev-jacobi" | "chebyshev" | "jacobi" | "optimization" | "optimisation" => ChebyshevJacobi,
+    "pbd" | "position-based" | "strain-limiting" => Pbd,
+});
 
 /// Options of the integrators. Every field has a default; the CLI can set
 /// them by name with [`IntegratorOptions::set`].
@@ -362,6 +370,36 @@ mod tests {
         assert_eq!(Integrator::names().len(), Integrator::ALL.len());
         let e = "leapfrog".parse::<Integrator>().unwrap_err();
         assert!(Integrator::names().iter().all(|n| e.contains(n)), "{e}");
+    }
+
+    /// The named choices read their canonical names and aliases in any
+    /// case with `_` for `-`, write their canonical names, and refuse an
+    /// unknown name naming the choice and every canonical name (exact
+    /// messages).
+    #[test]
+    fn named_choices_parse_write_and_refuse() {
+        for s in StrainSolver::ALL {
+            assert_eq!(s.to_string().parse::<StrainSolver>().unwrap(), s);
+        }
+        assert_eq!("GS".parse::<StrainSolver>(), Ok(StrainSolver::GaussSeidel));
+        assert_eq!(
+            "Gauss_Seidel".parse::<StrainSolver>(),
+            Ok(StrainSolver::GaussSeidel)
+        );
+        assert_eq!(
+            "sor".parse::<StrainSolver>().unwrap_err(),
+            "unknown strain solver \"sor\"; known: jacobi, gauss-seidel"
+        );
+        assert_eq!(
+            "Backward_Euler".parse::<Integrator>(),
+            Ok(Integrator::BackwardEuler)
+        );
+        assert_eq!(Integrator::Pbd.to_string(), "pbd");
+        assert_eq!(
+            "leapfrog".parse::<Integrator>().unwrap_err(),
+            "unknown integrator \"leapfrog\"; known: forward-euler, symplectic-euler, \
+             trapezoidal, backward-euler, chebyshev-jacobi, pbd"
+        );
     }
 
     #[test]

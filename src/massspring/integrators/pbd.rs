@@ -40,24 +40,10 @@ impl StrainSolver {
     }
 }
 
-impl fmt::Display for StrainSolver {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.name())
-    }
-}
-
-impl FromStr for StrainSolver {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
-        match s.to_ascii_lowercase().replace('_', "-").as_str() {
-            "jacobi" => Ok(StrainSolver::Jacobi),
-            "gauss-seidel" | "gs" => Ok(StrainSolver::GaussSeidel),
-            _ => Err(format!(
-                "unknown strain solver {s:?}; known: jacobi, gauss-seidel"
-            )),
-        }
-    }
-}
+named_choice!(StrainSolver, "strain solver", {
+    "jacobi" => Jacobi,
+    "gauss-seidel" | "gs" => GaussSeidel,
+});
 
 /// Strain at or below `limit` up to rounding (a spring set exactly onto its
 /// limit length can read back a few ulps above it).
