@@ -3,6 +3,7 @@
 //! `main.rs` only parses arguments and prints.
 //!
 //! * [`scenes`]: `yarnsim scenes`, `yarnsim scene show`.
+//! * [`materials`]: `yarnsim materials`, the yarn presets.
 //! * [`run`]: `yarnsim run` (+ [`table`] for its summary).
 //! * [`record`]: `yarnsim record`, the only module that talks to Rerun.
 //! * [`bench`]: `yarnsim bench`.
@@ -18,6 +19,7 @@ pub mod error;
 pub mod estimate;
 pub mod evidence;
 pub mod massspring;
+pub mod materials;
 pub mod record;
 pub mod run;
 pub mod scenes;

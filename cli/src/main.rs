@@ -45,6 +45,8 @@ enum Command {
     /// Inspect scenes.
     #[command(subcommand)]
     Scene(SceneCommand),
+    /// List the yarn material presets (real yarns) of `[material] preset = "NAME"`.
+    Materials,
     /// Run a scene and print a summary table (steps, wall time, throughput, energy, stretch).
     Run {
         #[command(flatten)]
@@ -213,6 +215,7 @@ fn main() -> ExitCode {
 fn execute(command: Command) -> Result<u8, CliError> {
     match command {
         Command::Scenes => print!("{}", list_scenes()),
+        Command::Materials => print!("{}", yarnsim_cli::materials::list_materials()),
         Command::Scene(SceneCommand::Show { name, set }) => print!("{}", show_scene(&name, &set)?),
         Command::Run {
             scene,

@@ -168,8 +168,49 @@ pub fn run_yarn(sim: &mut YarnSim, duration: f64, csv: Option<&Path>) -> Result<
             .filter(|s| s.substeps > 0)
             .map(|s| dt_range(&s)),
         diagnostics: yarn_rows(&initial, &last),
+        sheet: sheet_line(sim.scene()),
+        forces: per_yarn_forces(sim),
         ..Summary::of_run(frames, last.time - initial.time)
     })
+}
+
+/// The sheet a yarn material given per yarn stands for: its spacing, the
+/// yarns per metre of depth, the preset's name; `None` for a material
+/// given per metre of depth.
+pub fn sheet_line(scene: &YarnScene) -> Option<String> {
+    let s = scene.material.spacing()?;
+    let preset = scene
+        .material
+        .yarn
+        .as_ref()
+        .and_then(|y| y.preset.as_deref())
+        .map(|p| format!(", preset {p}"))
+        .unwrap_or_default();
+    Some(format!(
+        "spacing {s:.4e} m ({:.1} yarns per m of depth{preset})",
+        1.0 / s
+    ))
+}
+
+/// Each pin's force on its yarn over the last substep, per metre of depth
+/// (N/m) and per yarn (N, times the sheet spacing), for a material given
+/// per yarn; none otherwise. The initial column is 0 (no substep yet).
+fn per_yarn_forces(sim: &YarnSim) -> Vec<(String, f64, f64)> {
+    let Some(s) = sim.scene().material.spacing() else {
+        return Vec::new();
+    };
+    let mut rows = Vec::new();
+    for (i, f) in sim.pin_reactions().iter().enumerate() {
+        for (axis, v) in [("x", f.x), ("y", f.y)] {
+            rows.push((format!("pin {i} force {axis} [N/m]"), 0.0, v));
+            rows.push((
+                format!("pin {i} force {axis} per yarn [N]"),
+                0.0,
+                yarnsim::scene::material_units::per_yarn(v, s),
+            ));
+        }
+    }
+    rows
 }
 
 /// A number for the CSV: shortest form that reads back to the same `f64`,

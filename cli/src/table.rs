@@ -33,6 +33,12 @@ pub struct Summary {
     pub failure: Option<String>,
     /// Diagnostics at the start and at the end of the run.
     pub diagnostics: Vec<DiagRow>,
+    /// A yarn material given per yarn: the sheet it stands for (spacing,
+    /// yarns per metre of depth, preset).
+    pub sheet: Option<String>,
+    /// Rows with their unit in the name, after the diagnostics: the pins'
+    /// forces per metre of depth and per yarn, for a material given per yarn.
+    pub forces: Vec<(String, f64, f64)>,
 }
 
 impl Summary {
@@ -189,6 +195,9 @@ pub fn format_summary(s: &Summary, timing: Timing) -> String {
     for (k, v) in rows {
         let _ = writeln!(out, "{k:<18} {v}");
     }
+    if let Some(sheet) = &s.sheet {
+        let _ = writeln!(out, "{:<18} {sheet}", "yarn sheet");
+    }
     let _ = writeln!(out);
     let last = if s.failure.is_some() {
         "last frame"
@@ -200,8 +209,17 @@ pub fn format_summary(s: &Summary, timing: Timing) -> String {
         let k = with_unit(k);
         let _ = writeln!(out, "{k:<NAME_WIDTH$} {:>16} {:>16}", num(*x), num(*y));
     }
+    for (k, x, y) in &s.forces {
+        let _ = writeln!(out, "{k:<NAME_WIDTH$} {:>16} {:>16}", num(*x), num(*y));
+    }
     if s.model.starts_with("yarn") {
         let _ = writeln!(out, "(2D model: energies and momenta are per m of depth)");
+    }
+    if !s.forces.is_empty() {
+        let _ = writeln!(
+            out,
+            "(pin forces: on the yarn over the last substep, 0 before the first; per yarn = per m of depth x spacing)"
+        );
     }
     out
 }

@@ -55,6 +55,7 @@ fn help_texts() {
     for (name, args) in [
         ("help", vec!["--help"]),
         ("help_scenes", vec!["scenes", "--help"]),
+        ("help_materials", vec!["materials", "--help"]),
         ("help_scene_show", vec!["scene", "show", "--help"]),
         ("help_run", vec!["run", "--help"]),
         ("help_record", vec!["record", "--help"]),
@@ -101,6 +102,82 @@ fn scenes_lists_every_builtin() {
         assert!(line.chars().count() <= 100, "{line}");
     }
     insta::assert_snapshot!("scenes", text);
+}
+
+#[test]
+fn materials_lists_every_preset() {
+    let out = yarnsim(&["materials"]);
+    assert!(out.status.success());
+    let text = stdout(&out);
+    for p in yarnsim::scene::presets::PRESETS {
+        assert!(text.contains(p.name), "{} missing", p.name);
+        assert!(text.contains(p.description), "{} missing", p.description);
+    }
+    for line in text.lines() {
+        assert!(line.chars().count() <= 100, "{line}");
+    }
+    insta::assert_snapshot!("materials", text);
+}
+
+/// A hanging nylon monofilament given by its preset, 0.4 m from a pin.
+const PRESET_SCENE: &str = r#"
+name = "nylon"
+[grid]
+resolution = 32
+[time]
+dt = "auto"
+frame_dt = 1e-3
+[material]
+preset = "nylon66-mono-0.30mm"
+[walls]
+mode = "none"
+[[yarns]]
+start = [0.5, 0.8]
+end = [0.5, 0.4]
+vertices = 20
+[[pins]]
+yarn = 0
+end = "start"
+"#;
+
+#[test]
+fn a_preset_scene_reports_its_sheet_and_pin_forces_per_yarn() {
+    let scene = tmp("preset.toml");
+    std::fs::write(&scene, PRESET_SCENE).unwrap();
+    let out = yarnsim(&["run", scene.to_str().unwrap(), "--duration", "2ms"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let text = stdout(&out);
+    assert!(
+        text.contains("yarn sheet         spacing 3.0000e-4 m (3333.3 yarns per m of depth, preset nylon66-mono-0.30mm)"),
+        "{text}"
+    );
+    // the per-yarn row is the per-depth row times the spacing 3e-4 m (to the
+    // six digits printed)
+    let value = |name: &str| -> f64 {
+        let line = text.lines().find(|l| l.starts_with(name)).unwrap();
+        line.split_whitespace().last().unwrap().parse().unwrap()
+    };
+    let (depth, yarn) = (
+        value("pin 0 force y [N/m]"),
+        value("pin 0 force y per yarn [N]"),
+    );
+    assert!(depth > 0.0, "{text}");
+    assert!(
+        (yarn - 3e-4 * depth).abs() <= 1e-5 * yarn.abs(),
+        "{yarn} against {depth}"
+    );
+    // scene show states the sheet in a comment and reads back
+    let out = yarnsim(&["scene", "show", scene.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let shown = stdout(&out);
+    assert!(
+        shown.contains("# [material] is given per yarn: a sheet of yarns at spacing 3.0000e-4 m"),
+        "{shown}"
+    );
+    assert_eq!(
+        yarnsim::Scene::from_toml_str(&shown).unwrap(),
+        yarnsim::Scene::from_toml_str(PRESET_SCENE).unwrap()
+    );
 }
 
 #[test]

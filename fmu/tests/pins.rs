@@ -455,3 +455,71 @@ fn scene_parameter_must_keep_the_pins() {
         f.lines()
     );
 }
+
+/// A yarn given by a preset (the nylon monofilament, `[material] preset`)
+/// loads into the FMU with the converted parameters per metre of depth
+/// (`k = EA / s`, `density = tex 1e-6 / s`, `s` = the diameter), and its
+/// `pin[0].force.y` per metre of depth times the spacing is one yarn's
+/// weight `mu g L`: communication steps of one axial period `4 L / c` each
+/// average a whole period.
+#[test]
+fn a_preset_yarns_pin_force_times_the_spacing_is_one_yarns_weight() {
+    let (len, g) = (0.8, 9.8);
+    let s = YarnScene::from_toml_str(&format!(
+        r#"
+gravity = [0.0, -{g}]
+[grid]
+resolution = 64
+[time]
+dt = "auto"
+[material]
+preset = "nylon66-mono-0.30mm"
+plasticity = false
+[walls]
+mode = "none"
+[[yarns]]
+start = [0.5, 0.9]
+end = [0.5, {}]
+vertices = 100
+[[pins]]
+yarn = 0
+end = "start"
+"#,
+        0.9 - len
+    ))
+    .unwrap();
+    let p = yarnsim::scene::presets::preset("nylon66-mono-0.30mm").unwrap();
+    let spacing = s.material.spacing().unwrap();
+    assert_eq!(spacing, p.diameter);
+    let f = Fmu::initialized(&s);
+    // 1e-15 relative: the same quotient as the loader's
+    let k = f.get_real(&[VR_K]).unwrap()[0];
+    let density = f.get_real(&[VR_DENSITY]).unwrap()[0];
+    assert!((k - p.ea / spacing).abs() <= 1e-15 * k, "{k}");
+    assert!(
+        (density - p.tex * 1e-6 / spacing).abs() <= 1e-15 * density,
+        "{density}"
+    );
+    let period = 4.0 * len / (p.ea / (p.tex * 1e-6)).sqrt();
+    let mut sum = 0.0;
+    for k in 0..10 {
+        assert_eq!(
+            f.do_step(k as f64 * period, period),
+            fmi2OK,
+            "{:?}",
+            f.lines()
+        );
+        sum += f.get_real(&force_vrs(0)).unwrap()[1];
+    }
+    let per_yarn = -sum / 10.0 * spacing;
+    let weight = p.tex * 1e-6 * g * len;
+    let err = (per_yarn - weight) / weight;
+    eprintln!(
+        "preset yarn in the FMU: pin force per yarn {per_yarn:.4e} N, mu g L {weight:.4e} N, error {:+.2} %",
+        100.0 * err
+    );
+    // tolerance 2 %, as the library's test of the same yarn
+    // (tests/yarn_materials.rs): whole continuum periods of an undamped
+    // oscillation
+    assert!(err.abs() < 0.02, "{err}");
+}

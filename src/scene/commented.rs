@@ -29,8 +29,33 @@ impl Scene {
         // The scene types are plain structs of numbers, strings, arrays and
         // tables: serialization has nothing that can fail.
         let text = text.expect("a scene always serializes");
-        format!("{HEADER}\n{}", annotate(&text, fields))
+        let sheet = match self {
+            Scene::Yarn(s) => sheet_comment(s),
+            Scene::MassSpring(_) => String::new(),
+        };
+        format!("{HEADER}\n{sheet}{}", annotate(&text, fields))
     }
+}
+
+/// For a material given per yarn, comment lines with the sheet it stands
+/// for and the model's values per metre of depth; empty otherwise.
+fn sheet_comment(scene: &super::YarnScene) -> String {
+    let m = &scene.material;
+    let Some(s) = m.spacing() else {
+        return String::new();
+    };
+    format!(
+        "# [material] is given per yarn: a sheet of yarns at spacing {s:.4e} m ({:.1} per m of depth);\n\
+         # per m of depth: k = {:.4e} N/m, density = {:.4e} kg/m^2, bending = {:.4e} N m,\n\
+         # youngs_modulus = {:.4e} N/m, gamma = {:.4e} N/m. A force per m of depth (pin reactions,\n\
+         # the FMU's pin[i].force) times the spacing is one yarn's, in N.\n",
+        1.0 / s,
+        m.k,
+        m.density,
+        m.bending,
+        m.youngs_modulus,
+        m.gamma
+    )
 }
 
 /// Adds the comment of every `key = value` line of `text` (as the `toml`

@@ -406,7 +406,8 @@ fn edit_distance(a: &str, b: &str) -> usize {
 fn missing_field(message: &str) -> Option<&str> {
     message
         .strip_prefix("missing field `")
-        .and_then(|m| m.strip_suffix('`'))
+        .and_then(|m| m.split_once('`'))
+        .map(|(name, _)| name)
 }
 
 /// The line and dotted path of the table whose span starts at `pos`: a

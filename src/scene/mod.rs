@@ -15,14 +15,16 @@ pub mod overrides;
 pub(crate) mod readers;
 pub(crate) mod yarn;
 
+pub use yarn::{material_units, presets};
+
 pub use builtin::{builtin, builtin_names, builtin_toml, DEFAULT_SCENE};
 pub use error::SceneError;
 pub use fields::{FieldDoc, MASS_SPRING_FIELDS, YARN_FIELDS};
 pub use massspring::MassSpringScene;
 pub use yarn::{
     AttractorSpec, GridSpec, Integrator, Material, Obstacle, PinMotionKind, PinSpec, StepSize,
-    TimeSpec, TransferScheme, TransferSpec, WallMode, Walls, YarnEnd, YarnScene, YarnSpec,
-    DEFAULT_SAFETY,
+    TimeSpec, TransferScheme, TransferSpec, WallMode, Walls, YarnEnd, YarnMaterial, YarnScene,
+    YarnSpec, DEFAULT_SAFETY,
 };
 
 /// Any scene this crate can simulate.

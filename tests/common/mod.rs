@@ -188,6 +188,7 @@ impl SceneBuilder {
                 bending: 1e-4,
                 density: 1.0,
                 plasticity: false,
+                yarn: None,
             },
             gravity: [0.0, 0.0],
             attractor: AttractorSpec::default(),

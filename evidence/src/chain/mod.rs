@@ -132,6 +132,7 @@ pub fn chain_material() -> Material {
         bending: 0.0,
         density: DENSITY,
         plasticity: false,
+        yarn: None,
     }
 }
 

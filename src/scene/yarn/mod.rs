@@ -8,8 +8,13 @@ use super::error::{from_toml_error, line_of, table_line, SceneError};
 use crate::math::Vec2;
 
 mod geometry;
+mod material;
+pub mod material_units;
 mod overlap;
+pub mod presets;
 mod validate;
+
+pub use material::{Material, YarnMaterial};
 
 /// A complete yarn-bundle scene. See the README section "Scene files" for
 /// every field with its unit and default.
@@ -371,50 +376,6 @@ impl<'de> Deserialize<'de> for StepSize {
     }
 }
 
-/// Material of the yarns, per metre of depth: the 2D model is a sheet of
-/// parallel yarns one metre deep, so stiffnesses are in N/m (J/m^2, the
-/// energy density over the plane), the bending stiffness in N m and the
-/// density in kg/m^2.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct Material {
-    /// Fiber stretch stiffness `k` (N/m per metre of depth).
-    #[serde(deserialize_with = "nonnegative")]
-    pub k: f64,
-    /// Fiber shear stiffness `gamma` (N/m per metre of depth).
-    #[serde(deserialize_with = "nonnegative")]
-    pub gamma: f64,
-    /// Young's modulus `E` of the cross-section (N/m per metre of depth);
-    /// `mu = 0.4 E`, `lambda = 0.6 E`.
-    #[serde(deserialize_with = "nonnegative")]
-    pub youngs_modulus: f64,
-    /// Mohr-Coulomb friction coefficient `c_f` (dimensionless).
-    #[serde(deserialize_with = "nonnegative")]
-    pub friction: f64,
-    /// Bending stiffness `B` of the rod in N m^2 per m of depth (N m): the
-    /// energy is `int B / 2 kappa^2 ds` (discrete elastic rods, see
-    /// `crate::mpm::laws::vertex_forces`). 0 disables bending.
-    #[serde(default, deserialize_with = "nonnegative")]
-    pub bending: f64,
-    /// Density in kg/m^2: mass per metre of yarn per metre of depth.
-    #[serde(default = "one", deserialize_with = "positive")]
-    pub density: f64,
-    /// Mohr-Coulomb return mapping on (default) or off.
-    #[serde(default = "yes")]
-    pub plasticity: bool,
-}
-
-impl Material {
-    /// Lame `mu = 0.4 E`.
-    pub fn mu(&self) -> f64 {
-        0.4 * self.youngs_modulus
-    }
-    /// Lame `lambda = 0.6 E`.
-    pub fn lambda(&self) -> f64 {
-        0.6 * self.youngs_modulus
-    }
-}
-
 /// A point attractor ("mouse") pulling grid velocity toward `position`.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -487,7 +448,9 @@ pub struct Obstacle {
     /// Radius in m.
     #[serde(deserialize_with = "positive")]
     pub radius: f64,
-    /// Coulomb friction coefficient of the surface (default 0.3).
+    /// Coulomb friction coefficient of the surface (default: the
+    /// material's `friction_solid` where it has one, a preset's included,
+    /// else 0.3).
     #[serde(
         default = "default_obstacle_friction",
         deserialize_with = "nonnegative"
@@ -555,7 +518,8 @@ pub struct YarnSpec {
 impl YarnScene {
     /// Parses and validates a scene from TOML text.
     pub fn from_toml_str(text: &str) -> Result<Self, SceneError> {
-        let scene: YarnScene = toml::from_str(text).map_err(|e| from_toml_error(text, e))?;
+        let mut scene: YarnScene = toml::from_str(text).map_err(|e| from_toml_error(text, e))?;
+        scene.obstacles_take_solid_friction(text);
         scene.validate_with_source(Some(text))?;
         Ok(scene)
     }
@@ -563,6 +527,26 @@ impl YarnScene {
     /// The scene as TOML text that [`YarnScene::from_toml_str`] reads back.
     pub fn to_toml_string(&self) -> String {
         toml::to_string_pretty(self).expect("a yarn scene always serializes")
+    }
+
+    /// Gives every obstacle whose entry in `text` has no `friction` the
+    /// material's yarn-on-solid friction, where the material has one.
+    fn obstacles_take_solid_friction(&mut self, text: &str) {
+        let Some(f) = self.material.friction_solid() else {
+            return;
+        };
+        let table: toml::Table = match toml::from_str(text) {
+            Ok(t) => t,
+            Err(_) => return,
+        };
+        let Some(toml::Value::Array(entries)) = table.get("obstacles") else {
+            return;
+        };
+        for (o, entry) in self.obstacles.iter_mut().zip(entries) {
+            if entry.get("friction").is_none() {
+                o.friction = f;
+            }
+        }
     }
 
     /// Grid spacing `dx` in m.
@@ -602,7 +586,7 @@ fn default_obstacle_friction() -> f64 {
 
 use super::readers::{
     bounded_u32, finite2, nonnegative, one, opt_finite, opt_positive, positive,
-    unit_interval_closed, yes,
+    unit_interval_closed,
 };
 use serde::de::Error as _;
 
