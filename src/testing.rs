@@ -129,6 +129,47 @@ pub const CHAIN_LENGTH: f64 = 0.8;
 /// The hanging chain's gravity (m/s^2).
 pub const CHAIN_GRAVITY: f64 = 9.8;
 
+/// A straight yarn of the material `preset` (`[material] preset`, see
+/// `yarnsim materials`), L = `CHAIN_LENGTH` hanging at rest from a pin at
+/// its top (0.5, 0.9), no return mapping, no walls, 100 vertices on a 64^2
+/// grid at `dt = "auto"`, gravity `CHAIN_GRAVITY`: the scene of the checks
+/// that a preset's pin force per metre of depth times the sheet spacing is
+/// one yarn's weight.
+pub fn hanging_preset_yarn_toml(preset: &str) -> String {
+    let (len, g) = (CHAIN_LENGTH, CHAIN_GRAVITY);
+    let yarn = format!(
+        "start = [0.5, 0.9]\nend = [0.5, {}]\nvertices = 100\n",
+        0.9 - len
+    );
+    one_pinned_yarn_toml(
+        g,
+        64,
+        "\"auto\"",
+        &format!("preset = \"{preset}\"\n"),
+        &yarn,
+        "end = \"start\"\n",
+    )
+}
+
+/// A scene of one yarn with its first pin on yarn 0 and no walls, the text
+/// the oracles' one-yarn scenes share: `material` and `yarn` are the lines
+/// of those tables before `plasticity = false` / after `[[yarns]]`, `pin`
+/// the first pin's lines after `yarn = 0` (and any further tables).
+fn one_pinned_yarn_toml(
+    g: f64,
+    resolution: u32,
+    dt: &str,
+    material: &str,
+    yarn: &str,
+    pin: &str,
+) -> String {
+    format!(
+        "\ngravity = [0.0, -{g}]\n[grid]\nresolution = {resolution}\n[time]\ndt = {dt}\n\
+         [material]\n{material}plasticity = false\n[walls]\nmode = \"none\"\n\
+         [[yarns]]\n{yarn}[[pins]]\nyarn = 0\n{pin}"
+    )
+}
+
 /// The hanging chain of the yarn oracles as scene TOML: L = 0.8 m pinned at
 /// (0.5, 0.9), bending 0, k = 2000 (static strain at the top g L rho / k =
 /// 0.4 %), no cross-section energy, default FLIP, started in the first mode
@@ -145,29 +186,13 @@ pub fn hanging_chain_toml(vertices: u32, resolution: u32, dt: &str) -> String {
         })
         .collect::<Vec<_>>()
         .join(", ");
-    format!(
-        r#"
-gravity = [0.0, -{g}]
-[grid]
-resolution = {resolution}
-[time]
-dt = {dt}
-[material]
-k = 2000.0
-gamma = 0.0
-youngs_modulus = 0.0
-friction = 0.0
-bending = 0.0
-plasticity = false
-[walls]
-mode = "none"
-[[yarns]]
-points = [{points}]
-vertices = {vertices}
-[[pins]]
-yarn = 0
-end = "start"
-"#
+    one_pinned_yarn_toml(
+        g,
+        resolution,
+        dt,
+        "k = 2000.0\ngamma = 0.0\nyoungs_modulus = 0.0\nfriction = 0.0\nbending = 0.0\n",
+        &format!("points = [{points}]\nvertices = {vertices}\n"),
+        "end = \"start\"\n",
     )
 }
 
@@ -243,33 +268,19 @@ pub fn cantilever_setup() -> (f64, f64, f64, f64) {
 /// cross-section energy, 64^2 grid, dt 5e-5 s.
 pub fn cantilever_toml(vertices: u32) -> String {
     let (len, b, rho, g) = cantilever_setup();
-    format!(
-        r#"
-gravity = [0.0, -{g}]
-[grid]
-resolution = 64
-[time]
-dt = 5e-5
-[material]
-k = 1e4
-gamma = 0.0
-youngs_modulus = 0.0
-friction = 0.0
-bending = {b}
-density = {rho}
-plasticity = false
-[walls]
-mode = "none"
-[[yarns]]
-start = [0.25, 0.5]
-end = [{}, 0.5]
-vertices = {vertices}
-[[pins]]
-yarn = 0
-end = "start"
-count = 2
-"#,
-        0.25 + len
+    one_pinned_yarn_toml(
+        g,
+        64,
+        "5e-5",
+        &format!(
+            "k = 1e4\ngamma = 0.0\nyoungs_modulus = 0.0\nfriction = 0.0\n\
+             bending = {b}\ndensity = {rho}\n"
+        ),
+        &format!(
+            "start = [0.25, 0.5]\nend = [{}, 0.5]\nvertices = {vertices}\n",
+            0.25 + len
+        ),
+        "end = \"start\"\ncount = 2\n",
     )
 }
 

@@ -161,29 +161,11 @@ fn a_preset_scene_writes_back_to_the_same_parameters() {
 #[test]
 #[cfg_attr(debug_assertions, ignore = "release-mode test (cargo test --release)")]
 fn a_hanging_yarn_pin_carries_one_yarns_weight_per_spacing() {
-    let (len, g) = (0.8, 9.8);
-    let text = format!(
-        r#"
-gravity = [0.0, -{g}]
-[grid]
-resolution = 64
-[time]
-dt = "auto"
-[material]
-preset = "nylon66-mono-0.30mm"
-plasticity = false
-[walls]
-mode = "none"
-[[yarns]]
-start = [0.5, 0.9]
-end = [0.5, {}]
-vertices = 100
-[[pins]]
-yarn = 0
-end = "start"
-"#,
-        0.9 - len
+    let (len, g) = (
+        yarnsim::testing::CHAIN_LENGTH,
+        yarnsim::testing::CHAIN_GRAVITY,
     );
+    let text = yarnsim::testing::hanging_preset_yarn_toml("nylon66-mono-0.30mm");
     let s = common::scene(&text);
     let y = s.material.per_yarn().unwrap();
     let p = preset("nylon66-mono-0.30mm").unwrap();

@@ -464,28 +464,12 @@ fn scene_parameter_must_keep_the_pins() {
 /// average a whole period.
 #[test]
 fn a_preset_yarns_pin_force_times_the_spacing_is_one_yarns_weight() {
-    let (len, g) = (0.8, 9.8);
-    let s = YarnScene::from_toml_str(&format!(
-        r#"
-gravity = [0.0, -{g}]
-[grid]
-resolution = 64
-[time]
-dt = "auto"
-[material]
-preset = "nylon66-mono-0.30mm"
-plasticity = false
-[walls]
-mode = "none"
-[[yarns]]
-start = [0.5, 0.9]
-end = [0.5, {}]
-vertices = 100
-[[pins]]
-yarn = 0
-end = "start"
-"#,
-        0.9 - len
+    let (len, g) = (
+        yarnsim::testing::CHAIN_LENGTH,
+        yarnsim::testing::CHAIN_GRAVITY,
+    );
+    let s = YarnScene::from_toml_str(&yarnsim::testing::hanging_preset_yarn_toml(
+        "nylon66-mono-0.30mm",
     ))
     .unwrap();
     let p = yarnsim::scene::presets::preset("nylon66-mono-0.30mm").unwrap();
