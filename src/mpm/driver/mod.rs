@@ -285,6 +285,15 @@ impl YarnSim {
     pub fn has_two_fields(&self) -> bool {
         self.fields.is_some()
     }
+    /// Number of velocity fields the yarns scatter into (1: one field for
+    /// all; `crate::mpm::laws::fields`).
+    pub fn velocity_fields(&self) -> usize {
+        if self.fields.is_some() {
+            2
+        } else {
+            1
+        }
+    }
     /// Number of blocks (8x8 nodes) the last substep touched.
     pub fn active_blocks(&self) -> usize {
         self.grid.active.len()
