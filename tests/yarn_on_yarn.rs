@@ -7,9 +7,11 @@
 //! driving term there) whose own friction, 1.5,
 //! holds it at every tilt used here (tan theta <= 0.6): it does not move
 //! for a reason other than yarn-yarn friction, and neither yarn is pinned,
-//! so both are free yarns. The top yarn (0.3 m) is laid on it (one cell
-//! above its centre line, the contact distance) or dropped onto it (four
-//! cells above, a fall of three cells). Coulomb's law between the two
+//! so both are free yarns. The top yarn (0.3 m) is laid on it (two cells
+//! above its centre line: the stencils share a row of nodes) or dropped
+//! onto it (four cells above). Laid one cell above, deeper than it rests,
+//! the two stay interlocked (1.9 cells apart) and the top yarn slides at
+//! 5 to 40 % of the Coulomb rate: a placement to avoid, not a case here. Coulomb's law between the two
 //! with `mu = c_f` (`material.friction`; the incline law of
 //! `docs/obstacle-contact.md`): the top yarn holds for `tan theta < c_f`
 //! and slides with acceleration `g (sin theta - c_f cos theta)` above.
@@ -34,9 +36,11 @@ const BED_FRICTION: f64 = 1.5;
 /// How the top yarn starts.
 #[derive(Clone, Copy, Debug, PartialEq)]
 enum Start {
-    /// One cell above the lower yarn (touching it).
+    /// Two cells above the lower yarn (touching it: their stencils
+    /// share a row of nodes; it comes to rest about 2.9 cells above).
     Laid,
-    /// Four cells above it.
+    /// Four cells above it (a fall of about 1.1 cells before the stencils
+    /// touch).
     Dropped,
 }
 
@@ -44,14 +48,13 @@ impl Start {
     /// Height of the top yarn above the lower one.
     fn gap(self) -> f64 {
         match self {
-            Start::Laid => DX,
+            Start::Laid => 2.0 * DX,
             Start::Dropped => 4.0 * DX,
         }
     }
 
     /// Time before the slip is measured: settling on the lower yarn
-    /// (laid), or the fall of 23 mm (0.07 s) and the slip it starts
-    /// stopping (dropped).
+    /// (laid), or the fall and the slip it starts stopping (dropped).
     fn settle(self) -> f64 {
         match self {
             Start::Laid => 0.1,
@@ -117,6 +120,15 @@ fn slips<const N: usize>(
 ) -> ([f64; N], f64) {
     let mut sim = sim(theta, c_f, scheme, start);
     sim.advance(start.settle()).unwrap();
+    let ymid = |sim: &YarnSim, y: usize| {
+        let (a, b) = sim.yarn_endpoints(y);
+        0.5 * (a.y + b.y)
+    };
+    let gap = (ymid(&sim, 1) - ymid(&sim, 0)) / DX;
+    eprintln!(
+        "{start:?} {scheme:?} c_f {c_f} tan {:.3}: gap after settling {gap:.2} cells",
+        theta.tan()
+    );
     let rel = |sim: &YarnSim| centre(sim, 1) - centre(sim, 0);
     let (r0, l0) = (rel(&sim), centre(&sim, 0));
     let mut now = 0.0;
@@ -198,14 +210,14 @@ fn check(start: Start) {
 /// Laid on the lower yarn: holds below `c_f`, slides at the Coulomb rate
 /// above, for c_f 0.2 and 0.3, FLIP and APIC.
 #[test]
-#[ignore = "fails while free yarns share one velocity field"]
+#[cfg_attr(debug_assertions, ignore = "release-mode test (cargo test --release)")]
 fn yarn_laid_on_a_free_yarn_follows_coulomb() {
     check(Start::Laid);
 }
 
 /// Dropped three cells onto the lower yarn: the same.
 #[test]
-#[ignore = "fails while free yarns share one velocity field"]
+#[cfg_attr(debug_assertions, ignore = "release-mode test (cargo test --release)")]
 fn yarn_dropped_on_a_free_yarn_follows_coulomb() {
     check(Start::Dropped);
 }

@@ -61,6 +61,7 @@ pub const YARN_FIELDS: &[FieldDoc] = &[
     f("obstacles.friction", "1", ">= 0"),
     f("transfer.scheme", "", "\"flip\" or \"apic\""),
     f("transfer.flip_ratio", "1", "0 to 1"),
+    f("contact.fields", "", "\"per-yarn\" or \"held-free\""),
     f("yarns.start", "m", ""),
     f("yarns.end", "m", ""),
     f("yarns.direction", "", "not zero"),

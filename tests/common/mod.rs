@@ -186,6 +186,7 @@ impl SceneBuilder {
             },
             obstacles: Vec::new(),
             transfer: TransferSpec::default(),
+            contact: Default::default(),
             yarns: Vec::new(),
             pins: Vec::new(),
         })
