@@ -48,6 +48,9 @@ cells = 2
 scheme = "flip"
 flip_ratio = 0.95
 
+[contact]
+fields = "per-yarn"
+
 [[obstacles]]
 center = [1.0, 0.4]
 radius = 0.1

@@ -20,7 +20,7 @@
 
 mod common;
 
-use common::{friction_scene, on_threads};
+use common::{friction_scene, momentum_scale, on_threads};
 use yarnsim::scene::TransferScheme;
 use yarnsim::YarnSim;
 
@@ -79,6 +79,8 @@ fn scene_text(start: Start) -> String {
     let top_n = (0.3 / (0.5 * DX)).round() as u32 + 1;
     format!(
         r#"
+[contact]
+fields = "per-yarn"
 [[obstacles]]
 center = [0.5, {cy}]
 radius = {BED_R}
@@ -223,32 +225,83 @@ fn yarn_dropped_on_a_free_yarn_follows_coulomb() {
 }
 
 /// Two free yarns (each in a field of its own) and a third yarn held by a
-/// pin at one end, falling onto them: the same bits for 1 and 2 threads.
+/// pin at one end, falling onto them (three fields): the same bits for 1
+/// and 2 threads, under the explicit step and under backward Euler on
+/// the grid (one solve per field).
 #[test]
 fn many_fields_are_bit_identical_for_one_and_two_threads() {
     let t_end = if cfg!(debug_assertions) { 0.003 } else { 0.15 };
-    let run = |threads: usize| {
+    let run = |threads: usize, time: &str| {
         on_threads(threads, || {
             let mut text = scene_text(Start::Dropped);
             text.push_str(
                 "[[yarns]]\nstart = [0.45, 0.46]\nend = [0.7, 0.46]\nvertices = 65\n\
                  [[pins]]\nyarn = 2\nend = \"start\"\ncount = 3\n",
             );
-            let s = friction_scene(
-                [2.0, -9.8],
-                RES,
-                TransferScheme::Flip,
-                0.2,
-                &text,
-                "dt = 1e-4",
-            );
+            let s = friction_scene([2.0, -9.8], RES, TransferScheme::Flip, 0.2, &text, time);
             let mut sim = YarnSim::new(&s).unwrap();
             sim.advance(t_end).unwrap();
             (sim.velocity_fields(), sim.save_state())
         })
     };
-    let (na, a) = run(1);
-    let (nb, b) = run(2);
-    assert_eq!(na, nb);
-    assert!(a == b, "states differ");
+    for time in ["dt = 1e-4", "dt = 1e-3\nintegrator = \"implicit\""] {
+        let (na, a) = run(1, time);
+        let (nb, b) = run(2, time);
+        assert_eq!((na, nb), (3, 3), "{time}");
+        assert!(a == b, "{time}: states differ");
+    }
+}
+
+/// The many-field contact conserves momentum: three free yarns (three
+/// fields) thrown at each other, crossing, without obstacles, walls or
+/// pins, change the momentum of all particles, every substep, by exactly
+/// gravity's impulse, to round-off (1e-12 of `sum m |v|`), under both
+/// schemes; and they do not pass through each other (the crossing yarn's
+/// middle stays above the lower one's).
+#[test]
+fn many_field_contact_conserves_momentum() {
+    let yarns = r#"
+[contact]
+fields = "per-yarn"
+[[yarns]]
+start = [0.25, 0.5]
+end = [0.75, 0.5]
+vertices = 65
+velocity = [0.0, 0.5]
+[[yarns]]
+start = [0.3, 0.6]
+end = [0.7, 0.56]
+vertices = 52
+velocity = [0.0, -0.5]
+[[yarns]]
+start = [0.45, 0.45]
+end = [0.55, 0.65]
+vertices = 30
+velocity = [0.3, 0.0]
+"#;
+    for scheme in [TransferScheme::Flip, TransferScheme::Apic] {
+        let s = friction_scene([0.5, -9.8], 64, scheme, 0.3, yarns, "dt = 1e-4");
+        let mut sim = YarnSim::new(&s).unwrap();
+        assert_eq!(sim.velocity_fields(), 3);
+        let (dt, g) = (sim.dt(), sim.gravity());
+        let steps = if cfg!(debug_assertions) { 50 } else { 1500 };
+        let mut worst: f64 = 0.0;
+        for _ in 0..steps {
+            let d0 = sim.diagnostics();
+            sim.step().unwrap();
+            let d1 = sim.diagnostics();
+            let expect = g * d0.total_mass * dt;
+            let scale = momentum_scale(&sim) + expect.norm();
+            worst = worst.max((d1.momentum - d0.momentum - expect).norm() / scale);
+        }
+        let x = &sim.particles().vert.x;
+        // middle vertices: 32 of yarn 0, 65 + 26 of yarn 1
+        let gap = x[91].y - x[32].y;
+        eprintln!("three fields {scheme:?}: worst momentum balance {worst:.2e}; gap {gap:.4} m");
+        assert!(
+            gap > 0.5 / 64.0,
+            "{scheme:?}: yarn 1 passed through yarn 0 ({gap:.4})"
+        );
+        assert!(worst < 1e-12, "{scheme:?}: momentum balance {worst:.3e}");
+    }
 }

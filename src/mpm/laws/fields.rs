@@ -52,7 +52,7 @@
 use crate::math::Vec2;
 use crate::mpm::laws::contact::coulomb;
 use crate::mpm::laws::pins::{self, PinEntry};
-use crate::mpm::machinery::grid::{Grid, BLOCK, DVX, DVY, M, VX, VY};
+use crate::mpm::machinery::grid::{Grid, GridGeom, BLOCK, DVX, DVY, M, VX, VY};
 
 /// How yarns are partitioned into velocity fields (the scene's `[contact]
 /// fields`, see the module documentation).
@@ -69,6 +69,15 @@ pub enum Partition {
 /// bytes per node), so a bundle of many yarns shares them.
 pub const FREE_FIELDS_MAX: usize = 32;
 
+/// One field's node masses on the window `geom` (zero off the blocks
+/// `written`).
+#[derive(Clone, Debug, Default)]
+struct NodeMasses {
+    m: Vec<f64>,
+    geom: Option<GridGeom>,
+    written: Vec<u32>,
+}
+
 /// The velocity fields of a scene with more than one, and the scratch of
 /// their contact.
 #[derive(Clone, Debug)]
@@ -82,7 +91,7 @@ pub struct Fields {
     /// The held yarns' field, if any yarn is held.
     pub held: Option<u16>,
     /// Node masses of each field this substep (window storage).
-    masses: Vec<Vec<f64>>,
+    masses: Vec<NodeMasses>,
     /// Per node, 1 + the pin whose vertex's stencil holds it, or 0.
     pinned_node: Vec<u32>,
     /// Per window block, how many fields touched it.
@@ -128,7 +137,7 @@ impl Fields {
             vert_field,
             quad_field,
             held,
-            masses: vec![Vec::new(); n],
+            masses: vec![NodeMasses::default(); n],
             pinned_node: Vec::new(),
             block_fields: Vec::new(),
         })
@@ -194,9 +203,11 @@ impl Fields {
     ) {
         let geom = main.geom;
         debug_assert!(self.grids.iter().all(|g| g.geom == geom), "one window");
-        self.pinned_node.clear();
-        self.pinned_node.resize(geom.storage(), 0);
-        pins::mark_stencil_nodes(entries, &mut self.pinned_node);
+        if self.held.is_some() {
+            self.pinned_node.clear();
+            self.pinned_node.resize(geom.storage(), 0);
+            pins::mark_stencil_nodes(entries, &mut self.pinned_node);
+        }
         self.block_fields.clear();
         self.block_fields.resize(geom.blocks(), 0);
         for g in std::iter::once(&*main).chain(&self.grids) {
@@ -215,23 +226,34 @@ impl Fields {
             )
         };
         let n = self.count();
-        let mut here: Vec<u16> = Vec::with_capacity(n);
+        let (mut in_block, mut here) = (Vec::with_capacity(n), Vec::with_capacity(n));
         for b in 0..geom.blocks() {
             if self.block_fields[b] < 2 {
                 continue;
             }
+            in_block.clear();
+            in_block.extend((0..n as u16).filter(|&k| self.grid(main, k).is_active[b]));
             for idx in geom.block_nodes(b) {
                 here.clear();
-                here.extend((0..n as u16).filter(|&k| self.masses[k as usize][idx] > 0.0));
+                here.extend(
+                    in_block
+                        .iter()
+                        .filter(|&&k| self.masses[k as usize].m[idx] > 0.0),
+                );
+                if here.len() < 2 {
+                    continue;
+                }
                 for a in 0..here.len() {
                     for c in a + 1..here.len() {
                         let (i, j) = (here[a], here[c]);
                         // h: the held field in a pair with it, else the lower index
                         let (f, h) = if self.held == Some(j) { (i, j) } else { (j, i) };
-                        let (m_f, m_h) =
-                            (self.masses[f as usize][idx], self.masses[h as usize][idx]);
-                        let gf = grad(&self.masses[f as usize], idx);
-                        let gh = grad(&self.masses[h as usize], idx);
+                        let (m_f, m_h) = (
+                            self.masses[f as usize].m[idx],
+                            self.masses[h as usize].m[idx],
+                        );
+                        let gf = grad(&self.masses[f as usize].m, idx);
+                        let gh = grad(&self.masses[h as usize].m, idx);
                         let normal = if self.held == Some(h) {
                             contact_normal(gf, gh)
                         } else {
@@ -312,10 +334,26 @@ fn add_velocity(node: &mut [f64; 4], dv: Vec2) {
 
 /// Node masses of `grid`'s scatter buffers, summed in chunk order (the
 /// grid update's order) on its active blocks, zero elsewhere.
-fn node_masses(grid: &Grid, out: &mut Vec<f64>) {
+///
+/// Only the blocks written last time are zeroed again (the whole window
+/// when it has moved): with many fields the window is mostly other
+/// fields' blocks.
+fn node_masses(grid: &Grid, out: &mut NodeMasses) {
     let geom = grid.geom;
-    out.clear();
-    out.resize(geom.storage(), 0.0);
+    if out.geom != Some(geom) {
+        out.m.clear();
+        out.m.resize(geom.storage(), 0.0);
+        out.geom = Some(geom);
+    } else {
+        for &b in &out.written {
+            for idx in geom.block_nodes(b as usize) {
+                out.m[idx] = 0.0;
+            }
+        }
+    }
+    out.written.clear();
+    out.written.extend_from_slice(&grid.active);
+    let out = &mut out.m;
     for &b in &grid.active {
         let srcs: Vec<_> = grid
             .buffers
