@@ -105,8 +105,8 @@ pub enum FieldPartition {
     #[default]
     HeldFree,
     /// Held yarns in one field, each free yarn in one of its own: Coulomb
-    /// friction with `material.friction` between any two yarns (2.4 to
-    /// 2.9 times the single field's cost on the reference bundle).
+    /// friction with `material.friction` between any two yarns (its cost:
+    /// `docs/performance/contact.md`).
     PerYarn,
 }
 
