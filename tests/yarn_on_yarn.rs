@@ -260,51 +260,72 @@ fn many_fields_are_bit_identical_for_one_and_two_threads() {
 }
 
 /// The many-field contact conserves momentum: three free yarns (three
-/// fields) thrown at each other, crossing, without obstacles, walls or
-/// pins, change the momentum of all particles, every substep, by exactly
-/// gravity's impulse, to round-off (1e-12 of `sum m |v|`), under both
-/// schemes; and they do not pass through each other (the crossing yarn's
-/// middle stays above the lower one's).
+/// fields) thrown at each other, crossing, over a held tightrope (pinned
+/// at both ends only, so most of its contact nodes are not kinematic; the
+/// fourth field), without obstacles or walls, change the momentum of all
+/// particles, every substep, by exactly gravity's impulse plus the pins'
+/// (`dt` times [`YarnSim::pin_reactions`], which include what the contact
+/// delivers at pinned nodes), to round-off (1e-12 of `sum m |v|`), under
+/// both schemes; and the crossing yarn does not pass through the lower
+/// one (its middle stays above).
 #[test]
-fn many_field_contact_conserves_momentum() {
+fn many_field_contact_conserves_momentum_and_the_pins_carry_their_share() {
     let yarns = r#"
 [contact]
 fields = "per-yarn"
 [[yarns]]
-start = [0.25, 0.5]
-end = [0.75, 0.5]
+start = [0.25, 0.46]
+end = [0.75, 0.46]
 vertices = 65
-velocity = [0.0, 0.5]
+velocity = [0.0, -0.3]
 [[yarns]]
-start = [0.3, 0.6]
-end = [0.7, 0.56]
+start = [0.3, 0.54]
+end = [0.7, 0.52]
 vertices = 52
 velocity = [0.0, -0.5]
 [[yarns]]
-start = [0.45, 0.45]
+start = [0.45, 0.5]
 end = [0.55, 0.65]
 vertices = 30
 velocity = [0.3, 0.0]
+[[yarns]]
+start = [0.2, 0.42]
+end = [0.8, 0.42]
+vertices = 77
+[[pins]]
+yarn = 3
+end = "start"
+count = 3
+[[pins]]
+yarn = 3
+end = "end"
+count = 3
 "#;
     for scheme in [TransferScheme::Flip, TransferScheme::Apic] {
         let s = friction_scene([0.5, -9.8], 64, scheme, 0.3, yarns, "dt = 1e-4");
         let mut sim = YarnSim::new(&s).unwrap();
-        assert_eq!(sim.velocity_fields(), 3);
+        assert_eq!(sim.velocity_fields(), 4);
         let (dt, g) = (sim.dt(), sim.gravity());
-        let steps = if cfg!(debug_assertions) { 50 } else { 1500 };
+        let steps = if cfg!(debug_assertions) { 50 } else { 2500 };
         let mut worst: f64 = 0.0;
         for _ in 0..steps {
             let d0 = sim.diagnostics();
             sim.step().unwrap();
             let d1 = sim.diagnostics();
-            let expect = g * d0.total_mass * dt;
+            let pins: yarnsim::math::Vec2 = sim.pin_reactions().iter().sum();
+            let expect = (g * d0.total_mass + pins) * dt;
             let scale = momentum_scale(&sim) + expect.norm();
             worst = worst.max((d1.momentum - d0.momentum - expect).norm() / scale);
         }
         let x = &sim.particles().vert.x;
         // middle vertices: 32 of yarn 0, 65 + 26 of yarn 1
         let gap = x[91].y - x[32].y;
-        eprintln!("three fields {scheme:?}: worst momentum balance {worst:.2e}; gap {gap:.4} m");
+        let rope = x[65 + 52 + 30 + 38].y;
+        eprintln!(
+            "four fields {scheme:?}: worst momentum balance {worst:.2e}; gap {gap:.4} m; \
+             yarn 0's middle {:.4} m above the rope's",
+            x[32].y - rope
+        );
         assert!(
             gap > 0.5 / 64.0,
             "{scheme:?}: yarn 1 passed through yarn 0 ({gap:.4})"
