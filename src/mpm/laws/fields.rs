@@ -411,4 +411,35 @@ mod tests {
         assert_eq!(n, Vec2::new(0.0, 1.0));
         assert_eq!(contact_normal(Vec2::zeros(), Vec2::zeros()), None);
     }
+
+    /// The partitions: free yarns first in yarn order, the held yarns in
+    /// the last field; free yarns beyond [`FREE_FIELDS_MAX`] wrap around;
+    /// one field is `None`; a quadrature particle is in its left vertex's
+    /// field.
+    #[test]
+    fn partitions_number_free_yarns_first_and_the_held_field_last() {
+        use crate::mpm::machinery::grid::GridGeom;
+        let grid = Grid::new(GridGeom::new(16, 1.0));
+        // yarns of two vertices, one quadrature particle each
+        let fields = |p: Partition, held: &[bool]| {
+            let verts: Vec<usize> = (0..=held.len()).map(|y| 2 * y).collect();
+            let quads: Vec<u32> = (0..held.len() as u32).map(|y| 2 * y).collect();
+            Fields::of_yarns(p, held, &verts, &quads, &grid)
+        };
+        let f = fields(Partition::PerYarn, &[false, true, false, true]).unwrap();
+        assert_eq!(f.count(), 3);
+        assert_eq!(f.held, Some(2));
+        assert_eq!(f.vert_field, [0, 0, 2, 2, 1, 1, 2, 2]);
+        assert_eq!(f.quad_field, [0, 2, 1, 2]);
+        let f = fields(Partition::HeldFree, &[false, true, false, true]).unwrap();
+        assert_eq!((f.count(), f.held), (2, Some(1)));
+        assert_eq!(f.quad_field, [0, 1, 0, 1]);
+        assert!(fields(Partition::HeldFree, &[false, false, false]).is_none());
+        assert!(fields(Partition::PerYarn, &[true, true]).is_none());
+        assert!(fields(Partition::PerYarn, &[false]).is_none());
+        let many = vec![false; FREE_FIELDS_MAX + 2];
+        let f = fields(Partition::PerYarn, &many).unwrap();
+        assert_eq!((f.count(), f.held), (FREE_FIELDS_MAX, None));
+        assert_eq!(f.quad_field[FREE_FIELDS_MAX..], [0, 1]);
+    }
 }
