@@ -20,7 +20,10 @@
 
 mod common;
 
-use common::{momentum_scale, on_threads, pin_end, scene, straight, yarns_and_pins_toml};
+use common::{
+    friction_scene as yarn_scene_stepped, momentum_scale, on_threads, pin_end, straight,
+    yarns_and_pins_toml,
+};
 use yarnsim::scene::{TransferScheme, YarnEnd};
 use yarnsim::YarnSim;
 
@@ -71,39 +74,6 @@ fn yarn_scene(
     yarns: &str,
 ) -> yarnsim::YarnScene {
     yarn_scene_stepped(gravity, res, scheme, c_f, yarns, EXPLICIT)
-}
-
-/// [`yarn_scene`] with the `[time]` lines `time`.
-fn yarn_scene_stepped(
-    gravity: [f64; 2],
-    res: u32,
-    scheme: TransferScheme,
-    c_f: f64,
-    yarns: &str,
-    time: &str,
-) -> yarnsim::YarnScene {
-    let scheme = scheme.name();
-    scene(&format!(
-        r#"
-gravity = [{}, {}]
-[grid]
-resolution = {res}
-[time]
-{time}
-[transfer]
-scheme = "{scheme}"
-[material]
-k = 1000.0
-gamma = 500.0
-youngs_modulus = 1000.0
-friction = {c_f}
-bending = 0.0
-plasticity = true
-[walls]
-mode = "none"
-{yarns}"#,
-        gravity[0], gravity[1]
-    ))
 }
 
 /// Downhill displacements of the top yarn's centre at the times `ts`

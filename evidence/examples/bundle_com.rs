@@ -4,15 +4,17 @@
 //! impact"):
 //!
 //! ```text
-//! cargo run --release -p yarnsim-evidence --example bundle_com -- DT [apic]
+//! cargo run --release -p yarnsim-evidence --example bundle_com -- DT [apic] [per-yarn]
 //! ```
 //!
-//! `DT` is a number (s) or `auto`. Prints one line.
+//! `DT` is a number (s) or `auto`; `per-yarn`: `[contact] fields =
+//! "per-yarn"` (a velocity field per yarn, `src/mpm/laws/fields.rs`).
+//! Prints one line.
 
 use std::time::Instant;
 
 use yarnsim::scene::builtin::yarn_reference;
-use yarnsim::scene::{StepSize, TransferScheme};
+use yarnsim::scene::{FieldPartition, StepSize, TransferScheme};
 use yarnsim::YarnSim;
 
 fn main() {
@@ -24,12 +26,16 @@ fn main() {
     } else {
         s.time.dt = StepSize::Fixed(dt.parse().expect("DT: a number or auto"));
     }
-    if args.get(2).map(String::as_str) == Some("apic") {
+    let flag = |f: &str| args.iter().skip(2).any(|a| a == f);
+    if flag("apic") {
         s.transfer.scheme = TransferScheme::Apic;
+    }
+    if flag("per-yarn") {
+        s.contact.fields = FieldPartition::PerYarn;
     }
     let mut sim = YarnSim::new(&s).expect("scene");
     let start = Instant::now();
-    let mut line = format!("dt {dt} {:?}:", s.transfer.scheme);
+    let mut line = format!("dt {dt} {:?} {:?}:", s.transfer.scheme, s.contact.fields);
     for t in [0.5, 1.0] {
         sim.advance_to(t).expect("run");
         let c = sim.diagnostics().center_of_mass;

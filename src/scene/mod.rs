@@ -22,9 +22,9 @@ pub use error::SceneError;
 pub use fields::{FieldDoc, MASS_SPRING_FIELDS, YARN_FIELDS};
 pub use massspring::MassSpringScene;
 pub use yarn::{
-    AttractorSpec, GridSpec, Integrator, Material, Obstacle, PinMotionKind, PinSpec, StepSize,
-    TimeSpec, TransferScheme, TransferSpec, WallMode, Walls, YarnEnd, YarnMaterial, YarnScene,
-    YarnSpec, DEFAULT_SAFETY,
+    AttractorSpec, ContactSpec, FieldPartition, GridSpec, Integrator, Material, Obstacle,
+    PinMotionKind, PinSpec, StepSize, TimeSpec, TransferScheme, TransferSpec, WallMode, Walls,
+    YarnEnd, YarnMaterial, YarnScene, YarnSpec, DEFAULT_SAFETY,
 };
 
 /// Any scene this crate can simulate.

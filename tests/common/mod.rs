@@ -198,6 +198,7 @@ impl SceneBuilder {
             },
             obstacles: Vec::new(),
             transfer: TransferSpec::default(),
+            contact: Default::default(),
             yarns: Vec::new(),
             pins: Vec::new(),
         })
@@ -456,4 +457,41 @@ pub fn solved_options(
         o.rho = 0.9;
     }
     o
+}
+
+/// A scene of the built-in material (k 1000, gamma 500, E 1000) with
+/// fibre friction `c_f`, no bending, plasticity on, no walls, on `res`^2,
+/// gravity `gravity`, the `[time]` lines `time`, and the `[[yarns]]`,
+/// `[[pins]]` and `[[obstacles]]` of `yarns` (the friction oracles:
+/// `yarn_friction.rs`, `yarn_on_yarn.rs`).
+pub fn friction_scene(
+    gravity: [f64; 2],
+    res: u32,
+    scheme: TransferScheme,
+    c_f: f64,
+    yarns: &str,
+    time: &str,
+) -> YarnScene {
+    let scheme = scheme.name();
+    scene(&format!(
+        r#"
+gravity = [{}, {}]
+[grid]
+resolution = {res}
+[time]
+{time}
+[transfer]
+scheme = "{scheme}"
+[material]
+k = 1000.0
+gamma = 500.0
+youngs_modulus = 1000.0
+friction = {c_f}
+bending = 0.0
+plasticity = true
+[walls]
+mode = "none"
+{yarns}"#,
+        gravity[0], gravity[1]
+    ))
 }

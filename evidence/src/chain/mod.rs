@@ -187,6 +187,7 @@ pub fn chain_scene(resolution: u32, dt: impl Into<StepSize>, transfer: TransferS
         },
         obstacles: Vec::new(),
         transfer,
+        contact: Default::default(),
         yarns: vec![YarnSpec {
             points: Some(points),
             vertices: n,

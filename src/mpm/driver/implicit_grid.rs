@@ -104,8 +104,8 @@ pub(super) fn implicit_grid(
 
 impl YarnSim {
     /// The implicit substep's problems, one per velocity field (a yarn is
-    /// wholly in one, so the energy has no element across them): the only
-    /// field's, or the free field's then the held field's (with the pins).
+    /// wholly in one, so the energy has no element across them), in field
+    /// order (the held field's with the pins).
     /// Call after the scatter, before the grid update.
     pub(super) fn implicit_problems(
         &self,
@@ -116,15 +116,13 @@ impl YarnSim {
         let p = &self.particles;
         match &self.fields {
             None => vec![Problem::collect(p, &self.grid, model, dt, pin_entries)],
-            Some(f) => {
-                let (v, q) = (&f.vert_held[..], &f.quad_held[..]);
-                let free = Some((v, q, false));
-                let held = Some((v, q, true));
-                vec![
-                    Problem::collect_field(p, &self.grid, model, dt, &[], free),
-                    Problem::collect_field(p, &f.grid, model, dt, pin_entries, held),
-                ]
-            }
+            Some(f) => (0..f.count() as u16)
+                .map(|k| {
+                    let only = Some((&f.vert_field[..], &f.quad_field[..], k));
+                    let pins = if f.held == Some(k) { pin_entries } else { &[] };
+                    Problem::collect_field(p, f.grid(&self.grid, k), model, dt, pins, only)
+                })
+                .collect(),
         }
     }
 }
@@ -151,27 +149,34 @@ impl YarnSim {
         };
         let mut problems = self.implicit_problems(&model, dt, pin_entries);
         // v* without obstacles and walls; they act on the solved velocities
-        let (interior, mut masses, mut held_masses) =
-            (ext.without_boundaries(), Vec::new(), Vec::new());
+        let interior = ext.without_boundaries();
+        let mut masses = vec![Vec::new(); problems.len()];
         if ext.has_boundaries() {
-            grid_update::record_masses(&self.grid, &mut masses);
+            grid_update::record_masses(&self.grid, &mut masses[0]);
             if let Some(f) = &self.fields {
-                grid_update::record_masses(&f.grid, &mut held_masses);
+                for (g, m) in f.grids.iter().zip(&mut masses[1..]) {
+                    grid_update::record_masses(g, m);
+                }
             }
         }
         if let Some(f) = &mut self.fields {
             f.record_masses(&self.grid);
-            grid_update::grid_update(&mut f.grid, dt, &interior, flip);
+            for g in &mut f.grids {
+                grid_update::grid_update(g, dt, &interior, flip);
+            }
         }
         grid_update::grid_update(&mut self.grid, dt, &interior, flip);
         self.pin_reactions.resize(self.pins.len(), Vec2::zeros());
         let out = ImplicitFields {
             grid: &mut self.grid,
-            held: self.fields.as_mut().map(|f| &mut f.grid),
+            others: self
+                .fields
+                .as_mut()
+                .map_or(&mut [][..], |f| &mut f.grids[..]),
             pin_reactions: &mut self.pin_reactions,
             stats: &mut self.implicit_stats,
         };
-        if let Err(what) = implicit_solve(&mut problems, out, [&masses, &held_masses], &ext, flip) {
+        if let Err(what) = implicit_solve(&mut problems, out, &masses, &ext, flip) {
             let e = SimError::NonFinite {
                 step: self.steps + 1,
                 time: self.time + dt,
@@ -184,11 +189,11 @@ impl YarnSim {
     }
 }
 
-/// What [`implicit_solve`] writes: the (free) field's grid, the held
-/// field's with two fields, the pins' forces and the cost.
+/// What [`implicit_solve`] writes: field 0's grid, the other fields'
+/// grids, the pins' forces and the cost.
 struct ImplicitFields<'a> {
     pub grid: &'a mut Grid,
-    pub held: Option<&'a mut Grid>,
+    pub others: &'a mut [Grid],
     pub pin_reactions: &'a mut Vec<Vec2>,
     pub stats: &'a mut ImplicitStats,
 }
@@ -201,7 +206,7 @@ struct ImplicitFields<'a> {
 fn implicit_solve(
     problems: &mut [Problem],
     out: ImplicitFields,
-    masses: [&[[f64; 2]]; 2],
+    masses: &[Vec<[f64; 2]>],
     ext: &GridForces,
     flip: bool,
 ) -> Result<(), String> {
@@ -209,9 +214,8 @@ fn implicit_solve(
     out.pin_reactions
         .iter_mut()
         .for_each(|r| *r = Vec2::zeros());
-    let mut grids = [Some(out.grid), out.held];
-    for ((problem, grid), m) in problems.iter_mut().zip(&mut grids).zip(masses) {
-        let grid = grid.as_deref_mut().expect("one grid per problem");
+    let grids = std::iter::once(out.grid).chain(out.others.iter_mut());
+    for ((problem, grid), m) in problems.iter_mut().zip(grids).zip(masses) {
         problem.set_contacts(contact_terms(problem, grid, m, ext));
         let o = ImplicitOut {
             grid: &mut *grid,

@@ -11,7 +11,7 @@ use crate::math::Vec2;
 pub use crate::mpm::error::SimError;
 use crate::mpm::laws::bending;
 use crate::mpm::laws::constitutive::YarnEnergy;
-use crate::mpm::laws::fields::Fields;
+use crate::mpm::laws::fields::{Fields, Partition};
 use crate::mpm::laws::pins::{self, Pin};
 use crate::mpm::machinery::grid::{Grid, GridGeom};
 use crate::mpm::machinery::particles::Particles;
@@ -27,7 +27,8 @@ mod substep;
 pub mod timestep;
 
 use crate::scene::{
-    SceneError, StepSize, TransferScheme, TransferSpec, WallMode, YarnScene, DEFAULT_SAFETY,
+    FieldPartition, SceneError, StepSize, TransferScheme, TransferSpec, WallMode, YarnScene,
+    DEFAULT_SAFETY,
 };
 pub use cutback::{ENERGY_TOL, MAX_CUTBACKS};
 pub use diagnostics::Diagnostics;
@@ -76,8 +77,9 @@ pub struct YarnSim {
     pin_reactions: Vec<Vec2>,
     /// Whether each vertex is held by a pin.
     pinned: Vec<bool>,
-    /// The held field, when the scene has both held and free yarns
-    /// ([`crate::mpm::laws::fields`]); `None`: one field for all.
+    /// The velocity fields beyond the grid's own, when the scene's yarns
+    /// fall into more than one ([`crate::mpm::laws::fields`]); `None`: one
+    /// field for all.
     fields: Option<Fields>,
     /// Newton and CG iterations of the implicit substeps.
     implicit_stats: ImplicitStats,
@@ -132,6 +134,10 @@ impl YarnSim {
         }
         let grid = Grid::new(geom);
         let fields = Fields::of_yarns(
+            match scene.contact.fields {
+                FieldPartition::PerYarn => Partition::PerYarn,
+                FieldPartition::HeldFree => Partition::HeldFree,
+            },
             &held_yarn,
             &particles.yarn_vertices,
             &particles.quad.left,
@@ -278,12 +284,18 @@ impl YarnSim {
     /// Bytes the grid holds now: its window of nodes and the scatter
     /// buffers (they follow the particles' bounding box, not the domain).
     pub fn grid_memory_bytes(&self) -> usize {
-        self.grid.memory_bytes() + self.fields.as_ref().map_or(0, |f| f.grid.memory_bytes())
+        self.grid.memory_bytes() + self.fields.as_ref().map_or(0, Fields::memory_bytes)
     }
-    /// Whether held and free yarns move in velocity fields of their own
-    /// (`crate::mpm::laws::fields`): the scene has both.
+    /// Whether the yarns move in more than one velocity field
+    /// (`crate::mpm::laws::fields`): held and free yarns, or several free
+    /// yarns under the per-yarn partition.
     pub fn has_two_fields(&self) -> bool {
         self.fields.is_some()
+    }
+    /// Number of velocity fields the yarns scatter into (1: one field for
+    /// all; `crate::mpm::laws::fields`).
+    pub fn velocity_fields(&self) -> usize {
+        self.fields.as_ref().map_or(1, Fields::count)
     }
     /// Number of blocks (8x8 nodes) the last substep touched.
     pub fn active_blocks(&self) -> usize {

@@ -98,14 +98,20 @@ impl YarnSim {
         let ext = grid_forces(&self.scene, passes, self.gravity, attractor);
         if let Some(f) = &mut self.fields {
             f.record_masses(&self.grid);
-            grid_update::grid_update(&mut f.grid, dt, &ext, flip);
+            for g in &mut f.grids {
+                grid_update::grid_update(g, dt, &ext, flip);
+            }
         }
         grid_update::grid_update(&mut self.grid, dt, &ext, flip);
         if !self.pins.is_empty() {
+            let held = match &mut self.fields {
+                Some(f) => f.held_grid_mut(&mut self.grid),
+                None => &mut self.grid,
+            };
             pins::constrain_grid(
                 pin_entries,
                 self.pins.len(),
-                self.fields.as_mut().map_or(&mut self.grid, |f| &mut f.grid),
+                held,
                 dt,
                 &mut self.pin_reactions,
             );
@@ -133,14 +139,14 @@ impl YarnSim {
             self.frames_stale = false;
         }
         let t1 = Instant::now();
-        let held = self
+        let others = self
             .fields
             .as_mut()
-            .map(|f| (&mut f.grid, &f.vert_held[..], &f.quad_held[..]));
+            .map(|f| (&mut f.grids[..], &f.vert_field[..], &f.quad_field[..]));
         particle_to_grid::scatter_fields(
             &mut self.particles,
             &mut self.grid,
-            held,
+            others,
             dt,
             bending,
             active_obstacles(&self.scene, passes),
@@ -150,7 +156,10 @@ impl YarnSim {
         let pin_entries = if self.pins.is_empty() {
             Vec::new()
         } else {
-            let held = self.fields.as_ref().map_or(&self.grid, |f| &f.grid);
+            let held = match &self.fields {
+                Some(f) => f.held_grid(&self.grid),
+                None => &self.grid,
+            };
             pins::stencil_masses(&self.pins, &self.particles.vert, held, self.time + dt)
         };
         grid_velocities(self, dt, flip, &pin_entries, passes)?;
@@ -165,14 +174,14 @@ impl YarnSim {
             );
         }
         let obstacles = active_obstacles(&self.scene, passes);
-        let held = self
+        let others = self
             .fields
             .as_ref()
-            .map(|f| (&f.grid, &f.vert_held[..], &f.quad_held[..]));
+            .map(|f| (&f.grids[..], &f.vert_field[..], &f.quad_field[..]));
         let t3 = Instant::now();
         let gather = VertexGather {
             grid: &self.grid,
-            held: held.map(|(g, v, _)| (g, v)),
+            fields: others.map(|(g, v, _)| (g, v)),
             dt,
             obstacles,
             transfer,
@@ -192,7 +201,7 @@ impl YarnSim {
             &mut self.particles.quad,
             &self.particles.vert.x,
             &self.grid,
-            held.map(|(g, _, q)| (g, q)),
+            others.map(|(g, _, q)| (g, q)),
             dt,
             &self.energy,
             passes.plasticity,

@@ -181,11 +181,16 @@ fn transfer<const FLIP: bool>(
     (vn, cn)
 }
 
-/// The grid particle `i` gathers from: `held`'s when it names the particle.
+/// The other fields of a scene with several: the grids of fields 1, 2,
+/// ... and the field of each particle (0: the gather's own grid;
+/// [`crate::mpm::laws::fields`]).
+pub type FieldSources<'a> = (&'a [Grid], &'a [u16]);
+
+/// The grid particle `i` gathers from: its field's.
 #[inline(always)]
-fn field_of<'a>(grid: &'a Grid, held: Option<(&'a Grid, &'a [bool])>, i: usize) -> &'a Grid {
-    match held {
-        Some((h, mask)) if mask[i] => h,
+fn field_of<'a>(grid: &'a Grid, fields: Option<FieldSources<'a>>, i: usize) -> &'a Grid {
+    match fields {
+        Some((gs, f)) if f[i] > 0 => &gs[f[i] as usize - 1],
         _ => grid,
     }
 }
@@ -193,9 +198,9 @@ fn field_of<'a>(grid: &'a Grid, held: Option<(&'a Grid, &'a [bool])>, i: usize) 
 /// What the vertex gather reads.
 pub struct VertexGather<'a> {
     pub grid: &'a Grid,
-    /// With two fields: the held field's grid and which vertices it holds
-    /// (they gather from it, the others from `grid`).
-    pub held: Option<(&'a Grid, &'a [bool])>,
+    /// With several fields: the other fields' grids and each vertex's
+    /// field (field 0's vertices gather from `grid`).
+    pub fields: Option<FieldSources<'a>>,
     pub dt: f64,
     pub obstacles: &'a [Obstacle],
     pub transfer: Transfer,
@@ -259,7 +264,7 @@ multiversion! {
         let mut bad = None;
         let it = xs.iter_mut().zip(vs).zip(cs).zip(sts).zip(spins);
         for (k, ((((x, v), c), st), spin)) in it.enumerate() {
-            let grid = field_of(g.grid, g.held, base + k);
+            let grid = field_of(g.grid, g.fields, base + k);
             let (nv, _) = transfer::<FLIP>(grid, st, ratio, avx, v, c);
             *x += nv * dt;
             if FLIP {
@@ -295,14 +300,14 @@ multiversion! {
 /// vertices, `d2 += dt grad(v_grid) d2` and the return mapping (when
 /// `plastic`); then, for the next step, the particle's stencil and its
 /// stress from the new frame. Returns the first quadrature particle with a
-/// non-finite frame or velocity, if any. With `held`, the particles it names
-/// gather from its grid.
+/// non-finite frame or velocity, if any. With `fields`, each particle
+/// gathers from its field's grid.
 #[allow(clippy::too_many_arguments)]
 pub fn gather_quads(
     quad: &mut Quads,
     vx: &[Vec2],
     grid: &Grid,
-    held: Option<(&Grid, &[bool])>,
+    fields: Option<FieldSources>,
     dt: f64,
     energy: &YarnEnergy,
     plastic: bool,
@@ -317,7 +322,7 @@ pub fn gather_quads(
         energy,
         plastic,
         ratio: transfer.flip_ratio(),
-        held,
+        fields,
     };
     let flip = transfer.needs_delta();
     (
@@ -378,7 +383,7 @@ struct QuadRest<'a> {
     energy: &'a YarnEnergy,
     plastic: bool,
     ratio: f64,
-    held: Option<(&'a Grid, &'a [bool])>,
+    fields: Option<FieldSources<'a>>,
 }
 
 multiversion! {
@@ -398,7 +403,7 @@ multiversion! {
         // transfer, position and d1 from the vertices, d2 advected
         for k in 0..n {
             let g = base + k;
-            let field = field_of(grid, rest.held, g);
+            let field = field_of(grid, rest.fields, g);
             let (_, nc) = transfer::<FLIP>(field, &q.stencil[k], rest.ratio, avx, &mut q.v[k], &mut q.c[k]);
             let left = rest.left[g] as usize;
             let (xl, xr) = (rest.vx[left], rest.vx[left + 1]);

@@ -103,16 +103,17 @@ struct ScatterCtx<'a> {
     obstacles: &'a [Obstacle],
     /// Whether the internal forces are scattered.
     forces: bool,
-    /// Which vertices and quadrature particles scatter into the held field
-    /// (empty with one field).
-    vert_held: &'a [bool],
-    quad_held: &'a [bool],
+    /// The field each vertex and quadrature particle scatters into (empty
+    /// with one field).
+    vert_field: &'a [u16],
+    quad_field: &'a [u16],
 }
 
-/// The held field of a two-field scene as the scatter fills it: its grid
-/// and which vertices and quadrature particles belong to it
-/// ([`crate::mpm::laws::fields`]).
-pub type HeldTarget<'a> = (&'a mut Grid, &'a [bool], &'a [bool]);
+/// The other fields of a scene with several as the scatter fills them:
+/// the grids of fields 1, 2, ... and the field of each vertex and
+/// quadrature particle (0: the scatter's own grid;
+/// [`crate::mpm::laws::fields`]).
+pub type FieldTargets<'a> = (&'a mut [Grid], &'a [u16], &'a [u16]);
 
 /// Splits `v` into the scatter's chunks of `n` items.
 fn split_chunks<T>(v: &mut [T], n: usize) -> Vec<&mut [T]> {
@@ -137,14 +138,14 @@ pub fn scatter(p: &mut Particles, grid: &mut Grid, dt: f64, bending: f64, obstac
     scatter_fields(p, grid, None, dt, bending, obstacles, true)
 }
 
-/// The scatter of one field or two (with `held`: the particles it names go into its
-/// grid instead, same window, same chunks). `with_forces = false`: mass and
+/// [`scatter`] with several fields: the particles `fields` puts in field
+/// `k > 0` go into its grid `k - 1` instead (same window, same chunks). `with_forces = false`: mass and
 /// momentum only (no vertex, bending or normal force; the vertex forces
 /// `p.vert.f` are left zero), for the implicit step, whose solve adds them.
 pub fn scatter_fields(
     p: &mut Particles,
     grid: &mut Grid,
-    held: Option<HeldTarget>,
+    fields: Option<FieldTargets>,
     dt: f64,
     bending: f64,
     obstacles: &[Obstacle],
@@ -159,12 +160,14 @@ pub fn scatter_fields(
     }
     grid.fit_window(&bounds);
     let geom = grid.geom;
-    let (mut held_grid, vert_held, quad_held) = match held {
-        Some((g, v, q)) => {
-            g.fit_window(&bounds);
-            (Some(g), v, q)
+    let (others, vert_field, quad_field) = match fields {
+        Some((gs, v, q)) => {
+            for g in gs.iter_mut() {
+                g.fit_window(&bounds);
+            }
+            (gs, v, q)
         }
-        None => (None, &[][..], &[][..]),
+        None => (&mut [][..], &[][..], &[][..]),
     };
     let (nv, nq) = (p.vert.x.len(), p.quad.x.len());
     // Each chunk writes the stencils and forces of its own vertex range
@@ -181,50 +184,44 @@ pub fn scatter_fields(
         bending,
         obstacles,
         forces: with_forces,
-        vert_held,
-        quad_held,
+        vert_field,
+        quad_field,
     };
-    let mut held_bufs: Vec<Option<&mut ScatterBuffer>> = match held_grid.as_deref_mut() {
-        Some(g) => g.buffers.iter_mut().map(Some).collect(),
-        None => (0..CHUNKS).map(|_| None).collect(),
-    };
-    grid.buffers
-        .par_iter_mut()
-        .zip(held_bufs.par_iter_mut())
+    // per chunk, its buffer of every field
+    let mut chunk_bufs: Vec<ChunkBuffers> = (0..CHUNKS)
+        .map(|_| ChunkBuffers(Vec::with_capacity(1 + others.len())))
+        .collect();
+    for g in std::iter::once(&mut *grid).chain(others.iter_mut()) {
+        for (c, buf) in chunk_bufs.iter_mut().zip(g.buffers.iter_mut()) {
+            c.0.push(buf);
+        }
+    }
+    chunk_bufs
+        .into_par_iter()
         .zip(stencils)
         .zip(forces)
         .enumerate()
-        .for_each(|(k, (((buf, held), sts), fs))| {
+        .for_each(|(k, ((bufs, sts), fs))| {
             let (vr, qr) = (chunk_range(nv, k), chunk_range(nq, k));
-            let bufs = ChunkBuffers {
-                free: buf,
-                held: held.as_deref_mut(),
-            };
             scatter_chunk(bufs, sts, fs, vr, qr, &ctx)
         });
     p.vert.stencil = vert_stencils;
     p.vert.f = vert_forces;
     grid.collect_active();
-    if let Some(g) = held_grid {
+    for g in others.iter_mut() {
         g.collect_active();
     }
 }
 
-/// One chunk's scatter buffers: the (only, or free) field's and, with two
-/// fields, the held field's.
-struct ChunkBuffers<'a> {
-    free: &'a mut ScatterBuffer,
-    held: Option<&'a mut ScatterBuffer>,
-}
+/// One chunk's scatter buffers, one per field (field 0: the scatter's own
+/// grid's).
+struct ChunkBuffers<'a>(Vec<&'a mut ScatterBuffer>);
 
 impl ChunkBuffers<'_> {
-    /// The buffer of a particle: the held field's when `held` and there is one.
+    /// The buffer of field `k`.
     #[inline(always)]
-    fn of(&mut self, held: bool) -> &mut ScatterBuffer {
-        match &mut self.held {
-            Some(h) if held => h,
-            _ => &mut *self.free,
-        }
+    fn of(&mut self, k: u16) -> &mut ScatterBuffer {
+        &mut *self.0[k as usize]
     }
 }
 
@@ -245,11 +242,10 @@ multiversion! {
         // the normal force per unit of (w_i (x_i - x_p) / dx . d2): -dt dE/dd2 4 / dx
         let normal_scale = -dt * 4.0 * geom.inv_dx;
         let mut bufs = bufs;
-        bufs.free.clear();
-        if let Some(h) = &mut bufs.held {
-            h.clear();
+        for b in bufs.0.iter_mut() {
+            b.clear();
         }
-        let two = bufs.held.is_some();
+        let many = bufs.0.len() > 1;
         let (v0, q0) = (vr.start, qr.start);
         if ctx.forces {
             vertex_forces(vert, &quad.t1, ctx.bending, vr.clone(), fs);
@@ -266,7 +262,8 @@ multiversion! {
             let mc = contact_mass(ctx.obstacles, margin, x, m);
             let a = c * (m * dx);
             let s = Splat::new(m, mc, v * m + f0, a, f0, Mat2::zeros());
-            splat(bufs.of(two && ctx.vert_held[v0 + k]), geom, st, &s);
+            let field = if many { ctx.vert_field[v0 + k] } else { 0 };
+            splat(bufs.of(field), geom, st, &s);
         }
         let (qm, qd, qt2) = (&quad.m[qr.clone()], &quad.d[qr.clone()], &quad.t2[qr.clone()]);
         let (qx, qc, qv) = (&quad.x[qr.clone()], &quad.c[qr.clone()], &quad.v[qr.clone()]);
@@ -277,7 +274,8 @@ multiversion! {
             let mc = contact_mass(ctx.obstacles, margin, x, m);
             let a = c * (m * dx) + af;
             let s = Splat::new(m, mc, v * m, a, Vec2::zeros(), af);
-            splat(bufs.of(two && ctx.quad_held[q0 + k]), geom, st, &s);
+            let field = if many { ctx.quad_field[q0 + k] } else { 0 };
+            splat(bufs.of(field), geom, st, &s);
         }
     }
 }

@@ -132,19 +132,19 @@ impl Problem {
         Self::collect_field(p, grid, model, dt, pins, None)
     }
 
-    /// [`Problem::collect`] of one velocity field of a two-field scene
-    /// ([`crate::mpm::laws::fields`]): `only = Some((vert_held, quad_held,
-    /// held))` keeps the vertices and quadrature particles whose flag is
-    /// `held` (their grid is `grid`); the others are no part of this
+    /// [`Problem::collect`] of one velocity field of a scene with several
+    /// ([`crate::mpm::laws::fields`]): `only = Some((vert_field,
+    /// quad_field, k))` keeps the vertices and quadrature particles of
+    /// field `k` (their grid is `grid`); the others are no part of this
     /// problem (the energy has no element across the fields: a yarn is
-    /// wholly held or wholly free).
+    /// wholly in one).
     pub fn collect_field(
         p: &Particles,
         grid: &Grid,
         model: &Model,
         dt: f64,
         pins: &[PinEntry],
-        only: Option<(&[bool], &[bool], bool)>,
+        only: Option<(&[u16], &[u16], u16)>,
     ) -> Self {
         let keep_vert = |i: usize| only.is_none_or(|(v, _, h)| v[i] == h);
         let keep_quad = |i: usize| only.is_none_or(|(_, q, h)| q[i] == h);

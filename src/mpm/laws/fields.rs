@@ -1,114 +1,221 @@
-//! Two velocity fields for yarn-on-yarn contact: the yarns held by a pin
-//! (the *held* field) and the others (the *free* field) scatter into grids
-//! of their own, each gets the grid update, the pin constraint acts on the
-//! held field only, and where both fields have mass a Coulomb contact lets
-//! them slide past each other (multi-velocity-field MPM contact:
-//! Bardenhagen, Brackbill, Sulsky 2000, "The material-point method for
-//! granular materials", CMAME 187; Bardenhagen et al. 2001, "An improved
-//! contact algorithm for the material point method"; Nairn 2013).
+//! Velocity fields for yarn-on-yarn contact: the yarns held by a pin
+//! scatter into one field (the *held* field) and the others (the *free*
+//! yarns) into fields of their own, each gets the grid update, the pin
+//! constraint acts on the held field only, and where two or more fields
+//! have mass a Coulomb contact lets them slide past each other
+//! (multi-velocity-field MPM contact: Bardenhagen, Brackbill, Sulsky 2000,
+//! "The material-point method for granular materials", CMAME 187;
+//! Bardenhagen et al. 2001, "An improved contact algorithm for the
+//! material point method"; Nairn 2013; Homel and Herbold 2017 for many
+//! bodies).
 //!
-//! Why the partition is by pins: the pin constraint
-//! ([`crate::mpm::laws::pins::constrain_grid`]) sets grid node velocities, so in a
-//! field shared with other yarns it holds them too, wherever they share the
-//! pinned vertices' stencils. What it does not cover: free yarns among
-//! themselves (and held yarns among themselves) still share one field and
-//! interact through it and the return mapping, as before.
+//! The partition ([`Partition`], the scene's `[contact] fields`):
+//! `PerYarn` gives every free yarn a field of its own (free yarns beyond
+//! [`FREE_FIELDS_MAX`] share them, yarn `k` in field `k mod`
+//! [`FREE_FIELDS_MAX`], so that neighbouring yarns of a bundle still differ);
+//! `HeldFree` puts all free yarns in one field, where they interact only
+//! through the shared grid velocity and the return mapping, which is not
+//! Coulomb's law between yarns. Held yarns always share one field: the pin
+//! constraint ([`crate::mpm::laws::pins::constrain_grid`]) sets grid node
+//! velocities, so in a field shared with free yarns it would hold them
+//! too. Field 0 is the simulation's own grid; the free yarns' fields come
+//! first (in yarn order), the held field last, so a scene with one free
+//! and one held yarn has the same two fields under both partitions.
 //!
-//! The contact at a node with masses `m_f`, `m_h` and velocities `v_f`,
-//! `v_h` after the grid update and the pin constraint: the normal `n` from
-//! the held to the free field is along the held field's mass gradient,
-//! oriented by the difference of the two fields' gradients
-//! ([`contact_normal`]; central differences of the node masses); if the
-//! fields approach, `u = v_f - v_h` with `u . n < 0`, the
-//! relative velocity becomes `u' = coulomb(u, n, mu)`
-//! ([`crate::mpm::laws::contact::coulomb`]: no approach, tangential part reduced by
-//! `mu` times the normal change, or stopped), shared about the centre of
-//! mass: `v_f' = v_cm + m_h / (m_f + m_h) u'`, `v_h' = v_cm - m_f / (m_f +
-//! m_h) u'` (momentum conserved, the same Coulomb form in impulse terms as
-//! the obstacle law). At nodes of a pinned vertex's stencil the held field
-//! is kinematic (`v_h' = v_h`, as for infinite mass), so the contact leaves
+//! The contact of two fields `f`, `h` at a node with masses `m_f`, `m_h`
+//! and velocities `v_f`, `v_h` after the grid update and the pin
+//! constraint (central differences of the node masses for the gradients):
+//! with the held field `h`, the normal `n` from `h` to `f` is along `h`'s
+//! mass gradient, oriented by the difference of the two fields' gradients
+//! ([`contact_normal`]); between two free fields (`h` the lower index) it
+//! is the difference of the gradients itself ([`symmetric_normal`]; along
+//! either yarn's own gradient, a free yarn resting on another at 1.9 cells
+//! stuck there and slid at a third of the Coulomb rate, measured with
+//! `tests/yarn_on_yarn.rs`). If the fields approach, `u = v_f -
+//! v_h` with `u . n < 0`, the relative velocity becomes `u' = coulomb(u, n,
+//! mu)` ([`crate::mpm::laws::contact::coulomb`]: no approach, tangential
+//! part reduced by `mu` times the normal change, or stopped), shared about
+//! the pair's centre of mass: `v_f' = v_cm + m_h / (m_f + m_h) u'`, `v_h' =
+//! v_cm - m_f / (m_f + m_h) u'` (momentum conserved, the same Coulomb form
+//! in impulse terms as the obstacle law). Where three or more fields meet,
+//! the pairs are taken in order of field index, each from the velocities
+//! the pairs before it left (a Gauss-Seidel sweep over the pairs: each
+//! pair conserves momentum exactly, so the sweep does; the velocities it
+//! leaves do not approach pairwise along the normals of the pairs taken
+//! last). At nodes of a pinned vertex's stencil the held field is
+//! kinematic (`v_h' = v_h`, as for infinite mass), so the contact leaves
 //! the pin constraint satisfied; the impulse it delivers there is added to
 //! that pin's reaction. `mu` is `material.friction` (the derivation in
 //! `docs/obstacle-contact.md`). Nodes are visited in the order of the
-//! sorted active blocks, one at a time: the same bits for any thread count.
+//! window's blocks, one at a time: the same bits for any thread count.
 
 use crate::math::Vec2;
 use crate::mpm::laws::contact::coulomb;
 use crate::mpm::laws::pins::{self, PinEntry};
-use crate::mpm::machinery::grid::{Grid, DVX, DVY, M, VX, VY};
+use crate::mpm::machinery::grid::{Grid, GridGeom, BLOCK, DVX, DVY, M, VX, VY};
 
-/// The held field of a scene that has both held and free yarns, and the
-/// scratch of its contact.
+/// How yarns are partitioned into velocity fields (the scene's `[contact]
+/// fields`, see the module documentation).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Partition {
+    /// Held yarns in one field, all free yarns in another.
+    HeldFree,
+    /// Held yarns in one field, each free yarn in one of its own.
+    PerYarn,
+}
+
+/// Most fields the free yarns get under [`Partition::PerYarn`]: each
+/// field stores the grid window (a node and four scatter buffers, 224
+/// bytes per node), so a bundle of many yarns shares them.
+pub const FREE_FIELDS_MAX: usize = 32;
+
+/// One field's node masses on the window `geom` (zero off the blocks
+/// `written`).
+#[derive(Clone, Debug, Default)]
+struct NodeMasses {
+    m: Vec<f64>,
+    geom: Option<GridGeom>,
+    written: Vec<u32>,
+}
+
+/// The velocity fields of a scene with more than one, and the scratch of
+/// their contact.
 #[derive(Clone, Debug)]
 pub struct Fields {
-    /// The held field's grid (the free field is the simulation's own grid).
-    pub grid: Grid,
-    /// Whether each vertex is in the held field.
-    pub vert_held: Vec<bool>,
-    /// Whether each quadrature particle is in the held field.
-    pub quad_held: Vec<bool>,
-    /// Node masses of the free and held fields this substep (window storage).
-    mass_free: Vec<f64>,
-    mass_held: Vec<f64>,
+    /// The grids of fields 1, 2, ... (field 0 is the simulation's own grid).
+    pub grids: Vec<Grid>,
+    /// The field of each vertex.
+    pub vert_field: Vec<u16>,
+    /// The field of each quadrature particle.
+    pub quad_field: Vec<u16>,
+    /// The held yarns' field, if any yarn is held.
+    pub held: Option<u16>,
+    /// Node masses of each field this substep (window storage).
+    masses: Vec<NodeMasses>,
     /// Per node, 1 + the pin whose vertex's stencil holds it, or 0.
     pinned_node: Vec<u32>,
+    /// Per window block, how many fields touched it.
+    block_fields: Vec<u16>,
 }
 
 impl Fields {
-    /// Two fields when some yarns are held (`held_yarn[y]`: yarn `y` has a
-    /// pinned vertex) and some are not; `None` otherwise (one field, the
-    /// single-grid code path). `yarn_vertices` and `quad_left` are the
-    /// particles' yarn ranges and quadrature particles' left vertices.
+    /// The fields of `partition` (`held_yarn[y]`: yarn `y` has a pinned
+    /// vertex); `None` where that is one field (the single-grid code
+    /// path). `yarn_vertices` and `quad_left` are the particles' yarn
+    /// ranges and quadrature particles' left vertices.
     pub fn of_yarns(
+        partition: Partition,
         held_yarn: &[bool],
         yarn_vertices: &[usize],
         quad_left: &[u32],
         grid: &Grid,
     ) -> Option<Self> {
-        if held_yarn.iter().all(|&h| h) || !held_yarn.iter().any(|&h| h) {
+        let n_free = held_yarn.iter().filter(|&&h| !h).count();
+        let free_fields = match partition {
+            Partition::HeldFree => n_free.min(1),
+            Partition::PerYarn => n_free.min(FREE_FIELDS_MAX),
+        };
+        let held = held_yarn.iter().any(|&h| h).then_some(free_fields as u16);
+        let n = free_fields + held.is_some() as usize;
+        if n < 2 {
             return None;
         }
-        let mut vert_held = vec![false; *yarn_vertices.last().unwrap_or(&0)];
+        let mut vert_field = vec![0u16; *yarn_vertices.last().unwrap_or(&0)];
+        let mut free = 0;
         for (y, &h) in held_yarn.iter().enumerate() {
-            vert_held[yarn_vertices[y]..yarn_vertices[y + 1]].fill(h);
+            let f = if h {
+                free_fields
+            } else {
+                free += 1;
+                (free - 1) % free_fields
+            };
+            vert_field[yarn_vertices[y]..yarn_vertices[y + 1]].fill(f as u16);
         }
-        let quad_held = quad_left.iter().map(|&l| vert_held[l as usize]).collect();
+        let quad_field = quad_left.iter().map(|&l| vert_field[l as usize]).collect();
         Some(Fields {
-            grid: grid.clone(),
-            vert_held,
-            quad_held,
-            mass_free: Vec::new(),
-            mass_held: Vec::new(),
+            grids: vec![grid.clone(); n - 1],
+            vert_field,
+            quad_field,
+            held,
+            masses: vec![NodeMasses::default(); n],
             pinned_node: Vec::new(),
+            block_fields: Vec::new(),
         })
     }
 
-    /// Keeps the node masses of both fields (call after the scatter, before
-    /// the grid update consumes the scatter buffers).
-    pub fn record_masses(&mut self, free: &Grid) {
-        node_masses(free, &mut self.mass_free);
-        node_masses(&self.grid, &mut self.mass_held);
+    /// Number of fields.
+    pub fn count(&self) -> usize {
+        self.grids.len() + 1
     }
 
-    /// The contact of the two fields (see the module documentation), after
-    /// the grid update of both and the pin constraint on the held field
-    /// (`entries`, [`pins::stencil_masses`]). Adds to `reactions[k]` the
-    /// force pin `k` exerts through its kinematic nodes over `dt`.
+    /// Field `k`'s grid (`main`: field 0's, the simulation's own).
+    pub fn grid<'a>(&'a self, main: &'a Grid, k: u16) -> &'a Grid {
+        match k {
+            0 => main,
+            k => &self.grids[k as usize - 1],
+        }
+    }
+
+    /// [`Fields::grid`] for writing.
+    pub fn grid_mut<'a>(&'a mut self, main: &'a mut Grid, k: u16) -> &'a mut Grid {
+        match k {
+            0 => main,
+            k => &mut self.grids[k as usize - 1],
+        }
+    }
+
+    /// The grid the pins act on: the held field's, or `main` without one.
+    pub fn held_grid<'a>(&'a self, main: &'a Grid) -> &'a Grid {
+        self.grid(main, self.held.unwrap_or(0))
+    }
+
+    /// [`Fields::held_grid`] for writing.
+    pub fn held_grid_mut<'a>(&'a mut self, main: &'a mut Grid) -> &'a mut Grid {
+        let k = self.held.unwrap_or(0);
+        self.grid_mut(main, k)
+    }
+
+    /// Bytes the fields' grids hold (field 0's not counted).
+    pub fn memory_bytes(&self) -> usize {
+        self.grids.iter().map(Grid::memory_bytes).sum()
+    }
+
+    /// Keeps the node masses of every field (call after the scatter,
+    /// before the grid update consumes the scatter buffers).
+    pub fn record_masses(&mut self, main: &Grid) {
+        node_masses(main, &mut self.masses[0]);
+        for (g, m) in self.grids.iter().zip(&mut self.masses[1..]) {
+            node_masses(g, m);
+        }
+    }
+
+    /// The contact of the fields (see the module documentation), after
+    /// the grid update of every field and the pin constraint on the held
+    /// field (`entries`, [`pins::stencil_masses`]). Adds to `reactions[k]`
+    /// the force pin `k` exerts through its kinematic nodes over `dt`.
     pub fn contact(
         &mut self,
-        free: &mut Grid,
+        main: &mut Grid,
         entries: &[PinEntry],
         mu: f64,
         dt: f64,
         reactions: &mut [Vec2],
     ) {
-        let geom = free.geom;
-        debug_assert_eq!(geom, self.grid.geom, "both fields share one window");
-        self.pinned_node.clear();
-        self.pinned_node.resize(geom.storage(), 0);
-        pins::mark_stencil_nodes(entries, &mut self.pinned_node);
-        let (mf, mh) = (&self.mass_free, &self.mass_held);
-        let rows = geom.nbi * crate::mpm::machinery::grid::BLOCK;
+        let geom = main.geom;
+        debug_assert!(self.grids.iter().all(|g| g.geom == geom), "one window");
+        if self.held.is_some() {
+            self.pinned_node.clear();
+            self.pinned_node.resize(geom.storage(), 0);
+            pins::mark_stencil_nodes(entries, &mut self.pinned_node);
+        }
+        self.block_fields.clear();
+        self.block_fields.resize(geom.blocks(), 0);
+        for g in std::iter::once(&*main).chain(&self.grids) {
+            for &b in &g.active {
+                self.block_fields[b as usize] += 1;
+            }
+        }
+        let rows = geom.nbi * BLOCK;
         let s = geom.stride;
         let grad = |m: &[f64], idx: usize| {
             let (i, j) = (idx / s, idx % s);
@@ -118,37 +225,69 @@ impl Fields {
                 at(j + 1 < s, idx + 1) - at(j > 0, idx.wrapping_sub(1)),
             )
         };
-        for &b in &free.active {
-            if !self.grid.is_active[b as usize] {
+        let n = self.count();
+        let (mut in_block, mut here) = (Vec::with_capacity(n), Vec::with_capacity(n));
+        for b in 0..geom.blocks() {
+            if self.block_fields[b] < 2 {
                 continue;
             }
-            for idx in geom.block_nodes(b as usize) {
-                let (m_f, m_h) = (mf[idx], mh[idx]);
-                if m_f <= 0.0 || m_h <= 0.0 {
+            in_block.clear();
+            in_block.extend((0..n as u16).filter(|&k| self.grid(main, k).is_active[b]));
+            for idx in geom.block_nodes(b) {
+                here.clear();
+                here.extend(
+                    in_block
+                        .iter()
+                        .filter(|&&k| self.masses[k as usize].m[idx] > 0.0),
+                );
+                if here.len() < 2 {
                     continue;
                 }
-                let Some(n) = contact_normal(grad(mf, idx), grad(mh, idx)) else {
-                    continue;
-                };
-                let (nf, nh) = (&free.node[idx], &self.grid.node[idx]);
-                let (vf, vh) = (Vec2::new(nf[VX], nf[VY]), Vec2::new(nh[VX], nh[VY]));
-                let u = vf - vh;
-                if u.dot(&n) >= 0.0 {
-                    continue;
-                }
-                let u2 = coulomb(u, n, mu);
-                let pin = self.pinned_node[idx];
-                let (dvf, dvh) = if pin > 0 {
-                    (vh + u2 - vf, Vec2::zeros())
-                } else {
-                    let inv = 1.0 / (m_f + m_h);
-                    let vcm = (vf * m_f + vh * m_h) * inv;
-                    (vcm + u2 * (m_h * inv) - vf, vcm - u2 * (m_f * inv) - vh)
-                };
-                add_velocity(&mut free.node[idx], dvf);
-                add_velocity(&mut self.grid.node[idx], dvh);
-                if pin > 0 {
-                    reactions[pin as usize - 1] += dvf * (m_f / dt);
+                for a in 0..here.len() {
+                    for c in a + 1..here.len() {
+                        let (i, j) = (here[a], here[c]);
+                        // h: the held field in a pair with it, else the lower index
+                        let (f, h) = if self.held == Some(j) { (i, j) } else { (j, i) };
+                        let (m_f, m_h) = (
+                            self.masses[f as usize].m[idx],
+                            self.masses[h as usize].m[idx],
+                        );
+                        let gf = grad(&self.masses[f as usize].m, idx);
+                        let gh = grad(&self.masses[h as usize].m, idx);
+                        let normal = if self.held == Some(h) {
+                            contact_normal(gf, gh)
+                        } else {
+                            symmetric_normal(gf, gh)
+                        };
+                        let Some(nrm) = normal else {
+                            continue;
+                        };
+                        let pin = if self.held == Some(h) {
+                            self.pinned_node[idx]
+                        } else {
+                            0
+                        };
+                        let nf = self.grid(main, f).node[idx];
+                        let nh = self.grid(main, h).node[idx];
+                        let (vf, vh) = (Vec2::new(nf[VX], nf[VY]), Vec2::new(nh[VX], nh[VY]));
+                        let u = vf - vh;
+                        if u.dot(&nrm) >= 0.0 {
+                            continue;
+                        }
+                        let u2 = coulomb(u, nrm, mu);
+                        let (dvf, dvh) = if pin > 0 {
+                            (vh + u2 - vf, Vec2::zeros())
+                        } else {
+                            let inv = 1.0 / (m_f + m_h);
+                            let vcm = (vf * m_f + vh * m_h) * inv;
+                            (vcm + u2 * (m_h * inv) - vf, vcm - u2 * (m_f * inv) - vh)
+                        };
+                        add_velocity(&mut self.grid_mut(main, f).node[idx], dvf);
+                        add_velocity(&mut self.grid_mut(main, h).node[idx], dvh);
+                        if pin > 0 {
+                            reactions[pin as usize - 1] += dvf * (m_f / dt);
+                        }
+                    }
                 }
             }
         }
@@ -171,6 +310,18 @@ pub fn contact_normal(gf: Vec2, gh: Vec2) -> Option<Vec2> {
     (norm > 0.0).then(|| n / norm)
 }
 
+/// The contact normal between two free fields, from `h` to `f`: the
+/// difference of their mass gradients `gf - gh`, normalised (each
+/// gradient points into its own yarn, so the difference points from `h`
+/// into `f`; the symmetric choice of Nairn 2013, neither yarn's surface
+/// preferred); `None` where it vanishes.
+#[inline]
+pub fn symmetric_normal(gf: Vec2, gh: Vec2) -> Option<Vec2> {
+    let d = gf - gh;
+    let norm = d.norm();
+    (norm > 0.0).then(|| d / norm)
+}
+
 /// Adds `dv` to a node's velocity and to its change over the substep (read
 /// by the FLIP transfer only).
 #[inline]
@@ -183,10 +334,26 @@ fn add_velocity(node: &mut [f64; 4], dv: Vec2) {
 
 /// Node masses of `grid`'s scatter buffers, summed in chunk order (the
 /// grid update's order) on its active blocks, zero elsewhere.
-fn node_masses(grid: &Grid, out: &mut Vec<f64>) {
+///
+/// Only the blocks written last time are zeroed again (the whole window
+/// when it has moved): with many fields the window is mostly other
+/// fields' blocks.
+fn node_masses(grid: &Grid, out: &mut NodeMasses) {
     let geom = grid.geom;
-    out.clear();
-    out.resize(geom.storage(), 0.0);
+    if out.geom != Some(geom) {
+        out.m.clear();
+        out.m.resize(geom.storage(), 0.0);
+        out.geom = Some(geom);
+    } else {
+        for &b in &out.written {
+            for idx in geom.block_nodes(b as usize) {
+                out.m[idx] = 0.0;
+            }
+        }
+    }
+    out.written.clear();
+    out.written.extend_from_slice(&grid.active);
+    let out = &mut out.m;
     for &b in &grid.active {
         let srcs: Vec<_> = grid
             .buffers
@@ -243,5 +410,36 @@ mod tests {
         let n = contact_normal(Vec2::new(0.0, 2.0), Vec2::zeros()).unwrap();
         assert_eq!(n, Vec2::new(0.0, 1.0));
         assert_eq!(contact_normal(Vec2::zeros(), Vec2::zeros()), None);
+    }
+
+    /// The partitions: free yarns first in yarn order, the held yarns in
+    /// the last field; free yarns beyond [`FREE_FIELDS_MAX`] wrap around;
+    /// one field is `None`; a quadrature particle is in its left vertex's
+    /// field.
+    #[test]
+    fn partitions_number_free_yarns_first_and_the_held_field_last() {
+        use crate::mpm::machinery::grid::GridGeom;
+        let grid = Grid::new(GridGeom::new(16, 1.0));
+        // yarns of two vertices, one quadrature particle each
+        let fields = |p: Partition, held: &[bool]| {
+            let verts: Vec<usize> = (0..=held.len()).map(|y| 2 * y).collect();
+            let quads: Vec<u32> = (0..held.len() as u32).map(|y| 2 * y).collect();
+            Fields::of_yarns(p, held, &verts, &quads, &grid)
+        };
+        let f = fields(Partition::PerYarn, &[false, true, false, true]).unwrap();
+        assert_eq!(f.count(), 3);
+        assert_eq!(f.held, Some(2));
+        assert_eq!(f.vert_field, [0, 0, 2, 2, 1, 1, 2, 2]);
+        assert_eq!(f.quad_field, [0, 2, 1, 2]);
+        let f = fields(Partition::HeldFree, &[false, true, false, true]).unwrap();
+        assert_eq!((f.count(), f.held), (2, Some(1)));
+        assert_eq!(f.quad_field, [0, 1, 0, 1]);
+        assert!(fields(Partition::HeldFree, &[false, false, false]).is_none());
+        assert!(fields(Partition::PerYarn, &[true, true]).is_none());
+        assert!(fields(Partition::PerYarn, &[false]).is_none());
+        let many = vec![false; FREE_FIELDS_MAX + 2];
+        let f = fields(Partition::PerYarn, &many).unwrap();
+        assert_eq!((f.count(), f.held), (FREE_FIELDS_MAX, None));
+        assert_eq!(f.quad_field[FREE_FIELDS_MAX..], [0, 1]);
     }
 }

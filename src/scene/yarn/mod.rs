@@ -51,6 +51,10 @@ pub struct YarnScene {
     /// How particles take their velocity back from the grid.
     #[serde(default)]
     pub transfer: TransferSpec,
+    /// Yarn-on-yarn contact (`[contact]`): how yarns are split into
+    /// velocity fields.
+    #[serde(default, skip_serializing_if = "ContactSpec::is_default")]
+    pub contact: ContactSpec,
     /// The yarns (`[[yarns]]`), each entry with its copies.
     pub yarns: Vec<YarnSpec>,
     /// Pinned or driven yarn vertices.
@@ -79,6 +83,36 @@ impl Default for TransferSpec {
             flip_ratio: 1.0,
         }
     }
+}
+
+/// Yarn-on-yarn contact (`[contact]`); see `crate::mpm::laws::fields`.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ContactSpec {
+    /// `"held-free"` (default) or `"per-yarn"`.
+    #[serde(default)]
+    pub fields: FieldPartition,
+}
+
+impl ContactSpec {
+    /// Whether every setting is the default (then not written out).
+    pub fn is_default(&self) -> bool {
+        *self == ContactSpec::default()
+    }
+}
+
+/// How yarns are split into velocity fields (`[contact] fields`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "kebab-case")]
+pub enum FieldPartition {
+    /// Held yarns in one field, all free yarns in another: free yarns
+    /// interact through the shared grid velocity and the return mapping.
+    #[default]
+    HeldFree,
+    /// Held yarns in one field, each free yarn in one of its own: Coulomb
+    /// friction with `material.friction` between any two yarns (its cost:
+    /// `docs/performance/contact.md`).
+    PerYarn,
 }
 
 /// Name of a transfer scheme.
