@@ -52,7 +52,7 @@
 use crate::math::Vec2;
 use crate::mpm::laws::contact::coulomb;
 use crate::mpm::laws::pins::{self, PinEntry};
-use crate::mpm::machinery::grid::{Grid, GridGeom, BLOCK, DVX, DVY, M, VX, VY};
+use crate::mpm::machinery::grid::{Grid, GridGeom, P2gNode, BLOCK, CHUNKS, DVX, DVY, M, VX, VY};
 
 /// How yarns are partitioned into velocity fields (the scene's `[contact]
 /// fields`, see the module documentation).
@@ -70,10 +70,12 @@ pub enum Partition {
 pub const FREE_FIELDS_MAX: usize = 32;
 
 /// One field's node masses on the window `geom` (zero off the blocks
-/// `written`).
+/// `written`), and per window block the nodes where it has mass (bit
+/// `8 r + c` for the node of row `r`, column `c` of the block).
 #[derive(Clone, Debug, Default)]
 struct NodeMasses {
     m: Vec<f64>,
+    mask: Vec<u64>,
     geom: Option<GridGeom>,
     written: Vec<u32>,
 }
@@ -92,8 +94,10 @@ pub struct Fields {
     pub held: Option<u16>,
     /// Node masses of each field this substep (window storage).
     masses: Vec<NodeMasses>,
-    /// Per node, 1 + the pin whose vertex's stencil holds it, or 0.
+    /// Per node, 1 + the pin whose vertex's stencil holds it, or 0 (zero
+    /// between contacts, on the window `pinned_geom`).
     pinned_node: Vec<u32>,
+    pinned_geom: Option<GridGeom>,
     /// Per window block, how many fields touched it.
     block_fields: Vec<u16>,
 }
@@ -139,6 +143,7 @@ impl Fields {
             held,
             masses: vec![NodeMasses::default(); n],
             pinned_node: Vec::new(),
+            pinned_geom: None,
             block_fields: Vec::new(),
         })
     }
@@ -204,8 +209,11 @@ impl Fields {
         let geom = main.geom;
         debug_assert!(self.grids.iter().all(|g| g.geom == geom), "one window");
         if self.held.is_some() {
-            self.pinned_node.clear();
-            self.pinned_node.resize(geom.storage(), 0);
+            if self.pinned_geom != Some(geom) {
+                self.pinned_node.clear();
+                self.pinned_node.resize(geom.storage(), 0);
+                self.pinned_geom = Some(geom);
+            }
             pins::mark_stencil_nodes(entries, &mut self.pinned_node);
         }
         self.block_fields.clear();
@@ -231,18 +239,30 @@ impl Fields {
             if self.block_fields[b] < 2 {
                 continue;
             }
+            // the fields with mass in the block, and its nodes where two
+            // or more have (in node order: bit 8 r + c)
             in_block.clear();
-            in_block.extend((0..n as u16).filter(|&k| self.grid(main, k).is_active[b]));
-            for idx in geom.block_nodes(b) {
+            let (mut one, mut two) = (0u64, 0u64);
+            for k in 0..n {
+                let mk = self.masses[k].mask[b];
+                if mk != 0 {
+                    in_block.push(k as u16);
+                    two |= one & mk;
+                    one |= mk;
+                }
+            }
+            let first = block_first_node(&geom, b);
+            let mut nodes = two;
+            while nodes != 0 {
+                let bit = nodes.trailing_zeros() as usize;
+                nodes &= nodes - 1;
+                let idx = first + (bit / BLOCK) * s + bit % BLOCK;
                 here.clear();
                 here.extend(
                     in_block
                         .iter()
-                        .filter(|&&k| self.masses[k as usize].m[idx] > 0.0),
+                        .filter(|&&k| self.masses[k as usize].mask[b] >> bit & 1 != 0),
                 );
-                if here.len() < 2 {
-                    continue;
-                }
                 for a in 0..here.len() {
                     for c in a + 1..here.len() {
                         let (i, j) = (here[a], here[c]);
@@ -291,7 +311,17 @@ impl Fields {
                 }
             }
         }
+        if self.held.is_some() {
+            pins::unmark_stencil_nodes(entries, &mut self.pinned_node);
+        }
     }
+}
+
+/// Storage index of the first node of window block `b` (its row `r` starts
+/// `r * geom.stride` after it).
+#[inline]
+fn block_first_node(geom: &GridGeom, b: usize) -> usize {
+    (b / geom.nbj) * BLOCK * geom.stride + (b % geom.nbj) * BLOCK
 }
 
 /// The contact normal from the held to the free field at a node, from the
@@ -333,40 +363,56 @@ fn add_velocity(node: &mut [f64; 4], dv: Vec2) {
 }
 
 /// Node masses of `grid`'s scatter buffers, summed in chunk order (the
-/// grid update's order) on its active blocks, zero elsewhere.
+/// grid update's order) on its active blocks, zero elsewhere, and the
+/// blocks' masks of nodes with mass.
 ///
 /// Only the blocks written last time are zeroed again (the whole window
 /// when it has moved): with many fields the window is mostly other
 /// fields' blocks.
 fn node_masses(grid: &Grid, out: &mut NodeMasses) {
     let geom = grid.geom;
+    let s = geom.stride;
     if out.geom != Some(geom) {
         out.m.clear();
         out.m.resize(geom.storage(), 0.0);
+        out.mask.clear();
+        out.mask.resize(geom.blocks(), 0);
         out.geom = Some(geom);
     } else {
         for &b in &out.written {
-            for idx in geom.block_nodes(b as usize) {
-                out.m[idx] = 0.0;
+            let first = block_first_node(&geom, b as usize);
+            for r in 0..BLOCK {
+                out.m[first + r * s..][..BLOCK].fill(0.0);
             }
+            out.mask[b as usize] = 0;
         }
     }
     out.written.clear();
     out.written.extend_from_slice(&grid.active);
-    let out = &mut out.m;
     for &b in &grid.active {
-        let srcs: Vec<_> = grid
-            .buffers
-            .iter()
-            .filter(|s| s.touched[b as usize])
-            .collect();
-        for idx in geom.block_nodes(b as usize) {
-            let mut m = 0.0;
-            for s in &srcs {
-                m += s.node[idx][M];
-            }
-            out[idx] = m;
+        let b = b as usize;
+        let mut srcs: [&[P2gNode]; CHUNKS] = [&[]; CHUNKS];
+        let mut nsrc = 0;
+        for buf in grid.buffers.iter().filter(|buf| buf.touched[b]) {
+            srcs[nsrc] = &buf.node;
+            nsrc += 1;
         }
+        let srcs = &srcs[..nsrc];
+        let first = block_first_node(&geom, b);
+        let mut mask = 0u64;
+        for r in 0..BLOCK {
+            let start = first + r * s;
+            let row = &mut out.m[start..start + BLOCK];
+            for (c, out) in row.iter_mut().enumerate() {
+                let mut m = 0.0;
+                for src in srcs {
+                    m += src[start + c][M];
+                }
+                *out = m;
+                mask |= ((m > 0.0) as u64) << (r * BLOCK + c);
+            }
+        }
+        out.mask[b] = mask;
     }
 }
 

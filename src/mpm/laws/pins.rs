@@ -254,10 +254,22 @@ pub fn constrain_grid(
 /// pinned vertex's stencil that carry weight: `1 + pin` (the last pin in
 /// `entries` order where stencils of two pins share a node).
 pub fn mark_stencil_nodes(entries: &[PinEntry], out: &mut [u32]) {
+    set_stencil_nodes(entries, out, true);
+}
+
+/// Undoes [`mark_stencil_nodes`] of the same `entries`: their nodes back
+/// to 0.
+pub fn unmark_stencil_nodes(entries: &[PinEntry], out: &mut [u32]) {
+    set_stencil_nodes(entries, out, false);
+}
+
+/// The weighted stencil nodes of `entries` in `out` to `1 + pin` (`mark`)
+/// or 0.
+fn set_stencil_nodes(entries: &[PinEntry], out: &mut [u32], mark: bool) {
     for e in entries {
         for n in 0..9 {
             if e.w[n] > 0.0 {
-                out[e.idx[n]] = e.pin as u32 + 1;
+                out[e.idx[n]] = if mark { e.pin as u32 + 1 } else { 0 };
             }
         }
     }
