@@ -159,13 +159,14 @@ impl YarnSim {
                 }
             }
         }
-        if let Some(f) = &mut self.fields {
-            f.record_masses(&self.grid);
-            for g in &mut f.grids {
-                grid_update::grid_update(g, dt, &interior, flip);
+        match &mut self.fields {
+            Some(f) => {
+                for (g, m, mask) in f.grids_with_masses(&mut self.grid) {
+                    grid_update::grid_update_masses(g, dt, &interior, flip, Some((m, mask)));
+                }
             }
+            None => grid_update::grid_update(&mut self.grid, dt, &interior, flip),
         }
-        grid_update::grid_update(&mut self.grid, dt, &interior, flip);
         self.pin_reactions.resize(self.pins.len(), Vec2::zeros());
         let out = ImplicitFields {
             grid: &mut self.grid,

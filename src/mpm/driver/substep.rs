@@ -96,13 +96,14 @@ impl YarnSim {
     ) -> Result<(), SimError> {
         let attractor = self.active_attractor(passes);
         let ext = grid_forces(&self.scene, passes, self.gravity, attractor);
-        if let Some(f) = &mut self.fields {
-            f.record_masses(&self.grid);
-            for g in &mut f.grids {
-                grid_update::grid_update(g, dt, &ext, flip);
+        match &mut self.fields {
+            Some(f) => {
+                for (g, m, mask) in f.grids_with_masses(&mut self.grid) {
+                    grid_update::grid_update_masses(g, dt, &ext, flip, Some((m, mask)));
+                }
             }
+            None => grid_update::grid_update(&mut self.grid, dt, &ext, flip),
         }
-        grid_update::grid_update(&mut self.grid, dt, &ext, flip);
         if !self.pins.is_empty() {
             let held = match &mut self.fields {
                 Some(f) => f.held_grid_mut(&mut self.grid),

@@ -74,6 +74,24 @@ struct BandCtx<'a> {
 /// each node is zeroed as it is summed, ready for the next scatter (so no
 /// separate clearing pass walks them again).
 pub fn grid_update(grid: &mut Grid, dt: f64, ext: &GridForces, flip: bool) {
+    grid_update_masses(grid, dt, ext, flip, None);
+}
+
+/// Where [`grid_update_masses`] writes the node masses it sums: a mass per
+/// node of the window, and per window block the mask of its nodes with
+/// mass > 0 (bit `8 r + c` for row `r`, column `c` of the block).
+pub type MassOut<'a> = (&'a mut [f64], &'a mut [u64]);
+
+/// [`grid_update`] that also writes the node mass it sums (the same sum,
+/// in chunk order) on every node of the active blocks, and their masks, to
+/// `masses` (for the field contact, [`crate::mpm::laws::fields`]).
+pub fn grid_update_masses(
+    grid: &mut Grid,
+    dt: f64,
+    ext: &GridForces,
+    flip: bool,
+    masses: Option<MassOut>,
+) {
     let geom = grid.geom;
     let band_len = geom.stride * BLOCK;
     let mut bands: Vec<Vec<BandSrc>> = (0..geom.nbi).map(|_| Vec::with_capacity(CHUNKS)).collect();
@@ -94,17 +112,31 @@ pub fn grid_update(grid: &mut Grid, dt: f64, ext: &GridForces, flip: bool) {
     let ctx = &ctx;
     let mut contacts = std::mem::take(&mut grid.contacts);
     contacts.resize_with(geom.nbi, Vec::new);
+    let band_masses: Vec<Option<MassOut>> = match masses {
+        Some((m, mask)) => m
+            .chunks_mut(band_len)
+            .zip(mask.chunks_mut(geom.nbj))
+            .map(Some)
+            .collect(),
+        None => (0..geom.nbi).map(|_| None).collect(),
+    };
     grid.node
         .par_chunks_mut(band_len)
         .zip(bands)
         .zip(contacts.par_iter_mut())
+        .zip(band_masses)
         .enumerate()
-        .for_each(|(bi, ((band, mut srcs), contacts))| {
+        .for_each(|(bi, (((band, mut srcs), contacts), mut masses))| {
             contacts.clear();
+            let out = BandOut {
+                node: band,
+                masses: masses.as_mut(),
+                contacts,
+            };
             if flip {
-                grid_band::<true>(bi, band, &mut srcs, ctx, contacts)
+                grid_band::<true>(bi, out, &mut srcs, ctx)
             } else {
-                grid_band::<false>(bi, band, &mut srcs, ctx, contacts)
+                grid_band::<false>(bi, out, &mut srcs, ctx)
             }
         });
     pooled_friction(ext, &wedges, &contacts, &mut grid.node, geom.n, flip);
@@ -274,16 +306,25 @@ pub fn boundaries(grid: &mut Grid, masses: &[[f64; 2]], ext: &GridForces, flip: 
     grid.contacts = contacts;
 }
 
+/// What the grid update of one band (block row) writes: its nodes, their
+/// masses and the blocks' masks if asked for ([`MassOut`], the band's
+/// part), and its obstacle contact nodes.
+struct BandOut<'a, 'm> {
+    node: &'a mut [Node],
+    masses: Option<&'a mut MassOut<'m>>,
+    contacts: &'a mut Vec<ContactNode>,
+}
+
 multiversion! {
     /// [`grid_update`] on the active blocks of block row `bi` of the window.
     fn grid_band<const FLIP: bool>(
         bi: usize,
-        band: &mut [Node],
+        out: BandOut,
         buffers: &mut [BandSrc],
         ctx: &BandCtx,
-        contacts: &mut Vec<ContactNode>,
     ) {
         let BandCtx { is_active, geom, ext, .. } = *ctx;
+        let BandOut { node: band, mut masses, contacts } = out;
         let band_base = bi * geom.stride * BLOCK;
         for bj in 0..geom.nbj {
             let b = bi * geom.nbj + bj;
@@ -302,10 +343,14 @@ multiversion! {
             let srcs = &srcs[..nsrc];
             let (near_obstacle, near_wall) = block_near(geom, ext, b);
             let blk = BlockAt { bj, i0, j0, near_wall };
-            if near_obstacle {
-                update_block::<FLIP, true>(&blk, band_base, band, buffers, srcs, ctx, contacts);
+            let mass = masses.as_mut().map(|m| &mut *m.0);
+            let mask = if near_obstacle {
+                update_block::<FLIP, true>(&blk, band_base, band, mass, buffers, srcs, ctx, contacts)
             } else {
-                update_block::<FLIP, false>(&blk, band_base, band, buffers, srcs, ctx, contacts);
+                update_block::<FLIP, false>(&blk, band_base, band, mass, buffers, srcs, ctx, contacts)
+            };
+            if let Some(m) = masses.as_mut() {
+                m.1[bj] = mask;
             }
         }
     }
@@ -320,20 +365,23 @@ struct BlockAt {
     near_wall: bool,
 }
 
-/// The grid update of one active block. `NEAR`: an obstacle is within
-/// reach, so the contact law runs and contact nodes are recorded (a
-/// separate instance keeps the common loop free of it).
+/// The grid update of one active block, with its nodes' masses written to
+/// `mass` (the band's) if given; returns the block's mask of nodes with
+/// mass ([`MassOut`]). `NEAR`: an obstacle is within reach, so the
+/// contact law runs and contact nodes are recorded (a separate instance
+/// keeps the common loop free of it).
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
 fn update_block<const FLIP: bool, const NEAR: bool>(
     blk: &BlockAt,
     band_base: usize,
     band: &mut [Node],
+    mut mass: Option<&mut [f64]>,
     buffers: &mut [BandSrc],
     srcs: &[usize],
     ctx: &BandCtx,
     contacts: &mut Vec<ContactNode>,
-) {
+) -> u64 {
     let BandCtx {
         geom,
         dt,
@@ -349,6 +397,7 @@ fn update_block<const FLIP: bool, const NEAR: bool>(
     } = *blk;
     let cells = ext.wall_cells;
     let dx = geom.dx;
+    let mut mask = 0u64;
     for r in 0..BLOCK {
         let i = i0 + r;
         let row = r * geom.stride + bj * BLOCK;
@@ -362,6 +411,10 @@ fn update_block<const FLIP: bool, const NEAR: bool>(
                 }
                 *n = [0.0; P2G_LANES];
             }
+            if let Some(m) = mass.as_deref_mut() {
+                m[row + c] = acc[M];
+            }
+            mask |= ((acc[M] > 0.0) as u64) << (r * BLOCK + c);
             let out = &mut band[row + c];
             if acc[M] <= 0.0 {
                 *out = [0.0; 4];
@@ -402,4 +455,5 @@ fn update_block<const FLIP: bool, const NEAR: bool>(
             };
         }
     }
+    mask
 }

@@ -52,7 +52,7 @@
 use crate::math::Vec2;
 use crate::mpm::laws::contact::coulomb;
 use crate::mpm::laws::pins::{self, PinEntry};
-use crate::mpm::machinery::grid::{Grid, GridGeom, P2gNode, BLOCK, CHUNKS, DVX, DVY, M, VX, VY};
+use crate::mpm::machinery::grid::{Grid, GridGeom, BLOCK, DVX, DVY, VX, VY};
 
 /// How yarns are partitioned into velocity fields (the scene's `[contact]
 /// fields`, see the module documentation).
@@ -92,7 +92,8 @@ pub struct Fields {
     pub quad_field: Vec<u16>,
     /// The held yarns' field, if any yarn is held.
     pub held: Option<u16>,
-    /// Node masses of each field this substep (window storage).
+    /// Node masses of each field this substep (window storage), written by
+    /// the grid update ([`Fields::grids_with_masses`]).
     masses: Vec<NodeMasses>,
     /// Per node, 1 + the pin whose vertex's stencil holds it, or 0 (zero
     /// between contacts, on the window `pinned_geom`).
@@ -185,13 +186,24 @@ impl Fields {
         self.grids.iter().map(Grid::memory_bytes).sum()
     }
 
-    /// Keeps the node masses of every field (call after the scatter,
-    /// before the grid update consumes the scatter buffers).
-    pub fn record_masses(&mut self, main: &Grid) {
-        node_masses(main, &mut self.masses[0]);
-        for (g, m) in self.grids.iter().zip(&mut self.masses[1..]) {
-            node_masses(g, m);
-        }
+    /// Every field's grid (field 0: `main`) with its node-mass storage
+    /// ready for the grid update to fill: a mass per node of the window,
+    /// written on the grid's active blocks (zero elsewhere), and per window
+    /// block the mask of nodes with mass > 0 (bit `8 r + c` for row `r`,
+    /// column `c`). Call after the scatter; the grid update sums the masses
+    /// in chunk order, as it sums them for the velocities.
+    pub fn grids_with_masses<'a>(
+        &'a mut self,
+        main: &'a mut Grid,
+    ) -> Vec<(&'a mut Grid, &'a mut [f64], &'a mut [u64])> {
+        std::iter::once(main)
+            .chain(self.grids.iter_mut())
+            .zip(self.masses.iter_mut())
+            .map(|(g, m)| {
+                m.prepare(g);
+                (g, &mut m.m[..], &mut m.mask[..])
+            })
+            .collect()
     }
 
     /// The contact of the fields (see the module documentation), after
@@ -362,57 +374,30 @@ fn add_velocity(node: &mut [f64; 4], dv: Vec2) {
     node[DVY] += dv.y;
 }
 
-/// Node masses of `grid`'s scatter buffers, summed in chunk order (the
-/// grid update's order) on its active blocks, zero elsewhere, and the
-/// blocks' masks of nodes with mass.
-///
-/// Only the blocks written last time are zeroed again (the whole window
-/// when it has moved): with many fields the window is mostly other
-/// fields' blocks.
-fn node_masses(grid: &Grid, out: &mut NodeMasses) {
-    let geom = grid.geom;
-    let s = geom.stride;
-    if out.geom != Some(geom) {
-        out.m.clear();
-        out.m.resize(geom.storage(), 0.0);
-        out.mask.clear();
-        out.mask.resize(geom.blocks(), 0);
-        out.geom = Some(geom);
-    } else {
-        for &b in &out.written {
-            let first = block_first_node(&geom, b as usize);
-            for r in 0..BLOCK {
-                out.m[first + r * s..][..BLOCK].fill(0.0);
-            }
-            out.mask[b as usize] = 0;
-        }
-    }
-    out.written.clear();
-    out.written.extend_from_slice(&grid.active);
-    for &b in &grid.active {
-        let b = b as usize;
-        let mut srcs: [&[P2gNode]; CHUNKS] = [&[]; CHUNKS];
-        let mut nsrc = 0;
-        for buf in grid.buffers.iter().filter(|buf| buf.touched[b]) {
-            srcs[nsrc] = &buf.node;
-            nsrc += 1;
-        }
-        let srcs = &srcs[..nsrc];
-        let first = block_first_node(&geom, b);
-        let mut mask = 0u64;
-        for r in 0..BLOCK {
-            let start = first + r * s;
-            let row = &mut out.m[start..start + BLOCK];
-            for (c, out) in row.iter_mut().enumerate() {
-                let mut m = 0.0;
-                for src in srcs {
-                    m += src[start + c][M];
+impl NodeMasses {
+    /// Ready for `grid`'s active blocks to be written: sized to its window
+    /// and zeroed there when the window has moved, otherwise zeroed on the
+    /// blocks written last time only (with many fields the window is
+    /// mostly other fields' blocks).
+    fn prepare(&mut self, grid: &Grid) {
+        let geom = grid.geom;
+        if self.geom != Some(geom) {
+            self.m.clear();
+            self.m.resize(geom.storage(), 0.0);
+            self.mask.clear();
+            self.mask.resize(geom.blocks(), 0);
+            self.geom = Some(geom);
+        } else {
+            for &b in &self.written {
+                let first = block_first_node(&geom, b as usize);
+                for r in 0..BLOCK {
+                    self.m[first + r * geom.stride..][..BLOCK].fill(0.0);
                 }
-                *out = m;
-                mask |= ((m > 0.0) as u64) << (r * BLOCK + c);
+                self.mask[b as usize] = 0;
             }
         }
-        out.mask[b] = mask;
+        self.written.clear();
+        self.written.extend_from_slice(&grid.active);
     }
 }
 
