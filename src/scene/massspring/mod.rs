@@ -333,6 +333,7 @@ fn chain_count<'de, D: Deserializer<'de>>(d: D) -> Result<u32, D::Error> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::testing::assert_mentions;
 
     const WIRE: &str = r#"
 kind = "wire"
@@ -368,10 +369,7 @@ damping = 100.0
         let e =
             MassSpringScene::from_toml_str(&WIRE.replace("mass = 1.0", "mass = -1.0")).unwrap_err();
         let m = e.to_string();
-        assert!(
-            m.contains("line 10") && m.contains("`chains[0].mass`") && m.contains("> 0"),
-            "{m}"
-        );
+        assert_mentions(&m, &["line 10", "`chains[0].mass`", "> 0"]);
     }
 
     #[test]
@@ -380,7 +378,7 @@ damping = 100.0
         let m = MassSpringScene::from_toml_str(&text)
             .unwrap_err()
             .to_string();
-        assert!(m.contains("line 3") && m.contains("`pinned[0]`"), "{m}");
+        assert_mentions(&m, &["line 3", "`pinned[0]`"]);
     }
 
     #[test]
