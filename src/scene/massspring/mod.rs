@@ -82,11 +82,7 @@ pub struct TimeParams {
     pub frames: u32,
     /// Step size in s of the implicit and position-based integrators
     /// (default: `frame_time`). Explicit integrators use the CFL bound.
-    #[serde(
-        default,
-        skip_serializing_if = "Option::is_none",
-        deserialize_with = "opt_positive"
-    )]
+    #[serde(default, deserialize_with = "opt_positive")]
     pub time_step: Option<f64>,
     /// Fraction of the stability bound the explicit integrators step at
     /// (0 < c <= 1, default 0.5 as in the course notes).
@@ -100,11 +96,7 @@ pub struct TimeParams {
     /// Strain limit `s` of the position-based pass: after each step every
     /// spring length is pulled into `[(1-s) l0, (1+s) l0]`. Absent: no pass
     /// (the `pbd` integrator then uses `s = 0`).
-    #[serde(
-        default,
-        skip_serializing_if = "Option::is_none",
-        deserialize_with = "opt_strain"
-    )]
+    #[serde(default, deserialize_with = "opt_strain")]
     pub strain_limit: Option<f64>,
 }
 
@@ -137,11 +129,7 @@ pub struct SpringSpec {
     #[serde(default, deserialize_with = "nonnegative")]
     pub damping: f64,
     /// Rest length in m (default: the initial distance).
-    #[serde(
-        default,
-        skip_serializing_if = "Option::is_none",
-        deserialize_with = "opt_positive"
-    )]
+    #[serde(default, deserialize_with = "opt_positive")]
     pub rest_length: Option<f64>,
 }
 
