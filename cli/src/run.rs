@@ -16,20 +16,31 @@ use crate::schedule::Schedule;
 use crate::table::{count, energy_rows, yarn_rows, DiagRow, Summary};
 use crate::yarn::YarnFlags;
 
-/// Runs `scene` for `duration` seconds; writes the CSV to `csv` if given.
-/// `integrator`: the mass-spring integrator, and `allow_unstable` for both
-/// kinds of scene (see [`start_yarn`]).
-pub fn run(
-    scene: &Scene,
-    duration: f64,
-    csv: Option<&Path>,
-    integrator: &IntegratorArgs,
-) -> Result<Summary, CliError> {
-    match scene {
-        Scene::Yarn(y) => run_yarn(&mut start_yarn(y, integrator)?, duration, csv),
-        Scene::MassSpring(l) => {
-            run_massspring(&mut MassSpringRun::new(l, integrator)?, duration, csv)
-        }
+/// A scene's simulation, started with the command's integrator flags, for
+/// `run` and `record`.
+pub enum Started {
+    Yarn(Box<YarnSim>),
+    MassSpring(Box<MassSpringRun>),
+}
+
+impl Started {
+    /// Starts `scene`. `integrator`: the mass-spring integrator, and
+    /// `allow_unstable` for both kinds of scene (see [`start_yarn`]).
+    pub fn new(scene: &Scene, integrator: &IntegratorArgs) -> Result<Self, CliError> {
+        Ok(match scene {
+            Scene::Yarn(y) => Started::Yarn(Box::new(start_yarn(y, integrator)?)),
+            Scene::MassSpring(l) => {
+                Started::MassSpring(Box::new(MassSpringRun::new(l, integrator)?))
+            }
+        })
+    }
+}
+
+/// Runs `sim` for `duration` seconds; writes the CSV to `csv` if given.
+pub fn run(sim: &mut Started, duration: f64, csv: Option<&Path>) -> Result<Summary, CliError> {
+    match sim {
+        Started::Yarn(sim) => run_yarn(sim, duration, csv),
+        Started::MassSpring(run) => run_massspring(run, duration, csv),
     }
 }
 
