@@ -145,7 +145,9 @@ impl Instance {
             };
             return error(format!("{}: {what}", self.op_name(Operation::SetFloat)));
         }
-        self.set_values(Operation::SetFloat, |m, ctx| m.set_real(vrs, vals, ctx))
+        self.set_values(Operation::SetFloat, |m, ctx| {
+            m.set_real(Set { vrs, vals, ctx })
+        })
     }
 
     /// Sets the execution parameters `max_substeps_per_step` and `threads`
@@ -193,11 +195,17 @@ impl Instance {
     pub fn set_boolean(&mut self, vrs: &[u32], vals: &[c_int]) -> Res {
         let vals: Vec<bool> = vals.iter().map(|&v| v != 0).collect();
         self.set_values(Operation::SetBoolean, |m, ctx| {
-            m.set_boolean(vrs, &vals, ctx)
+            m.set_boolean(Set {
+                vrs,
+                vals: &vals,
+                ctx,
+            })
         })
     }
 
     pub fn set_string(&mut self, vrs: &[u32], vals: &[Option<String>]) -> Res {
-        self.set_values(Operation::SetString, |m, ctx| m.set_string(vrs, vals, ctx))
+        self.set_values(Operation::SetString, |m, ctx| {
+            m.set_string(Set { vrs, vals, ctx })
+        })
     }
 }

@@ -14,7 +14,7 @@ use yarnsim::massspring::{Integrator, IntegratorOptions, MassSpringScene, Simula
 
 use crate::model_description::table_name;
 use crate::models::model::{
-    refuse, Checkpoint, FmuModel, ModelResult, ModelSnapshot, SetContext, StepFailure, VarName,
+    refuse, Checkpoint, FmuModel, ModelResult, ModelSnapshot, Set, StepFailure, VarName,
 };
 use crate::models::state_bytes::{Reader, Writer};
 
@@ -170,7 +170,8 @@ impl FmuModel for MsModel {
     }
     /// Sets the gravity inputs and the `dt` parameter; true when the
     /// parameter changed. A rejected call changes nothing.
-    fn set_real(&mut self, vrs: &[u32], vals: &[f64], ctx: &SetContext) -> ModelResult<bool> {
+    fn set_real(&mut self, set: Set<f64>) -> ModelResult<bool> {
+        let Set { vrs, vals, ctx } = set;
         let mut gravity = self.gravity;
         let mut dt = self.dt;
         for (&vr, &v) in vrs.iter().zip(vals) {
@@ -216,8 +217,8 @@ impl FmuModel for MsModel {
         self.dt = dt;
         Ok(changed)
     }
-    fn set_boolean(&mut self, vrs: &[u32], _vals: &[bool], _: &SetContext) -> ModelResult<bool> {
-        match vrs.first() {
+    fn set_boolean(&mut self, set: Set<bool>) -> ModelResult<bool> {
+        match set.vrs.first() {
             None => Ok(false),
             Some(&vr) => refuse(format!(
                 "{} is not a Boolean input or parameter (this FMU has none)",
@@ -226,12 +227,8 @@ impl FmuModel for MsModel {
         }
     }
     /// Sets the `integrator` parameter; true when it changed.
-    fn set_string(
-        &mut self,
-        vrs: &[u32],
-        vals: &[Option<String>],
-        ctx: &SetContext,
-    ) -> ModelResult<bool> {
+    fn set_string(&mut self, set: Set<Option<String>>) -> ModelResult<bool> {
+        let Set { vrs, vals, ctx } = set;
         let mut integrator = self.integrator;
         for (&vr, v) in vrs.iter().zip(vals) {
             if vr != VR_INTEGRATOR {

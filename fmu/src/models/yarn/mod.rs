@@ -11,8 +11,7 @@ use yarnsim::scene::{Integrator, TransferScheme, YarnScene};
 
 use crate::model_description::*;
 use crate::models::model::{
-    refuse, Checkpoint, FmuModel, ModelError, ModelResult, ModelSnapshot, SetContext, StepFailure,
-    VarName,
+    refuse, Checkpoint, FmuModel, ModelError, ModelResult, ModelSnapshot, Set, StepFailure, VarName,
 };
 use crate::models::state_bytes::{Reader, Writer};
 
@@ -208,11 +207,10 @@ impl YarnModel {
     /// (`ctx.resources`) or the bundled one, `bundled`; true when it changed.
     pub fn set_string(
         &mut self,
-        vrs: &[u32],
-        vals: &[Option<String>],
-        ctx: &SetContext,
+        set: Set<Option<String>>,
         bundled: &YarnScene,
     ) -> ModelResult<bool> {
+        let Set { vrs, vals, ctx } = set;
         let mut changed = false;
         for (&vr, v) in vrs.iter().zip(vals) {
             if vr != VR_SCENE && vr != VR_TRANSFER_SCHEME && vr != VR_INTEGRATOR {
@@ -472,7 +470,8 @@ impl FmuModel for YarnModel {
     }
     /// Sets Real inputs and parameters; true when a parameter changed (the
     /// simulation must be rebuilt). A rejected call changes nothing.
-    fn set_real(&mut self, vrs: &[u32], vals: &[f64], ctx: &SetContext) -> ModelResult<bool> {
+    fn set_real(&mut self, set: Set<f64>) -> ModelResult<bool> {
+        let Set { vrs, vals, ctx } = set;
         let mut inputs = self.inputs.clone();
         let mut attractor = self.sim.attractor();
         let mut gravity = self.sim.gravity();
@@ -561,7 +560,8 @@ impl FmuModel for YarnModel {
         Ok(changed)
     }
     /// Sets Boolean inputs and parameters; true when a parameter changed.
-    fn set_boolean(&mut self, vrs: &[u32], vals: &[bool], ctx: &SetContext) -> ModelResult<bool> {
+    fn set_boolean(&mut self, set: Set<bool>) -> ModelResult<bool> {
+        let Set { vrs, vals, ctx } = set;
         let mut attractor = self.sim.attractor();
         let mut plasticity = self.config.plasticity;
         for (&vr, &v) in vrs.iter().zip(vals) {
@@ -613,16 +613,11 @@ impl FmuModel for YarnModel {
         self.forces = forces;
         self.diag = None;
     }
-    fn set_string(
-        &mut self,
-        vrs: &[u32],
-        vals: &[Option<String>],
-        ctx: &SetContext,
-    ) -> ModelResult<bool> {
-        let yarnsim::scene::Scene::Yarn(bundled) = ctx.bundled else {
+    fn set_string(&mut self, set: Set<Option<String>>) -> ModelResult<bool> {
+        let yarnsim::scene::Scene::Yarn(bundled) = set.ctx.bundled else {
             return Err(ModelError("a yarn model with a mass-spring scene".into()));
         };
-        YarnModel::set_string(self, vrs, vals, ctx, bundled)
+        YarnModel::set_string(self, set, bundled)
     }
     fn save(&self) -> ModelSnapshot {
         Box::new(YarnModel::save(self))
