@@ -90,6 +90,14 @@ impl Rng {
     }
 }
 
+/// Asserts that the error message `m` names every one of `parts` (a
+/// field, its line, the bound it breaks); the failure prints `m`.
+pub fn assert_mentions(m: &str, parts: &[&str]) {
+    for part in parts {
+        assert!(m.contains(part), "no {part:?} in the message: {m}");
+    }
+}
+
 /// The material of the reference scene (`yarn-reference`).
 pub fn reference_material() -> Material {
     yarn_reference().material

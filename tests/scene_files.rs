@@ -3,6 +3,7 @@
 use yarnsim::scene::{
     builtin, builtin_names, builtin_toml, Integrator, Scene, SceneError, YarnScene,
 };
+use yarnsim::testing::assert_mentions;
 
 /// The smallest complete yarn scene file.
 const GOOD: &str = yarnsim::testing::MINIMAL_TOML;
@@ -37,46 +38,40 @@ fn every_builtin_round_trips_through_toml() {
 fn negative_value_names_field_and_line() {
     let e = err(&GOOD.replace("dt = 1e-4", "dt = -1e-4"));
     let m = e.to_string();
-    assert!(
-        m.contains("line 6") && m.contains("time.dt") && m.contains("> 0"),
-        "{m}"
-    );
+    assert_mentions(&m, &["line 6", "time.dt", "> 0"]);
 }
 
 #[test]
 fn unknown_field_names_field_and_line() {
     let e = err(&GOOD.replace("gamma = 500.0", "gamma = 500.0\nstifness = 3"));
     let m = e.to_string();
-    assert!(m.contains("line 10") && m.contains("stifness"), "{m}");
+    assert_mentions(&m, &["line 10", "stifness"]);
 }
 
 #[test]
 fn wrong_type_and_syntax_errors_name_the_line() {
     let m = err(&GOOD.replace("resolution = 64", "resolution = \"big\"")).to_string();
-    assert!(m.contains("line 4") && m.contains("grid.resolution"), "{m}");
+    assert_mentions(&m, &["line 4", "grid.resolution"]);
     let m = err(&GOOD.replace("[material]", "[material")).to_string();
-    assert!(m.contains("line 7"), "{m}");
+    assert_mentions(&m, &["line 7"]);
     let m = err(&GOOD.replace("resolution = 64", "resolution = 3")).to_string();
-    assert!(m.contains("line 4") && m.contains("from 8"), "{m}");
+    assert_mentions(&m, &["line 4", "from 8"]);
 }
 
 #[test]
 fn missing_field_is_named() {
     let m = err(&GOOD.replace("friction = 0.05\n", "")).to_string();
-    assert!(m.contains("friction"), "{m}");
+    assert_mentions(&m, &["friction"]);
 }
 
 #[test]
 fn inconsistent_geometry_names_the_yarn_and_its_line() {
     let m = err(&GOOD.replace("length = 0.5", "length = 5.0")).to_string();
-    assert!(
-        m.contains("yarns[0]") && m.contains("line 12") && m.contains("outside"),
-        "{m}"
-    );
+    assert_mentions(&m, &["yarns[0]", "line 12", "outside"]);
     let m = err(&GOOD.replace("direction = [1.0, 0.0]\n", "")).to_string();
-    assert!(m.contains("yarns[0]") && m.contains("give either"), "{m}");
+    assert_mentions(&m, &["yarns[0]", "give either"]);
     let m = err(&GOOD.replace("direction = [1.0, 0.0]", "direction = [0.0, 0.0]")).to_string();
-    assert!(m.contains("direction") && m.contains("zero"), "{m}");
+    assert_mentions(&m, &["direction", "zero"]);
 }
 
 #[test]
@@ -128,10 +123,7 @@ fn implicit_integrator_loads_and_an_unknown_one_is_refused_naming_the_field_and_
     YarnScene::from_toml_str(&mixed).unwrap();
     // An unknown integrator is a field error too.
     let m = err(&GOOD.replace("dt = 1e-4", "dt = 1e-4\nintegrator = \"rk4\"")).to_string();
-    assert!(
-        m.contains("line 7") && m.contains("time.integrator") && m.contains("rk4"),
-        "{m}"
-    );
+    assert_mentions(&m, &["line 7", "time.integrator", "rk4"]);
 }
 
 /// Every built-in is a file under `scenes/` (`scenes/yarn/NAME.toml`,

@@ -21,7 +21,7 @@
 mod common;
 
 use common::{
-    friction_scene as yarn_scene_stepped, momentum_scale, on_threads, pin_end, straight,
+    friction_scene as yarn_scene_stepped, on_threads, pin_end, straight, worst_momentum_balance,
     yarns_and_pins_toml,
 };
 use yarnsim::scene::{TransferScheme, YarnEnd};
@@ -253,18 +253,8 @@ fn two_field_contact_conserves_momentum_on_a_held_tightrope() {
         let s = yarn_scene([1.0, -9.8], 64, scheme, 0.2, &yarns);
         let mut sim = YarnSim::new(&s).unwrap();
         assert!(sim.has_two_fields());
-        let (dt, g) = (sim.dt(), sim.gravity());
         let steps = if cfg!(debug_assertions) { 50 } else { 1500 };
-        let mut worst: f64 = 0.0;
-        for _ in 0..steps {
-            let d0 = sim.diagnostics();
-            sim.step().unwrap();
-            let d1 = sim.diagnostics();
-            let pins: yarnsim::math::Vec2 = sim.pin_reactions().iter().sum();
-            let expect = (g * d0.total_mass + pins) * dt;
-            let scale = momentum_scale(&sim) + expect.norm();
-            worst = worst.max((d1.momentum - d0.momentum - expect).norm() / scale);
-        }
+        let worst = worst_momentum_balance(&mut sim, steps);
         // the top yarn rests on the sagging rope, its middle vertex more
         // than half a cell (7.8 mm) above the rope's (vertices 89 and 38)
         let x = &sim.particles().vert.x;

@@ -27,8 +27,10 @@
 
 mod common;
 
-use common::{friction_scene, momentum_scale, on_threads};
-use yarnsim::scene::TransferScheme;
+use common::{
+    friction_scene, on_threads, pin_end, straight, worst_momentum_balance, yarns_and_pins_toml,
+};
+use yarnsim::scene::{TransferScheme, YarnEnd, YarnSpec};
 use yarnsim::YarnSim;
 
 /// Gravity of the scenes.
@@ -270,53 +272,23 @@ fn many_fields_are_bit_identical_for_one_and_two_threads() {
 /// one (its middle stays above).
 #[test]
 fn many_field_contact_conserves_momentum_and_the_pins_carry_their_share() {
-    let yarns = r#"
-[contact]
-fields = "per-yarn"
-[[yarns]]
-start = [0.25, 0.46]
-end = [0.75, 0.46]
-vertices = 65
-velocity = [0.0, -0.3]
-[[yarns]]
-start = [0.3, 0.54]
-end = [0.7, 0.52]
-vertices = 52
-velocity = [0.0, -0.5]
-[[yarns]]
-start = [0.45, 0.5]
-end = [0.55, 0.65]
-vertices = 30
-velocity = [0.3, 0.0]
-[[yarns]]
-start = [0.2, 0.42]
-end = [0.8, 0.42]
-vertices = 77
-[[pins]]
-yarn = 3
-end = "start"
-count = 3
-[[pins]]
-yarn = 3
-end = "end"
-count = 3
-"#;
+    let moving = |yarn: YarnSpec, velocity: [f64; 2]| YarnSpec { velocity, ..yarn };
+    let yarns = "[contact]\nfields = \"per-yarn\"\n".to_string()
+        + &yarns_and_pins_toml(
+            &[
+                moving(straight([0.25, 0.46], [0.75, 0.46], 65), [0.0, -0.3]),
+                moving(straight([0.3, 0.54], [0.7, 0.52], 52), [0.0, -0.5]),
+                moving(straight([0.45, 0.5], [0.55, 0.65], 30), [0.3, 0.0]),
+                straight([0.2, 0.42], [0.8, 0.42], 77),
+            ],
+            &[pin_end(3, YarnEnd::Start, 3), pin_end(3, YarnEnd::End, 3)],
+        );
     for scheme in [TransferScheme::Flip, TransferScheme::Apic] {
-        let s = friction_scene([0.5, -9.8], 64, scheme, 0.3, yarns, "dt = 1e-4");
+        let s = friction_scene([0.5, -9.8], 64, scheme, 0.3, &yarns, "dt = 1e-4");
         let mut sim = YarnSim::new(&s).unwrap();
         assert_eq!(sim.velocity_fields(), 4);
-        let (dt, g) = (sim.dt(), sim.gravity());
         let steps = if cfg!(debug_assertions) { 50 } else { 2500 };
-        let mut worst: f64 = 0.0;
-        for _ in 0..steps {
-            let d0 = sim.diagnostics();
-            sim.step().unwrap();
-            let d1 = sim.diagnostics();
-            let pins: yarnsim::math::Vec2 = sim.pin_reactions().iter().sum();
-            let expect = (g * d0.total_mass + pins) * dt;
-            let scale = momentum_scale(&sim) + expect.norm();
-            worst = worst.max((d1.momentum - d0.momentum - expect).norm() / scale);
-        }
+        let worst = worst_momentum_balance(&mut sim, steps);
         let x = &sim.particles().vert.x;
         // middle vertices: 32 of yarn 0, 65 + 26 of yarn 1
         let gap = x[91].y - x[32].y;

@@ -18,7 +18,8 @@ pub trait Stepper {
     fn steps(&self) -> u64;
     /// Number of particles (the unit of the throughput figure).
     fn num_particles(&self) -> usize;
-    /// The simulation's clock, s (adaptive schedules).
+    /// The simulation's clock, s (adaptive schedules; the recordings'
+    /// simulated-time timeline).
     fn time(&self) -> f64 {
         0.0
     }

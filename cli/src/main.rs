@@ -15,7 +15,7 @@ use yarnsim_cli::record::{
     parse_memory_limit, record, MemoryLimit, RecordOptions, Sink, DEFAULT_CONNECT_URL,
     DEFAULT_SERVER_MEMORY_LIMIT, DEFAULT_SERVE_PORT,
 };
-use yarnsim_cli::run::run;
+use yarnsim_cli::run::{run, Started};
 use yarnsim_cli::scenes::{list_scenes, load_scene, show_scene};
 use yarnsim_cli::table::{format_summary, Timing};
 
@@ -225,7 +225,8 @@ fn execute(command: Command) -> Result<u8, CliError> {
         } => {
             let scene = scene.load()?;
             announce(&Estimate::of(&scene, duration, None));
-            let summary = run(&scene, duration, csv.as_deref(), &integrator.args())?;
+            let mut sim = Started::new(&scene, &integrator.args())?;
+            let summary = run(&mut sim, duration, csv.as_deref())?;
             print!("{}", format_summary(&summary, Timing::Show));
             if let Some(failure) = &summary.failure {
                 eprintln!("error: {failure}");
@@ -261,7 +262,8 @@ fn execute(command: Command) -> Result<u8, CliError> {
             let scene = scene.load()?;
             announce(&Estimate::of(&scene, duration, Some(every)));
             let opts = RecordOptions { sink, every };
-            let r = record(&scene, duration, &opts, &integrator.args())?;
+            let mut sim = Started::new(&scene, &integrator.args())?;
+            let r = record(&mut sim, duration, &opts)?;
             let o = r.outcome;
             let every_note = if every > 1 {
                 format!(" (1 in {every} of {} frames)", o.last_frame + 1)

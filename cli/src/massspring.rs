@@ -185,6 +185,9 @@ impl Stepper for MassSpringRun {
     fn num_particles(&self) -> usize {
         self.sim.system().len()
     }
+    fn time(&self) -> f64 {
+        MassSpringRun::time(self)
+    }
     fn check_finite(&self) -> Result<(), CliError> {
         let finite = |v: &[V3]| v.iter().all(|x| x.iter().all(|c| c.is_finite()));
         let e = self.sim.energies();

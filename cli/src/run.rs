@@ -13,23 +13,34 @@ use crate::driver::run_frames_shown;
 use crate::error::CliError;
 use crate::massspring::{IntegratorArgs, MassSpringRun, MsDiagnostics};
 use crate::schedule::Schedule;
-use crate::table::{count, yarn_rows, DiagRow, Summary};
+use crate::table::{count, energy_rows, yarn_rows, DiagRow, Summary};
 use crate::yarn::YarnFlags;
 
-/// Runs `scene` for `duration` seconds; writes the CSV to `csv` if given.
-/// `integrator`: the mass-spring integrator, and `allow_unstable` for both
-/// kinds of scene (see [`start_yarn`]).
-pub fn run(
-    scene: &Scene,
-    duration: f64,
-    csv: Option<&Path>,
-    integrator: &IntegratorArgs,
-) -> Result<Summary, CliError> {
-    match scene {
-        Scene::Yarn(y) => run_yarn(&mut start_yarn(y, integrator)?, duration, csv),
-        Scene::MassSpring(l) => {
-            run_massspring(&mut MassSpringRun::new(l, integrator)?, duration, csv)
-        }
+/// A scene's simulation, started with the command's integrator flags, for
+/// `run` and `record`.
+pub enum Started {
+    Yarn(Box<YarnSim>),
+    MassSpring(Box<MassSpringRun>),
+}
+
+impl Started {
+    /// Starts `scene`. `integrator`: the mass-spring integrator, and
+    /// `allow_unstable` for both kinds of scene (see [`start_yarn`]).
+    pub fn new(scene: &Scene, integrator: &IntegratorArgs) -> Result<Self, CliError> {
+        Ok(match scene {
+            Scene::Yarn(y) => Started::Yarn(Box::new(start_yarn(y, integrator)?)),
+            Scene::MassSpring(l) => {
+                Started::MassSpring(Box::new(MassSpringRun::new(l, integrator)?))
+            }
+        })
+    }
+}
+
+/// Runs `sim` for `duration` seconds; writes the CSV to `csv` if given.
+pub fn run(sim: &mut Started, duration: f64, csv: Option<&Path>) -> Result<Summary, CliError> {
+    match sim {
+        Started::Yarn(sim) => run_yarn(sim, duration, csv),
+        Started::MassSpring(run) => run_massspring(run, duration, csv),
     }
 }
 
@@ -70,15 +81,8 @@ pub fn run_massspring(
 
 /// The summary rows of a mass-spring run.
 pub fn ms_rows(a: &MsDiagnostics, b: &MsDiagnostics) -> Vec<DiagRow> {
-    let total = |d: &MsDiagnostics| d.kinetic_energy + d.elastic_energy + d.gravity_energy;
-    vec![
-        ("time [s]", a.time, b.time),
-        ("kinetic energy", a.kinetic_energy, b.kinetic_energy),
-        ("elastic energy", a.elastic_energy, b.elastic_energy),
-        ("gravity energy", a.gravity_energy, b.gravity_energy),
-        ("total energy", total(a), total(b)),
-        ("momentum x", a.momentum.x, b.momentum.x),
-        ("momentum y", a.momentum.y, b.momentum.y),
+    let mut rows = energy_rows!(a, b, "time [s]", gravity_energy, "gravity energy");
+    rows.extend([
         ("momentum z", a.momentum.z, b.momentum.z),
         (
             "ang. momentum x",
@@ -96,7 +100,8 @@ pub fn ms_rows(a: &MsDiagnostics, b: &MsDiagnostics) -> Vec<DiagRow> {
             b.angular_momentum.z,
         ),
         ("max strain", a.max_strain, b.max_strain),
-    ]
+    ]);
+    rows
 }
 
 /// The simulation of a yarn scene for `run`, `record` and `bench`, with

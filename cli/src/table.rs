@@ -67,21 +67,42 @@ impl Summary {
     }
 }
 
+/// The rows that open every run's summary, from the diagnostics `$a` at
+/// the start and `$b` at the end: the time (the row `$time`), the kinetic,
+/// elastic and potential energies (the field `$potential`, the row
+/// `$name`), their total, the momentum's x and y. A macro, not a function:
+/// the yarn's and the mass-spring's diagnostics name these fields alike
+/// but share no trait.
+macro_rules! energy_rows {
+    ($a:expr, $b:expr, $time:literal, $potential:ident, $name:literal) => {{
+        let (a, b) = ($a, $b);
+        let rows: Vec<$crate::table::DiagRow> = vec![
+            ($time, a.time, b.time),
+            ("kinetic energy", a.kinetic_energy, b.kinetic_energy),
+            ("elastic energy", a.elastic_energy, b.elastic_energy),
+            ($name, a.$potential, b.$potential),
+            (
+                "total energy",
+                a.kinetic_energy + a.elastic_energy + a.$potential,
+                b.kinetic_energy + b.elastic_energy + b.$potential,
+            ),
+            ("momentum x", a.momentum.x, b.momentum.x),
+            ("momentum y", a.momentum.y, b.momentum.y),
+        ];
+        rows
+    }};
+}
+pub(crate) use energy_rows;
+
 /// The summary rows of a yarn run.
 pub fn yarn_rows(a: &Diagnostics, b: &Diagnostics) -> Vec<DiagRow> {
-    let total = |d: &Diagnostics| d.kinetic_energy + d.elastic_energy + d.potential_energy;
-    vec![
-        ("time", a.time, b.time),
-        ("kinetic energy", a.kinetic_energy, b.kinetic_energy),
-        ("elastic energy", a.elastic_energy, b.elastic_energy),
-        ("potential energy", a.potential_energy, b.potential_energy),
-        ("total energy", total(a), total(b)),
-        ("momentum x", a.momentum.x, b.momentum.x),
-        ("momentum y", a.momentum.y, b.momentum.y),
+    let mut rows = energy_rows!(a, b, "time", potential_energy, "potential energy");
+    rows.extend([
         ("angular momentum", a.angular_momentum, b.angular_momentum),
         ("min stretch", a.min_stretch, b.min_stretch),
         ("max stretch", a.max_stretch, b.max_stretch),
-    ]
+    ]);
+    rows
 }
 
 /// The unit of a diagnostic row by its quantity (the row's name up to its

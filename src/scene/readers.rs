@@ -1,6 +1,8 @@
 //! Validating field readers for `#[serde(deserialize_with = ...)]` and serde
 //! defaults, shared by every scene kind. A reader's error carries the value's span, so the TOML
-//! loader reports the line and the field of a bad value.
+//! loader reports the line and the field of a bad value. An optional field
+//! (`Option`) needs `default` for reading but no `skip_serializing_if` for
+//! writing: the `toml` serializer leaves a `None` field out of its table.
 
 use serde::de::Error as _;
 use serde::{Deserialize, Deserializer};

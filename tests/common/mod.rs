@@ -26,6 +26,25 @@ pub fn momentum_scale(sim: &YarnSim) -> f64 {
         .sum()
 }
 
+/// Runs `steps` substeps of `sim` and returns the worst momentum balance
+/// of one substep: the change of momentum less the impulse of gravity and
+/// of the pins' reactions, `(g M + sum R) dt`, relative to
+/// [`momentum_scale`] plus that impulse.
+pub fn worst_momentum_balance(sim: &mut YarnSim, steps: u32) -> f64 {
+    let (dt, g) = (sim.dt(), sim.gravity());
+    let mut worst: f64 = 0.0;
+    for _ in 0..steps {
+        let d0 = sim.diagnostics();
+        sim.step().unwrap();
+        let d1 = sim.diagnostics();
+        let pins: Vec2 = sim.pin_reactions().iter().sum();
+        let expect = (g * d0.total_mass + pins) * dt;
+        let scale = momentum_scale(sim) + expect.norm();
+        worst = worst.max((d1.momentum - d0.momentum - expect).norm() / scale);
+    }
+    worst
+}
+
 /// Runs `f` on a rayon pool of `threads` threads (for the bit-identity
 /// checks across thread counts).
 pub fn on_threads<R: Send>(threads: usize, f: impl FnOnce() -> R + Send) -> R {

@@ -3,9 +3,11 @@
 
 use std::path::Path;
 
-use rerun::RecordingStream;
+use rerun::{RecordingStream, SeriesLines};
 
 use super::sink::{Server, Sink};
+use super::style::series_color;
+use super::{TIMELINE_FRAME, TIMELINE_SIM_TIME};
 use crate::driver::{run_frames_shown, FrameInfo, FrameRun, Outcome, Stepper};
 use crate::error::CliError;
 use crate::schedule::Schedule;
@@ -48,8 +50,9 @@ pub struct RecordOutcome {
     pub server: Option<Server>,
 }
 
-/// Runs `schedule` on `sim`, logging the frames `opts` selects with `log`,
-/// then flushes and closes the stream whatever happened (divergence,
+/// Runs `schedule` on `sim`, logging the frames `opts` selects with `log`
+/// (at their frame number and simulated time since the start, on the
+/// timelines [`TIMELINE_FRAME`] and [`TIMELINE_SIM_TIME`]), then flushes and closes the stream whatever happened (divergence,
 /// Ctrl-C, SIGTERM), so a file ends readable.
 pub(super) fn record_frames<S: Stepper + Send>(
     rec: RecordingStream,
@@ -60,8 +63,11 @@ pub(super) fn record_frames<S: Stepper + Send>(
     mut log: impl FnMut(&RecordingStream, &S, FrameInfo) -> rerun::RecordingStreamResult<()>,
 ) -> Result<RecordOutcome, CliError> {
     let mut frames_logged = 0;
+    let t0 = sim.time();
     let result = run_frames_shown(sim, schedule, label, |sim, frame| {
         if opts.logs(&frame) {
+            rec.set_time_sequence(TIMELINE_FRAME, frame.frame as i64);
+            rec.set_duration_secs(TIMELINE_SIM_TIME, sim.time() - t0);
             log(&rec, sim, frame).map_err(|e| opts.sink.error(e))?;
             frames_logged += 1;
         }
@@ -90,6 +96,42 @@ pub(super) fn record_frames<S: Stepper + Send>(
         failure,
         server,
     })
+}
+
+/// The scalars that open both kinds of recording, from the diagnostics
+/// `$d`: the kinetic, elastic and potential energies (the last at the path
+/// `$path`, from the field `$potential`), the momentum's x and y. A macro
+/// for the reason of [`crate::table::energy_rows`]: the yarn's and the
+/// mass-spring's diagnostics name these fields alike but share no trait.
+macro_rules! energy_scalars {
+    ($d:expr, $path:expr, $potential:ident) => {{
+        let d = $d;
+        [
+            ($crate::record::paths::KINETIC, d.kinetic_energy),
+            ($crate::record::paths::ELASTIC, d.elastic_energy),
+            ($path, d.$potential),
+            ($crate::record::paths::MOMENTUM_X, d.momentum.x),
+            ($crate::record::paths::MOMENTUM_Y, d.momentum.y),
+        ]
+    }};
+}
+pub(crate) use energy_scalars;
+
+/// Names and colours the plotted series `series` (entity path, display
+/// name), statically: the series tables of [`super::paths`].
+pub fn log_series(
+    rec: &RecordingStream,
+    series: &[(&str, &str)],
+) -> rerun::RecordingStreamResult<()> {
+    for &(path, name) in series {
+        rec.log_static(
+            path,
+            &SeriesLines::new()
+                .with_names([name])
+                .with_colors([series_color(series, path)]),
+        )?;
+    }
+    Ok(())
 }
 
 /// Logs a frame's plotted scalars (entity path, value) and, when the frame

@@ -3,15 +3,17 @@
 
 use rerun::components::{Color, Scalar, Vector3D};
 use rerun::{
-    AnyValues, Ellipsoids3D, LineStrips3D, Points3D, RecordingStream, Scalars, SeriesLines,
-    TextDocument, ViewCoordinates,
+    AnyValues, Ellipsoids3D, LineStrips3D, Points3D, RecordingStream, Scalars, TextDocument,
+    ViewCoordinates,
 };
 
 use super::blueprint::massspring_blueprint;
-use super::frames::{log_scalars, record_frames, RecordOptions, RecordOutcome};
+use super::frames::{
+    energy_scalars, log_scalars, log_series, record_frames, RecordOptions, RecordOutcome,
+};
 use super::sink::open;
-use super::style::{legend, p3, series_color, stretch_color};
-use super::{paths, values, TIMELINE_FRAME, TIMELINE_SIM_TIME};
+use super::style::{legend, p3, stretch_color};
+use super::{paths, values};
 use crate::driver::FrameInfo;
 use crate::error::CliError;
 use crate::massspring::{spring_stretches, MassSpringRun};
@@ -27,10 +29,7 @@ pub fn record_massspring(
     let name = run.name.clone();
     let rec = open(&name, &massspring_blueprint(duration), &opts.sink)?;
     log_massspring_static(&rec, run).map_err(|e| opts.sink.error(e))?;
-    let t0 = run.time();
-    record_frames(rec, run, &schedule, &name, opts, |rec, run, frame| {
-        log_massspring_frame(rec, run, frame, run.time() - t0)
-    })
+    record_frames(rec, run, &schedule, &name, opts, log_massspring_frame)
 }
 
 /// Mass-spring geometry that never changes: sphere colliders, series names.
@@ -49,14 +48,7 @@ fn log_massspring_static(
             .with_colors([Color::from_rgb(90, 200, 120)]),
         )?;
     }
-    for (path, name) in paths::MS_SERIES {
-        rec.log_static(
-            path,
-            &SeriesLines::new()
-                .with_names([name])
-                .with_colors([series_color(&paths::MS_SERIES, path)]),
-        )?;
-    }
+    log_series(rec, &paths::MS_SERIES)?;
     rec.log_static(paths::LEGEND, &TextDocument::from_markdown(legend(false)))?;
     // The scenes are Y-up (gravity along -y): without this the viewer lays
     // them on its floor grid and frames them badly.
@@ -85,10 +77,7 @@ fn log_massspring_frame(
     rec: &RecordingStream,
     run: &MassSpringRun,
     frame: FrameInfo,
-    t: f64,
 ) -> rerun::RecordingStreamResult<()> {
-    rec.set_time_sequence(TIMELINE_FRAME, frame.frame as i64);
-    rec.set_duration_secs(TIMELINE_SIM_TIME, t);
     let sim = &run.sim;
     let sys = sim.system();
     let x: Vec<[f32; 3]> = sim.positions().iter().map(p3).collect();
@@ -122,12 +111,8 @@ fn log_massspring_frame(
         &AnyValues::default().with_component::<Scalar>(values::STRETCH, stretch),
     )?;
     let d = run.diagnostics();
-    let scalars = [
-        (paths::KINETIC, d.kinetic_energy),
-        (paths::ELASTIC, d.elastic_energy),
-        (paths::GRAVITY, d.gravity_energy),
-        (paths::MOMENTUM_X, d.momentum.x),
-        (paths::MOMENTUM_Y, d.momentum.y),
+    let mut scalars = energy_scalars!(&d, paths::GRAVITY, gravity_energy).to_vec();
+    scalars.extend([
         (paths::MOMENTUM_Z, d.momentum.z),
         (paths::ANGULAR_MOMENTUM_X, d.angular_momentum.x),
         (paths::ANGULAR_MOMENTUM_Y, d.angular_momentum.y),
@@ -140,7 +125,7 @@ fn log_massspring_frame(
         (paths::COM_X, d.center_of_mass.x),
         (paths::COM_Y, d.center_of_mass.y),
         (paths::COM_Z, d.center_of_mass.z),
-    ];
+    ]);
     if frame.substeps > 0 {
         rec.log(
             paths::CG_ITERATIONS,

@@ -168,24 +168,17 @@ pub mod values {
     pub const PLASTIC: &str = "plastic";
 }
 
-use yarnsim::scene::Scene;
-
 use crate::error::CliError;
-use crate::massspring::{IntegratorArgs, MassSpringRun};
-use crate::run::start_yarn;
+use crate::run::Started;
 
-/// Records `scene` for `duration` seconds; `integrator` applies to
-/// mass-spring scenes only.
+/// Records `sim` for `duration` seconds.
 pub fn record(
-    scene: &Scene,
+    sim: &mut Started,
     duration: f64,
     opts: &RecordOptions,
-    integrator: &IntegratorArgs,
 ) -> Result<RecordOutcome, CliError> {
-    match scene {
-        Scene::Yarn(y) => record_yarn(&mut start_yarn(y, integrator)?, duration, opts),
-        Scene::MassSpring(l) => {
-            record_massspring(&mut MassSpringRun::new(l, integrator)?, duration, opts)
-        }
+    match sim {
+        Started::Yarn(sim) => record_yarn(sim, duration, opts),
+        Started::MassSpring(run) => record_massspring(run, duration, opts),
     }
 }

@@ -3,21 +3,22 @@
 
 use rerun::components::{Color, Scalar, Vector2D};
 use rerun::{
-    AnyValues, Boxes2D, Ellipses2D, LineStrips2D, Points2D, RecordingStream, SeriesLines,
-    TextDocument,
+    AnyValues, Boxes2D, Ellipses2D, LineStrips2D, Points2D, RecordingStream, TextDocument,
 };
 use yarnsim::math::qr::qr;
 use yarnsim::scene::WallMode;
 use yarnsim::YarnSim;
 
 use super::blueprint::yarn_blueprint;
-use super::frames::{log_scalars, record_frames, RecordOptions, RecordOutcome};
+use super::frames::{
+    energy_scalars, log_scalars, log_series, record_frames, RecordOptions, RecordOutcome,
+};
 use super::sink::open;
 use super::style::{
-    legend, p2, scale, series_color, stretch_color, view2, yarn_color, QUADRATURE_RADIUS,
-    STRIP_RADIUS, VERTEX_RADIUS,
+    legend, p2, scale, stretch_color, view2, yarn_color, QUADRATURE_RADIUS, STRIP_RADIUS,
+    VERTEX_RADIUS,
 };
-use super::{paths, values, TIMELINE_FRAME, TIMELINE_SIM_TIME};
+use super::{paths, values};
 use crate::driver::FrameInfo;
 use crate::error::CliError;
 
@@ -33,10 +34,7 @@ pub fn record_yarn(
     let layout = yarn_blueprint(sim.scene().grid.size, duration);
     let rec = open(&name, &layout, &opts.sink)?;
     log_yarn_static(&rec, sim).map_err(|e| opts.sink.error(e))?;
-    let t0 = sim.time();
-    let mut out = record_frames(rec, sim, &schedule, &name, opts, |rec, sim, frame| {
-        log_yarn_frame(rec, sim, frame, sim.time() - t0)
-    })?;
+    let mut out = record_frames(rec, sim, &schedule, &name, opts, log_yarn_frame)?;
     let stats = sim.dt_stats();
     out.adaptive_dt = (sim.is_auto() && stats.substeps > 0).then(|| crate::run::dt_range(&stats));
     Ok(out)
@@ -111,14 +109,7 @@ fn log_yarn_static(rec: &RecordingStream, sim: &YarnSim) -> rerun::RecordingStre
                 .with_labels([format!("attractor {} m/s^2", a.strength)]),
         )?;
     }
-    for (path, name) in paths::SERIES {
-        rec.log_static(
-            path,
-            &SeriesLines::new()
-                .with_names([name])
-                .with_colors([series_color(&paths::SERIES, path)]),
-        )?;
-    }
+    log_series(rec, &paths::SERIES)?;
     log_scale(rec, sc.grid.size)?;
     let walls = match sc.walls.mode {
         WallMode::Sticky => format!("brown: sticky walls, {} cells", sc.walls.cells),
@@ -165,15 +156,12 @@ fn log_scale(rec: &RecordingStream, size: f64) -> rerun::RecordingStreamResult<(
     Ok(())
 }
 
-/// Everything that changes, at frame `frame.frame` and simulated time `t`.
+/// Everything that changes, at frame `frame.frame`.
 fn log_yarn_frame(
     rec: &RecordingStream,
     sim: &YarnSim,
     frame: FrameInfo,
-    t: f64,
 ) -> rerun::RecordingStreamResult<()> {
-    rec.set_time_sequence(TIMELINE_FRAME, frame.frame as i64);
-    rec.set_duration_secs(TIMELINE_SIM_TIME, t);
     let p = sim.particles();
     let dx = sim.scene().dx() as f32;
     let seg = sim.stretches();
@@ -234,12 +222,8 @@ fn log_yarn_frame(
     )?;
 
     let d = sim.diagnostics();
-    let scalars = [
-        (paths::KINETIC, d.kinetic_energy),
-        (paths::ELASTIC, d.elastic_energy),
-        (paths::POTENTIAL, d.potential_energy),
-        (paths::MOMENTUM_X, d.momentum.x),
-        (paths::MOMENTUM_Y, d.momentum.y),
+    let mut scalars = energy_scalars!(&d, paths::POTENTIAL, potential_energy).to_vec();
+    scalars.extend([
         (paths::ANGULAR_MOMENTUM, d.angular_momentum),
         (
             paths::TOTAL,
@@ -250,6 +234,6 @@ fn log_yarn_frame(
         (paths::MEAN_STRETCH, d.mean_stretch),
         (paths::COM_X, d.center_of_mass.x),
         (paths::COM_Y, d.center_of_mass.y),
-    ];
+    ]);
     log_scalars(rec, &scalars, &frame)
 }

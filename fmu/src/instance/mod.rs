@@ -24,8 +24,8 @@ mod values;
 use yarnsim::scene::Scene;
 
 pub use crate::models::model::{
-    shown, FmuModel, ModelError, ModelResult, ModelSnapshot, ParamCheck, SetContext, StepFailure,
-    VarName,
+    shown, FmuModel, ModelError, ModelResult, ModelSnapshot, ParamCheck, Set, SetContext,
+    StepFailure, VarName,
 };
 pub use crate::models::state_bytes::*;
 pub use crate::models::{new_model, SceneFmu};

@@ -112,17 +112,18 @@ impl Instance {
     fn set_values(
         &mut self,
         op: Operation,
-        set: impl FnOnce(&mut dyn FmuModel, ParamCheck, &SetContext) -> ModelResult<bool>,
+        set: impl FnOnce(&mut dyn FmuModel, &SetContext) -> ModelResult<bool>,
     ) -> Res {
         self.require(op)?;
         let (phase, api) = (self.phase, self.api);
         let check =
             |name: &str| parameter_settable(phase, api, op, name).map_err(|f| ModelError(f.msg));
         let ctx = SetContext {
+            check: &check,
             resources: &self.resources,
             bundled: &self.bundled,
         };
-        let changed = set(self.model.physics.as_mut(), &check, &ctx)?;
+        let changed = set(self.model.physics.as_mut(), &ctx)?;
         self.model.clock.dirty |= changed;
         self.model.outputs_checked = false;
         Ok(())
@@ -144,8 +145,8 @@ impl Instance {
             };
             return error(format!("{}: {what}", self.op_name(Operation::SetFloat)));
         }
-        self.set_values(Operation::SetFloat, |m, check, _| {
-            m.set_real(vrs, vals, check)
+        self.set_values(Operation::SetFloat, |m, ctx| {
+            m.set_real(Set { vrs, vals, ctx })
         })
     }
 
@@ -193,14 +194,18 @@ impl Instance {
 
     pub fn set_boolean(&mut self, vrs: &[u32], vals: &[c_int]) -> Res {
         let vals: Vec<bool> = vals.iter().map(|&v| v != 0).collect();
-        self.set_values(Operation::SetBoolean, |m, check, _| {
-            m.set_boolean(vrs, &vals, check)
+        self.set_values(Operation::SetBoolean, |m, ctx| {
+            m.set_boolean(Set {
+                vrs,
+                vals: &vals,
+                ctx,
+            })
         })
     }
 
     pub fn set_string(&mut self, vrs: &[u32], vals: &[Option<String>]) -> Res {
-        self.set_values(Operation::SetString, |m, check, ctx| {
-            m.set_string(vrs, vals, check, ctx)
+        self.set_values(Operation::SetString, |m, ctx| {
+            m.set_string(Set { vrs, vals, ctx })
         })
     }
 }

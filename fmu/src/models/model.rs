@@ -79,12 +79,23 @@ pub fn shown(name: Option<VarName>, vr: u32) -> String {
     }
 }
 
-/// What the setter of String variables may need besides the values.
+/// What the setters may need besides the values: the check of the
+/// parameters, and for String variables the FMU's resources.
 pub struct SetContext<'a> {
+    /// Whether a parameter may be set now ([`ParamCheck`]).
+    pub check: ParamCheck<'a>,
     /// The FMU's `resources/` folder (relative scene paths).
     pub resources: &'a Path,
     /// The scene bundled in `resources/`.
     pub bundled: &'a Scene,
+}
+
+/// One call of a setter: the value references `vrs`, their values (`vals[i]`
+/// for `vrs[i]`) and what the setter may need besides ([`SetContext`]).
+pub struct Set<'a, T> {
+    pub vrs: &'a [u32],
+    pub vals: &'a [T],
+    pub ctx: &'a SetContext<'a>,
 }
 
 /// The state a failed communication step goes back to
@@ -184,18 +195,12 @@ pub trait FmuModel: fmt::Debug + Send {
     fn get_string(&self, vr: u32) -> Option<&str>;
     /// Sets Real inputs and parameters; true when a parameter changed (the
     /// simulation must be rebuilt). A rejected call changes nothing.
-    fn set_real(&mut self, vrs: &[u32], vals: &[f64], check: ParamCheck) -> ModelResult<bool>;
+    fn set_real(&mut self, set: Set<f64>) -> ModelResult<bool>;
     /// Sets Boolean inputs and parameters; true when a parameter changed.
-    fn set_boolean(&mut self, vrs: &[u32], vals: &[bool], check: ParamCheck) -> ModelResult<bool>;
+    fn set_boolean(&mut self, set: Set<bool>) -> ModelResult<bool>;
     /// Sets String parameters (`None`: a null pointer); true when one
     /// changed.
-    fn set_string(
-        &mut self,
-        vrs: &[u32],
-        vals: &[Option<String>],
-        check: ParamCheck,
-        ctx: &SetContext,
-    ) -> ModelResult<bool>;
+    fn set_string(&mut self, set: Set<Option<String>>) -> ModelResult<bool>;
     /// This model's part of an FMU state (`fmi2GetFMUstate`).
     fn save(&self) -> ModelSnapshot;
     /// Puts back a [`Self::save`] of a model of this kind (`fmi2SetFMUstate`),

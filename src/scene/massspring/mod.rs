@@ -82,11 +82,7 @@ pub struct TimeParams {
     pub frames: u32,
     /// Step size in s of the implicit and position-based integrators
     /// (default: `frame_time`). Explicit integrators use the CFL bound.
-    #[serde(
-        default,
-        skip_serializing_if = "Option::is_none",
-        deserialize_with = "opt_positive"
-    )]
+    #[serde(default, deserialize_with = "opt_positive")]
     pub time_step: Option<f64>,
     /// Fraction of the stability bound the explicit integrators step at
     /// (0 < c <= 1, default 0.5 as in the course notes).
@@ -100,11 +96,7 @@ pub struct TimeParams {
     /// Strain limit `s` of the position-based pass: after each step every
     /// spring length is pulled into `[(1-s) l0, (1+s) l0]`. Absent: no pass
     /// (the `pbd` integrator then uses `s = 0`).
-    #[serde(
-        default,
-        skip_serializing_if = "Option::is_none",
-        deserialize_with = "opt_strain"
-    )]
+    #[serde(default, deserialize_with = "opt_strain")]
     pub strain_limit: Option<f64>,
 }
 
@@ -137,11 +129,7 @@ pub struct SpringSpec {
     #[serde(default, deserialize_with = "nonnegative")]
     pub damping: f64,
     /// Rest length in m (default: the initial distance).
-    #[serde(
-        default,
-        skip_serializing_if = "Option::is_none",
-        deserialize_with = "opt_positive"
-    )]
+    #[serde(default, deserialize_with = "opt_positive")]
     pub rest_length: Option<f64>,
 }
 
@@ -333,6 +321,7 @@ fn chain_count<'de, D: Deserializer<'de>>(d: D) -> Result<u32, D::Error> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::testing::assert_mentions;
 
     const WIRE: &str = r#"
 kind = "wire"
@@ -368,10 +357,7 @@ damping = 100.0
         let e =
             MassSpringScene::from_toml_str(&WIRE.replace("mass = 1.0", "mass = -1.0")).unwrap_err();
         let m = e.to_string();
-        assert!(
-            m.contains("line 10") && m.contains("`chains[0].mass`") && m.contains("> 0"),
-            "{m}"
-        );
+        assert_mentions(&m, &["line 10", "`chains[0].mass`", "> 0"]);
     }
 
     #[test]
@@ -380,7 +366,7 @@ damping = 100.0
         let m = MassSpringScene::from_toml_str(&text)
             .unwrap_err()
             .to_string();
-        assert!(m.contains("line 3") && m.contains("`pinned[0]`"), "{m}");
+        assert_mentions(&m, &["line 3", "`pinned[0]`"]);
     }
 
     #[test]

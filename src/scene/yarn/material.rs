@@ -219,105 +219,39 @@ fn unknown_preset(name: &str) -> String {
 #[derive(Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 struct MaterialFile {
-    #[serde(
-        default,
-        skip_serializing_if = "Option::is_none",
-        deserialize_with = "opt_preset"
-    )]
+    #[serde(default, deserialize_with = "opt_preset")]
     preset: Option<String>,
-    #[serde(
-        default,
-        skip_serializing_if = "Option::is_none",
-        deserialize_with = "opt_pos"
-    )]
+    #[serde(default, deserialize_with = "opt_pos")]
     tex: Option<f64>,
-    #[serde(
-        default,
-        skip_serializing_if = "Option::is_none",
-        deserialize_with = "opt_pos"
-    )]
+    #[serde(default, deserialize_with = "opt_pos")]
     diameter: Option<f64>,
-    #[serde(
-        rename = "EA",
-        default,
-        skip_serializing_if = "Option::is_none",
-        deserialize_with = "opt_pos"
-    )]
+    #[serde(rename = "EA", default, deserialize_with = "opt_pos")]
     ea: Option<f64>,
-    #[serde(
-        default,
-        skip_serializing_if = "Option::is_none",
-        deserialize_with = "opt_pos"
-    )]
+    #[serde(default, deserialize_with = "opt_pos")]
     specific_modulus: Option<f64>,
-    #[serde(
-        rename = "EI",
-        default,
-        skip_serializing_if = "Option::is_none",
-        deserialize_with = "opt_nonneg"
-    )]
+    #[serde(rename = "EI", default, deserialize_with = "opt_nonneg")]
     ei: Option<f64>,
-    #[serde(
-        default,
-        skip_serializing_if = "Option::is_none",
-        deserialize_with = "opt_nonneg"
-    )]
+    #[serde(default, deserialize_with = "opt_nonneg")]
     friction_solid: Option<f64>,
-    #[serde(
-        default,
-        skip_serializing_if = "Option::is_none",
-        deserialize_with = "opt_pos"
-    )]
+    #[serde(default, deserialize_with = "opt_pos")]
     spacing: Option<f64>,
-    #[serde(
-        default,
-        skip_serializing_if = "Option::is_none",
-        deserialize_with = "opt_nonneg"
-    )]
+    #[serde(default, deserialize_with = "opt_nonneg")]
     transverse_modulus: Option<f64>,
-    #[serde(
-        default,
-        skip_serializing_if = "Option::is_none",
-        deserialize_with = "opt_nonneg"
-    )]
+    #[serde(default, deserialize_with = "opt_nonneg")]
     shear_modulus: Option<f64>,
-    #[serde(
-        default,
-        skip_serializing_if = "Option::is_none",
-        deserialize_with = "opt_nonneg"
-    )]
+    #[serde(default, deserialize_with = "opt_nonneg")]
     k: Option<f64>,
-    #[serde(
-        default,
-        skip_serializing_if = "Option::is_none",
-        deserialize_with = "opt_nonneg"
-    )]
+    #[serde(default, deserialize_with = "opt_nonneg")]
     gamma: Option<f64>,
-    #[serde(
-        default,
-        skip_serializing_if = "Option::is_none",
-        deserialize_with = "opt_nonneg"
-    )]
+    #[serde(default, deserialize_with = "opt_nonneg")]
     youngs_modulus: Option<f64>,
-    #[serde(
-        default,
-        skip_serializing_if = "Option::is_none",
-        deserialize_with = "opt_nonneg"
-    )]
+    #[serde(default, deserialize_with = "opt_nonneg")]
     friction: Option<f64>,
-    #[serde(
-        default,
-        skip_serializing_if = "Option::is_none",
-        deserialize_with = "opt_nonneg"
-    )]
+    #[serde(default, deserialize_with = "opt_nonneg")]
     bending: Option<f64>,
-    #[serde(
-        default,
-        skip_serializing_if = "Option::is_none",
-        deserialize_with = "opt_pos"
-    )]
+    #[serde(default, deserialize_with = "opt_pos")]
     density: Option<f64>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[serde(default)]
     plasticity: Option<bool>,
 }
 

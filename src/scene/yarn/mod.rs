@@ -174,10 +174,10 @@ pub struct PinSpec {
     /// Yarn index, counting every copy (`count`) of every `[[yarns]]` entry in order.
     pub yarn: u32,
     /// `"start"` or `"end"` of the yarn.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[serde(default)]
     pub end: Option<YarnEnd>,
     /// First vertex index within the yarn (instead of `end`).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[serde(default)]
     pub vertex: Option<u32>,
     /// How many consecutive vertices (default 1).
     #[serde(default = "one_u32", deserialize_with = "copy_count")]
@@ -186,25 +186,13 @@ pub struct PinSpec {
     #[serde(default)]
     pub motion: PinMotionKind,
     /// Velocity `[vx, vy]` in m/s of a `"line"` motion.
-    #[serde(
-        default,
-        skip_serializing_if = "Option::is_none",
-        deserialize_with = "opt_finite2"
-    )]
+    #[serde(default, deserialize_with = "opt_finite2")]
     pub velocity: Option<[f64; 2]>,
     /// Centre `[x, y]` in m of a `"circle"` motion.
-    #[serde(
-        default,
-        skip_serializing_if = "Option::is_none",
-        deserialize_with = "opt_finite2"
-    )]
+    #[serde(default, deserialize_with = "opt_finite2")]
     pub center: Option<[f64; 2]>,
     /// Angular velocity in rad/s of a `"circle"` motion (counter-clockwise positive).
-    #[serde(
-        default,
-        skip_serializing_if = "Option::is_none",
-        deserialize_with = "opt_finite"
-    )]
+    #[serde(default, deserialize_with = "opt_finite")]
     pub angular_velocity: Option<f64>,
 }
 
@@ -230,19 +218,11 @@ pub struct TimeSpec {
     /// Safety factor of `dt = "auto"`: the substep is `safety` times the
     /// stability bound (default [`DEFAULT_SAFETY`]; 0 < safety <= 2). Only
     /// with `dt = "auto"`.
-    #[serde(
-        default,
-        skip_serializing_if = "Option::is_none",
-        deserialize_with = "opt_safety"
-    )]
+    #[serde(default, deserialize_with = "opt_safety")]
     pub safety: Option<f64>,
     /// Largest substep of `dt = "auto"` in s (default: no cap). Only with
     /// `dt = "auto"`.
-    #[serde(
-        default,
-        skip_serializing_if = "Option::is_none",
-        deserialize_with = "opt_positive"
-    )]
+    #[serde(default, deserialize_with = "opt_positive")]
     pub dt_max: Option<f64>,
     /// Output frame interval in s (CLI frames and recordings; default 1/60).
     #[serde(default = "default_frame_dt", deserialize_with = "positive")]
@@ -500,39 +480,19 @@ pub struct Obstacle {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize, Default)]
 #[serde(deny_unknown_fields)]
 pub struct YarnSpec {
-    #[serde(
-        default,
-        skip_serializing_if = "Option::is_none",
-        deserialize_with = "opt_finite2"
-    )]
+    #[serde(default, deserialize_with = "opt_finite2")]
     /// First point of a straight yarn in m.
     pub start: Option<[f64; 2]>,
-    #[serde(
-        default,
-        skip_serializing_if = "Option::is_none",
-        deserialize_with = "opt_finite2"
-    )]
+    #[serde(default, deserialize_with = "opt_finite2")]
     /// Last point of a straight yarn in m (or give `direction` and `length`).
     pub end: Option<[f64; 2]>,
-    #[serde(
-        default,
-        skip_serializing_if = "Option::is_none",
-        deserialize_with = "opt_finite2"
-    )]
+    #[serde(default, deserialize_with = "opt_finite2")]
     /// Direction from `start` of a straight yarn given by `direction` and `length` (not zero).
     pub direction: Option<[f64; 2]>,
-    #[serde(
-        default,
-        skip_serializing_if = "Option::is_none",
-        deserialize_with = "opt_positive"
-    )]
+    #[serde(default, deserialize_with = "opt_positive")]
     /// Length in m of a straight yarn given by `direction` and `length`.
     pub length: Option<f64>,
-    #[serde(
-        default,
-        skip_serializing_if = "Option::is_none",
-        deserialize_with = "opt_points"
-    )]
+    #[serde(default, deserialize_with = "opt_points")]
     /// The points of a polyline yarn in m (instead of `start`).
     pub points: Option<Vec<[f64; 2]>>,
     /// Number of type-2 vertices (2 or more).

@@ -14,8 +14,7 @@ use yarnsim::massspring::{Integrator, IntegratorOptions, MassSpringScene, Simula
 
 use crate::model_description::table_name;
 use crate::models::model::{
-    refuse, Checkpoint, FmuModel, ModelResult, ModelSnapshot, ParamCheck, SetContext, StepFailure,
-    VarName,
+    refuse, Checkpoint, FmuModel, ModelResult, ModelSnapshot, Set, StepFailure, VarName,
 };
 use crate::models::state_bytes::{Reader, Writer};
 
@@ -171,14 +170,15 @@ impl FmuModel for MsModel {
     }
     /// Sets the gravity inputs and the `dt` parameter; true when the
     /// parameter changed. A rejected call changes nothing.
-    fn set_real(&mut self, vrs: &[u32], vals: &[f64], param_ok: ParamCheck) -> ModelResult<bool> {
+    fn set_real(&mut self, set: Set<f64>) -> ModelResult<bool> {
+        let Set { vrs, vals, ctx } = set;
         let mut gravity = self.gravity;
         let mut dt = self.dt;
         for (&vr, &v) in vrs.iter().zip(vals) {
             match vr {
                 VR_GRAVITY_X..=VR_GRAVITY_Z => gravity[(vr - VR_GRAVITY_X) as usize] = v,
                 VR_DT => {
-                    param_ok("dt")?;
+                    (ctx.check)("dt")?;
                     if !(0.0..=1e3).contains(&v) {
                         return refuse(format!(
                             "dt = {v} s is out of range (0 = automatic, else up to 1e3 s)"
@@ -217,8 +217,8 @@ impl FmuModel for MsModel {
         self.dt = dt;
         Ok(changed)
     }
-    fn set_boolean(&mut self, vrs: &[u32], _vals: &[bool], _: ParamCheck) -> ModelResult<bool> {
-        match vrs.first() {
+    fn set_boolean(&mut self, set: Set<bool>) -> ModelResult<bool> {
+        match set.vrs.first() {
             None => Ok(false),
             Some(&vr) => refuse(format!(
                 "{} is not a Boolean input or parameter (this FMU has none)",
@@ -227,19 +227,14 @@ impl FmuModel for MsModel {
         }
     }
     /// Sets the `integrator` parameter; true when it changed.
-    fn set_string(
-        &mut self,
-        vrs: &[u32],
-        vals: &[Option<String>],
-        param_ok: ParamCheck,
-        _ctx: &SetContext,
-    ) -> ModelResult<bool> {
+    fn set_string(&mut self, set: Set<Option<String>>) -> ModelResult<bool> {
+        let Set { vrs, vals, ctx } = set;
         let mut integrator = self.integrator;
         for (&vr, v) in vrs.iter().zip(vals) {
             if vr != VR_INTEGRATOR {
                 return refuse(format!("{} is not a String parameter", self.shown(vr)));
             }
-            param_ok("integrator")?;
+            (ctx.check)("integrator")?;
             let Some(v) = v else {
                 return refuse("the integrator name is a null pointer");
             };

@@ -11,8 +11,7 @@ use yarnsim::scene::{Integrator, TransferScheme, YarnScene};
 
 use crate::model_description::*;
 use crate::models::model::{
-    refuse, Checkpoint, FmuModel, ModelError, ModelResult, ModelSnapshot, ParamCheck, SetContext,
-    StepFailure, VarName,
+    refuse, Checkpoint, FmuModel, ModelError, ModelResult, ModelSnapshot, Set, StepFailure, VarName,
 };
 use crate::models::state_bytes::{Reader, Writer};
 
@@ -204,22 +203,20 @@ impl YarnModel {
         *self.diag.get_or_insert_with(|| self.sim.diagnostics())
     }
 
-    /// Sets the `scene` parameter: a scene file in `resources` (or the
-    /// bundled one, `bundled`); true when it changed.
+    /// Sets the `scene` parameter: a scene file in the FMU's resources
+    /// (`ctx.resources`) or the bundled one, `bundled`; true when it changed.
     pub fn set_string(
         &mut self,
-        vrs: &[u32],
-        vals: &[Option<String>],
-        param_ok: ParamCheck,
-        resources: &Path,
+        set: Set<Option<String>>,
         bundled: &YarnScene,
     ) -> ModelResult<bool> {
+        let Set { vrs, vals, ctx } = set;
         let mut changed = false;
         for (&vr, v) in vrs.iter().zip(vals) {
             if vr != VR_SCENE && vr != VR_TRANSFER_SCHEME && vr != VR_INTEGRATOR {
                 return refuse(format!("{} is not a String parameter", self.shown(vr)));
             }
-            param_ok(name_of(vr))?;
+            (ctx.check)(name_of(vr))?;
             if vr == VR_INTEGRATOR {
                 let i = refuse_unknown("integrator", v, &INTEGRATORS, "an integrator")?;
                 changed |= replace(&mut self.config.integrator, i);
@@ -236,7 +233,7 @@ impl YarnModel {
             let base = if v == SCENE_FILE {
                 bundled.clone()
             } else {
-                read_scene(&resources.join(v)).or_else(refuse)?
+                read_scene(&ctx.resources.join(v)).or_else(refuse)?
             };
             let yarns = num_yarns(&base);
             if yarns != num_yarns(bundled) {
@@ -473,7 +470,8 @@ impl FmuModel for YarnModel {
     }
     /// Sets Real inputs and parameters; true when a parameter changed (the
     /// simulation must be rebuilt). A rejected call changes nothing.
-    fn set_real(&mut self, vrs: &[u32], vals: &[f64], param_ok: ParamCheck) -> ModelResult<bool> {
+    fn set_real(&mut self, set: Set<f64>) -> ModelResult<bool> {
+        let Set { vrs, vals, ctx } = set;
         let mut inputs = self.inputs.clone();
         let mut attractor = self.sim.attractor();
         let mut gravity = self.sim.gravity();
@@ -502,7 +500,7 @@ impl FmuModel for YarnModel {
                 VR_GRAVITY_Y => gravity.y = v,
                 _ if real_param(vr).is_some() => {
                     let name = name_of(vr);
-                    param_ok(name)?;
+                    (ctx.check)(name)?;
                     let (i, field) = real_param(vr).unwrap();
                     let ok = if field.positive { v > 0.0 } else { v >= 0.0 } && v <= field.max;
                     if !ok {
@@ -562,19 +560,15 @@ impl FmuModel for YarnModel {
         Ok(changed)
     }
     /// Sets Boolean inputs and parameters; true when a parameter changed.
-    fn set_boolean(
-        &mut self,
-        vrs: &[u32],
-        vals: &[bool],
-        param_ok: ParamCheck,
-    ) -> ModelResult<bool> {
+    fn set_boolean(&mut self, set: Set<bool>) -> ModelResult<bool> {
+        let Set { vrs, vals, ctx } = set;
         let mut attractor = self.sim.attractor();
         let mut plasticity = self.config.plasticity;
         for (&vr, &v) in vrs.iter().zip(vals) {
             match vr {
                 VR_ATTRACTOR_ACTIVE => attractor.active = v,
                 VR_PLASTICITY => {
-                    param_ok(name_of(vr))?;
+                    (ctx.check)(name_of(vr))?;
                     plasticity = Some(v);
                 }
                 _ => {
@@ -619,17 +613,11 @@ impl FmuModel for YarnModel {
         self.forces = forces;
         self.diag = None;
     }
-    fn set_string(
-        &mut self,
-        vrs: &[u32],
-        vals: &[Option<String>],
-        check: ParamCheck,
-        ctx: &SetContext,
-    ) -> ModelResult<bool> {
-        let yarnsim::scene::Scene::Yarn(bundled) = ctx.bundled else {
+    fn set_string(&mut self, set: Set<Option<String>>) -> ModelResult<bool> {
+        let yarnsim::scene::Scene::Yarn(bundled) = set.ctx.bundled else {
             return Err(ModelError("a yarn model with a mass-spring scene".into()));
         };
-        YarnModel::set_string(self, vrs, vals, check, ctx.resources, bundled)
+        YarnModel::set_string(self, set, bundled)
     }
     fn save(&self) -> ModelSnapshot {
         Box::new(YarnModel::save(self))
