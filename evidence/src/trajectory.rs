@@ -169,7 +169,7 @@ impl Trajectory {
                 .map(str::parse)
                 .collect::<Result<_, _>>()
                 .map_err(|e| format!("line {}: {e}", n + 1))?;
-            if v.len() < 7 || (v.len() - 7) % 2 != 0 {
+            if v.len() < 7 || !(v.len() - 7).is_multiple_of(2) {
                 return Err(format!("line {}: {} columns", n + 1, v.len()));
             }
             t.frames.push(Frame {
@@ -209,7 +209,8 @@ fn dist(a: [f64; 2], b: [f64; 2]) -> f64 {
 }
 
 /// Compares `a` against `b` frame by frame. Both must have the same frame
-/// times (to 1e-9 s) and the same number of yarn ends; the shorter run
+/// times to 1 ms (a run ends each frame on its first substep at or past the
+/// frame time, so fixed-step runs overshoot by less than one substep) and the same number of yarn ends; the shorter run
 /// bounds the comparison.
 pub fn compare(a: &Trajectory, b: &Trajectory) -> Result<Comparison, String> {
     let mut c = Comparison {
@@ -218,7 +219,7 @@ pub fn compare(a: &Trajectory, b: &Trajectory) -> Result<Comparison, String> {
         ends_max: 0.0,
     };
     for (fa, fb) in a.frames.iter().zip(&b.frames) {
-        if (fa.time - fb.time).abs() > 1e-9 {
+        if (fa.time - fb.time).abs() > 1e-3 {
             return Err(format!("frame times differ: {} s, {} s", fa.time, fb.time));
         }
         if fa.ends.len() != fb.ends.len() {
@@ -311,7 +312,7 @@ mod tests {
         let back = Trajectory::from_csv(&a.to_csv()).unwrap();
         assert_eq!(back, a);
         assert_eq!(back.wall_per_second(), 2.0);
-        b.frames[3].time += 1e-3;
+        b.frames[3].time += 1e-2;
         assert!(compare(&a, &b).unwrap_err().contains("frame times differ"));
     }
 }
