@@ -29,6 +29,7 @@ pub mod roofline;
 mod scene;
 pub mod skip;
 pub mod stress;
+pub mod trajectory;
 
 pub use scene::small_yarn_scene;
 
