@@ -10,7 +10,7 @@
 use serde::de::Error as _;
 use serde::{Deserialize, Deserializer, Serialize};
 
-use super::material_units::{YarnProperties, KG_PER_M_PER_TEX, SHEAR_OF_TRANSVERSE};
+use super::material_units::{shear_or_default, ModelParameters, Sheet, YarnProperties};
 use super::presets::{preset, preset_names};
 use crate::scene::readers::{nonnegative, positive};
 
@@ -72,18 +72,17 @@ impl Material {
     pub fn per_yarn(&self) -> Option<YarnProperties> {
         let p = self.yarn.as_ref()?.partial().ok()?;
         let d = p.diameter?;
-        let s = p.spacing.unwrap_or(d);
-        let area = std::f64::consts::PI * d * d / 4.0;
+        let model = ModelParameters {
+            k: self.k,
+            density: self.density,
+            bending: self.bending,
+            youngs_modulus: Some(self.youngs_modulus),
+            gamma: Some(self.gamma),
+        };
         Some(YarnProperties {
-            tex: self.density * s / KG_PER_M_PER_TEX,
-            diameter: d,
-            ea: self.k * s,
-            ei: self.bending * s,
             friction: Some(self.friction),
             friction_solid: p.friction_solid,
-            spacing: s,
-            transverse_modulus: Some(self.youngs_modulus * s / area),
-            shear_modulus: Some(self.gamma * s / area),
+            ..YarnProperties::from_model(&model, d, p.spacing.unwrap_or(d))
         })
     }
 }
@@ -190,20 +189,18 @@ impl Partial {
     /// `k = EA / s`, `density = mu / s`, `bending = EI / s`,
     /// `E = E_T A / s`, `gamma = G A / s` ([`super::material_units`]).
     fn derived(&self) -> Derived {
-        let (Some(d), Some(s)) = (self.diameter, self.spacing) else {
+        let (Some(diameter), Some(spacing)) = (self.diameter, self.spacing) else {
             return Derived::default();
         };
-        let area_over_s = std::f64::consts::PI * d * d / 4.0 / s;
-        let shear = self
-            .shear_modulus
-            .or(self.transverse_modulus.map(|e| SHEAR_OF_TRANSVERSE * e));
+        let sheet = Sheet { diameter, spacing };
+        let shear = shear_or_default(self.shear_modulus, self.transverse_modulus);
         Derived {
-            k: self.ea.map(|ea| ea / s),
-            gamma: shear.map(|g| g * area_over_s),
-            youngs_modulus: self.transverse_modulus.map(|e| e * area_over_s),
+            k: self.ea.map(|ea| sheet.k(ea)),
+            gamma: shear.map(|g| sheet.cross_section(g)),
+            youngs_modulus: self.transverse_modulus.map(|e| sheet.cross_section(e)),
             friction: self.friction,
-            bending: self.ei.map(|ei| ei / s),
-            density: self.tex.map(|t| t * KG_PER_M_PER_TEX / s),
+            bending: self.ei.map(|ei| sheet.bending(ei)),
+            density: self.tex.map(|t| sheet.density(t)),
         }
     }
 }

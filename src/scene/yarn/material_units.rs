@@ -63,6 +63,46 @@ pub struct YarnProperties {
     pub shear_modulus: Option<f64>,
 }
 
+/// The sheet of yarns of diameter `d` at spacing `s`: each conversion of a
+/// per-yarn value to its value per metre of depth, written once (the whole
+/// description's [`YarnProperties::model`] and a partial one's, which
+/// converts the values it has).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Sheet {
+    /// Yarn diameter `d`, m.
+    pub diameter: f64,
+    /// Spacing `s` of the sheet's yarns, m.
+    pub spacing: f64,
+}
+
+impl Sheet {
+    /// `k = EA / s`, N/m.
+    pub fn k(&self, ea: f64) -> f64 {
+        ea / self.spacing
+    }
+    /// `density = tex 1e-6 / s`, kg/m^2.
+    pub fn density(&self, tex: f64) -> f64 {
+        tex * KG_PER_M_PER_TEX / self.spacing
+    }
+    /// `bending = EI / s`, N m.
+    pub fn bending(&self, ei: f64) -> f64 {
+        ei / self.spacing
+    }
+    /// A cross-section modulus (Pa) over the yarn's area per metre of
+    /// depth, `M A / s` (N/m): the model's `youngs_modulus` from `E_T`,
+    /// its `gamma` from `G`.
+    pub fn cross_section(&self, modulus: f64) -> f64 {
+        let d = self.diameter;
+        modulus * (PI * d * d / 4.0 / self.spacing)
+    }
+}
+
+/// The cross-section's shear modulus: the given one, else
+/// [`SHEAR_OF_TRANSVERSE`] times the transverse modulus.
+pub fn shear_or_default(shear: Option<f64>, transverse: Option<f64>) -> Option<f64> {
+    shear.or(transverse.map(|e| SHEAR_OF_TRANSVERSE * e))
+}
+
 /// The model parameters (per metre of depth) one engineering description
 /// gives; `None` where the description has nothing to say.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -108,20 +148,26 @@ impl YarnProperties {
     /// The shear modulus in Pa: the given one, else [`SHEAR_OF_TRANSVERSE`]
     /// times the transverse modulus.
     pub fn shear(&self) -> Option<f64> {
-        self.shear_modulus
-            .or(self.transverse_modulus.map(|e| SHEAR_OF_TRANSVERSE * e))
+        shear_or_default(self.shear_modulus, self.transverse_modulus)
+    }
+
+    /// The sheet these yarns form.
+    pub fn sheet(&self) -> Sheet {
+        Sheet {
+            diameter: self.diameter,
+            spacing: self.spacing,
+        }
     }
 
     /// The model's parameters per metre of depth (module documentation).
     pub fn model(&self) -> ModelParameters {
-        let s = self.spacing;
-        let a_over_s = self.area() / s;
+        let sheet = self.sheet();
         ModelParameters {
-            k: self.ea / s,
-            density: self.line_density() / s,
-            bending: self.ei / s,
-            youngs_modulus: self.transverse_modulus.map(|e| e * a_over_s),
-            gamma: self.shear().map(|g| g * a_over_s),
+            k: sheet.k(self.ea),
+            density: sheet.density(self.tex),
+            bending: sheet.bending(self.ei),
+            youngs_modulus: self.transverse_modulus.map(|e| sheet.cross_section(e)),
+            gamma: self.shear().map(|g| sheet.cross_section(g)),
         }
     }
 
