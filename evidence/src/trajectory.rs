@@ -99,9 +99,10 @@ pub fn record(
     let mut sim = YarnSim::new(&scene).map_err(RecordError::Scene)?;
     let frames_n = (duration / frame_dt).round() as usize;
     let start = Instant::now();
+    // the first frame dissipated nothing (`frame_of` without a start total)
     let first = frame_of(&sim, None);
     let total0 = first.energy[..3].iter().sum::<f64>();
-    let mut frames = vec![frame_of(&sim, Some(total0))];
+    let mut frames = vec![first];
     for k in 1..=frames_n {
         sim.advance_to(k as f64 * frame_dt)
             .map_err(RecordError::Sim)?;
