@@ -125,34 +125,43 @@ fn bundles_at_any_orientation_spacing_and_drop_run_their_second() {
     assert!(failed.is_empty(), "{failed:#?}");
 }
 
-/// A bundle that still diverges under `dt = "auto"` (found while writing
-/// the test above, with its first placement of the bundle: lowest point
-/// 43.1 mm above the left circle's top): 12 yarns of 0.4 m tilted 27.6
-/// degrees, 0.87 cells apart; at dt 4e-5 it runs its second (stretch
-/// 0.954-1.100). Open: the divergence below the bound is not fixed here.
+/// A bundle that collapsed under `dt = "auto"` while `dt = "auto"` took the
+/// cross-section's rest stiffness for its elastic bound: the ninth clear
+/// draw of seed 7 (12 yarns of 0.4 m tilted 16.4 degrees, 1.18 cells
+/// apart, the top 91.3 mm lower). The yarns crush each other's
+/// cross-section where they pile on a circle, and a crushed cross-section
+/// is up to 65x stiffer than at rest (`YarnEnergy::normal_tangent`); with
+/// the rest bound a segment shrank to 0.003 of its length (of 16 draws of
+/// seed 7, the one that failed; the crushed bound runs all 16). Tolerance:
+/// no divergence, stretch within [0.8, 1.25], as above.
 #[test]
-#[ignore = "open: diverges at t = 0.92 s under dt = \"auto\" (vertex 287 at 1140 m/s)"]
-fn tilted_bundle_that_diverges_under_auto_dt() {
+#[cfg_attr(debug_assertions, ignore = "release-mode test (cargo test --release)")]
+fn crushed_bundle_runs_its_second_under_auto_dt() {
     let dx = 1.0 / 256.0;
-    let mut rng = Rng::new(39);
-    let mut draw = || {
-        (
+    let mut rng = Rng::new(7);
+    let mut clear = Vec::new();
+    while clear.len() < 9 {
+        let (angle, spacing, lower) = (
             rng.uniform(0.0, 90.0),
             rng.uniform(0.5, 3.0) * dx,
-            rng.uniform(0.005, 0.06),
-        )
-    };
-    let (angle, spacing, drop) = (draw(), draw()).1;
-    let a = angle.to_radians();
-    let half_y = 0.5 * (0.4 * a.sin() + 11.0 * spacing * a.cos());
-    let lower = TOP - (0.68 + drop + 2.0 * half_y);
+            rng.uniform(0.0, 0.1),
+        );
+        if clear_of_circles(&bundle(angle, spacing, lower, 0.4, 100)) {
+            clear.push((angle, spacing, lower));
+        }
+    }
+    let (angle, spacing, lower) = clear[8];
+    assert!((angle - 16.4).abs() < 0.05, "the draws changed: {angle}");
     let mut s = bundle(angle, spacing, lower, 0.4, 100);
     s.time.dt = StepSize::Auto;
     let r = run(&s);
     eprintln!(
-        "{angle:.1} deg, spacing {:.2} cells, drop {:.1} mm, dt auto: {r:?}",
+        "{angle:.1} deg, spacing {:.2} cells, top {:.1} mm lower, dt auto: {r:?}",
         spacing / dx,
-        drop * 1e3
+        lower * 1e3
     );
-    assert!(r.is_ok(), "{r:?}");
+    assert!(
+        matches!(r, Ok((lo, hi)) if lo >= 0.8 && hi <= 1.25),
+        "{r:?}"
+    );
 }

@@ -70,6 +70,20 @@ impl YarnEnergy {
         f + g + h
     }
 
+    /// The cross-section's stiffness against further compression at `r22`,
+    /// Pa: `d2psi/dr22^2 = (2 mu + lambda) (1 - log r22) / r22^2` for
+    /// `r22 < 1` (`r22` clamped to [`R22_MIN`]), and the rest value
+    /// `2 mu + lambda` otherwise. A crushed cross-section is stiffer than
+    /// the one at rest (6.8x at `r22 = 0.5`, 65x at 0.2): its waves are
+    /// faster, and the explicit step's elastic bound shrinks with it.
+    pub fn normal_tangent(&self, r22: f64) -> f64 {
+        if r22 >= 1.0 {
+            return self.normal;
+        }
+        let r = r22.max(R22_MIN);
+        self.normal * (1.0 - r.ln()) / (r * r)
+    }
+
     /// `psi(G)` for a fiber-frame deformation gradient `G`.
     pub fn psi(&self, g: &Mat2) -> f64 {
         let d = qr(g);
@@ -295,5 +309,35 @@ mod plastic_state_tests {
         // Cross-section in tension: separated.
         let (r12, r22) = e.return_map(0.1, 1.2);
         assert_eq!(e.plastic_state(r12, r22), PlasticState::Separated);
+    }
+}
+
+#[cfg(test)]
+mod normal_tangent_tests {
+    use super::*;
+
+    /// The crushed cross-section's stiffness is the second derivative of
+    /// `psi` in `r22`: central differences of `psi_r` (step 1e-4, error
+    /// O(h^2) ~ 1e-7 relative), tolerance 1e-5 relative.
+    #[test]
+    fn normal_tangent_is_the_second_derivative_of_psi() {
+        let e = YarnEnergy {
+            k: 1000.0,
+            gamma: 500.0,
+            normal: 1400.0,
+            friction: 0.3,
+        };
+        for r22 in [0.2, 0.5, 0.9, 0.999] {
+            let h = 1e-4 * r22;
+            let fd = (e.psi_r(1.0, 0.0, r22 + h) - 2.0 * e.psi_r(1.0, 0.0, r22)
+                + e.psi_r(1.0, 0.0, r22 - h))
+                / (h * h);
+            let t = e.normal_tangent(r22);
+            assert!((fd - t).abs() <= 1e-5 * t, "r22 {r22}: {fd} against {t}");
+        }
+        // at and above rest: the rest stiffness, 6.8x it at r22 = 0.5
+        assert_eq!(e.normal_tangent(1.0), 1400.0);
+        assert_eq!(e.normal_tangent(1.3), 1400.0);
+        assert!((e.normal_tangent(0.5) / 1400.0 - 6.77).abs() < 0.01);
     }
 }
