@@ -12,8 +12,8 @@
 
 mod common;
 
-use common::friction_scene;
-use yarnsim::scene::{TransferScheme, YarnMaterial, YarnScene};
+use common::{friction_scene, with_diameter};
+use yarnsim::scene::{SceneError, TransferScheme, YarnScene, MAX_DIAMETER_CELLS};
 use yarnsim::YarnSim;
 
 /// The circle.
@@ -27,15 +27,6 @@ enum Start {
     Laid,
     /// Four cells above where they rest.
     Dropped,
-}
-
-/// Adds the yarn diameter `d` (m) to a scene given per metre of depth.
-fn with_diameter(mut s: YarnScene, d: f64) -> YarnScene {
-    s.material.yarn = Some(YarnMaterial {
-        diameter: Some(d),
-        ..YarnMaterial::default()
-    });
-    s
 }
 
 /// The circle, a yarn of 0.4 m across its top and, with `two`, a yarn of
@@ -75,10 +66,7 @@ fn scene(res: u32, d: Option<f64>, start: Start, two: bool) -> YarnScene {
         &yarns,
         &format!("dt = {dt}"),
     );
-    match d {
-        Some(d) => with_diameter(s, d),
-        None => s,
-    }
+    with_diameter(s, d)
 }
 
 /// Mean distance from the circle's centre of yarn `y`'s vertices within
@@ -136,4 +124,91 @@ fn measure_rest_distances() {
             }
         }
     }
+}
+
+/// The rest distances of the lower yarn from the circle (`d / 2`) and of
+/// the upper yarn from the lower one (`d`), each within 15 %, laid and
+/// dropped: d = 3 mm at 256^2 and 512^2 (0.77 and 1.54 cells), 4.5 mm at
+/// 256^2 (1.15 cells), 2.5 mm at 512^2 (1.28 cells). The runs go in
+/// parallel threads (each is deterministic for any thread count).
+#[test]
+#[cfg_attr(debug_assertions, ignore = "release-mode test (cargo test --release)")]
+fn yarns_rest_half_a_diameter_off_a_circle_and_a_diameter_apart() {
+    let cases = [(256, 3e-3), (512, 3e-3), (256, 4.5e-3), (512, 2.5e-3)];
+    let runs: Vec<(u32, f64, Start)> = cases
+        .iter()
+        .flat_map(|&(res, d)| [Start::Laid, Start::Dropped].map(|s| (res, d, s)))
+        .collect();
+    let results: Vec<(f64, f64)> = std::thread::scope(|sc| {
+        let handles: Vec<_> = runs
+            .iter()
+            .map(|&(res, d, start)| {
+                sc.spawn(move || {
+                    let (h, sep) = rest(res, Some(d), start, true);
+                    (h, sep.unwrap())
+                })
+            })
+            .collect();
+        handles.into_iter().map(|h| h.join().unwrap()).collect()
+    });
+    let mut failed = Vec::new();
+    for (&(res, d, start), &(h, sep)) in runs.iter().zip(&results) {
+        let line = format!(
+            "{res}^2 d {d} m ({:.2} cells) {start:?}: circle {h:.4e} m ({:+.1} % of d/2), \
+             yarns {sep:.4e} m ({:+.1} % of d)",
+            d * res as f64,
+            100.0 * (h - 0.5 * d) / (0.5 * d),
+            100.0 * (sep - d) / d
+        );
+        eprintln!("{line}");
+        // tolerances: 15 % of d / 2 from the circle, 15 % of d between the yarns
+        if (h - 0.5 * d).abs() > 0.15 * 0.5 * d || (sep - d).abs() > 0.15 * d {
+            failed.push(line);
+        }
+    }
+    assert!(failed.is_empty(), "{failed:#?}");
+}
+
+/// Two yarns in per-yarn fields with a diameter of 2 cells (above
+/// [`MAX_DIAMETER_CELLS`]) are refused, naming `material.diameter` and the
+/// coarsest-resolution bound that carries it; one yarn is not (nothing to
+/// meet), nor are two in the shared field without pins.
+#[test]
+fn a_diameter_beyond_the_grid_is_refused_with_the_resolution_it_needs() {
+    let d = 2.0 / 256.0;
+    let e = with_diameter(scene(256, None, Start::Laid, true), Some(d))
+        .validate()
+        .unwrap_err();
+    let SceneError::Invalid { field, message, .. } = &e else {
+        panic!("{e}");
+    };
+    assert_eq!(field, "material.diameter");
+    // at most floor(1.75 / 2 * 256) = 224 cells carry 2 / 256 m
+    let most = (MAX_DIAMETER_CELLS * 256.0 / 2.0).floor();
+    assert!(
+        message.contains(&format!("grid.resolution to at most {most}")),
+        "{message}"
+    );
+    assert!(with_diameter(scene(256, None, Start::Laid, false), Some(d))
+        .validate()
+        .is_ok());
+    let mut shared = with_diameter(scene(256, None, Start::Laid, true), Some(d));
+    shared.contact.fields = yarnsim::scene::FieldPartition::HeldFree;
+    assert!(shared.validate().is_ok());
+}
+
+/// A diameter with the free yarns in one field (`"held-free"`, the
+/// default) warns that it does not act between them; per-yarn fields and
+/// no diameter do not warn.
+#[test]
+fn a_diameter_with_shared_fields_warns() {
+    let mut s = scene(256, Some(3e-3), Start::Laid, true);
+    assert_eq!(s.diameter_warning(), None);
+    s.contact.fields = yarnsim::scene::FieldPartition::HeldFree;
+    let w = s.diameter_warning().expect("a warning");
+    assert!(
+        w.contains("material.diameter") && w.contains("per-yarn"),
+        "{w}"
+    );
+    assert_eq!(scene(256, None, Start::Laid, true).diameter_warning(), None);
 }

@@ -148,6 +148,7 @@ impl YarnSim {
             &particles.yarn_vertices,
             &particles.quad.left,
             &grid,
+            scene.material.diameter(),
         );
         let mut sim = YarnSim {
             obstacles: with_yarn_radius(&scene.obstacles, scene.material.diameter()),

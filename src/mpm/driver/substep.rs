@@ -181,6 +181,7 @@ impl YarnSim {
         grid_velocities(self, dt, flip, &pin_entries, passes)?;
         if let Some(f) = &mut self.fields {
             let mu = self.scene.material.friction;
+            f.locate(&self.particles);
             f.contact(
                 &mut self.grid,
                 &pin_entries,
