@@ -38,6 +38,12 @@
 //! `docs/obstacle-contact.md`, "Under impact"). Pooling whole nodes, the
 //! wedge's tangential momentum is that of the whole cross-section on the
 //! obstacle, as for a yarn laid on it.
+//!
+//! With a yarn diameter `d` (`material.diameter`) the laws act on the
+//! obstacles grown by `d / 2` ([`with_yarn_radius`]), a particle touches
+//! only on or inside the grown circle, and the normal part acts on the
+//! touching mass only, inside too ([`normal_share`]): a yarn's centre line
+//! rests `d / 2` from the surface whatever the cell.
 
 use crate::math::Vec2;
 pub use crate::mpm::machinery::grid::ContactNode;
@@ -129,8 +135,8 @@ pub fn obstacle_normal(
 /// particle projection [`project_out`] keeps on its surface), never by
 /// where it lies, so the nodes of a yarn's stencil that reach into the
 /// circle do not stop it before its centre line reaches `d / 2` from the
-/// surface (in full inside, they held it 0.15 to 0.25 cells early at
-/// 256^2: `docs/obstacle-contact.md`, "Yarn diameter").
+/// surface (in full inside the obstacle itself, they held it up to 0.15
+/// cells early at 256^2: `docs/obstacle-contact.md`, "Yarn diameter").
 #[inline]
 pub fn normal_share(o: &Obstacle, xi: Vec2, touching: f64, yarn_radius: f64) -> (f64, Vec2, f64) {
     let (n, dist) = outward(o, xi);
