@@ -368,6 +368,25 @@ pub fn project_out(o: &Obstacle, x: &mut Vec2, v: &mut Vec2) {
 mod tests {
     use super::*;
 
+    /// With a yarn diameter the grown circle's normal law acts on the
+    /// touching mass only, inside too; without one, in full inside; the
+    /// obstacles grow by d / 2 and stay as they are without a diameter.
+    #[test]
+    fn a_yarn_diameter_grows_the_circle_and_drops_the_full_law_inside() {
+        let o = Obstacle {
+            center: [0.5, 0.5],
+            radius: 0.1,
+            friction: 0.3,
+        };
+        let grown = with_yarn_radius(std::slice::from_ref(&o), Some(0.004));
+        assert_eq!(grown[0].radius, 0.1 + 0.002);
+        assert_eq!(with_yarn_radius(std::slice::from_ref(&o), None)[0], o);
+        let inside = Vec2::new(0.5, 0.55);
+        assert_eq!(normal_share(&o, inside, 0.0, 0.0).0, 1.0);
+        assert_eq!(normal_share(&grown[0], inside, 0.0, 0.002).0, 0.0);
+        assert_eq!(normal_share(&grown[0], inside, 0.25, 0.002).0, 0.25);
+    }
+
     #[test]
     fn polar_angle_matches_atan2_to_2e_5_rad() {
         for k in 0..100_000 {
