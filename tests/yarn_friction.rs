@@ -21,8 +21,8 @@
 mod common;
 
 use common::{
-    friction_scene as yarn_scene_stepped, on_threads, pin_end, straight, worst_momentum_balance,
-    yarns_and_pins_toml,
+    friction_scene as yarn_scene_stepped, on_threads, pin_end, straight, with_diameter,
+    worst_momentum_balance, yarns_and_pins_toml,
 };
 use yarnsim::scene::{TransferScheme, YarnEnd};
 use yarnsim::YarnSim;
@@ -37,7 +37,7 @@ const SETTLE: f64 = 0.1;
 /// fibre friction `c_f` and no bending, gravity g tilted by `theta`
 /// (downhill along +x), dt 1e-4.
 fn incline(theta: f64, c_f: f64, scheme: TransferScheme) -> YarnSim {
-    incline_stepped(theta, c_f, scheme, EXPLICIT)
+    incline_stepped(theta, c_f, scheme, EXPLICIT, None)
 }
 
 /// The explicit step of the incline scenes: `[time]` lines.
@@ -45,8 +45,15 @@ const EXPLICIT: &str = "dt = 1e-4";
 /// Backward Euler at 10x the explicit step.
 const IMPLICIT: &str = "dt = 1e-3\nintegrator = \"implicit\"";
 
-/// [`incline`] with the `[time]` lines `time`.
-fn incline_stepped(theta: f64, c_f: f64, scheme: TransferScheme, time: &str) -> YarnSim {
+/// [`incline`] with the `[time]` lines `time` and the yarn diameter `d`
+/// (`material.diameter`, none given: `None`).
+fn incline_stepped(
+    theta: f64,
+    c_f: f64,
+    scheme: TransferScheme,
+    time: &str,
+    d: Option<f64>,
+) -> YarnSim {
     let res = 128;
     let dx = 1.0 / res as f64;
     let bed_n = (0.8 / (0.5 * dx)).round() as u32 + 1;
@@ -60,7 +67,8 @@ fn incline_stepped(theta: f64, c_f: f64, scheme: TransferScheme, time: &str) -> 
         &[pin_end(0, YarnEnd::Start, bed_n)],
     );
     let gravity = [G * theta.sin(), -G * theta.cos()];
-    YarnSim::new(&yarn_scene_stepped(gravity, res, scheme, c_f, &yarns, time)).unwrap()
+    let s = yarn_scene_stepped(gravity, res, scheme, c_f, &yarns, time);
+    YarnSim::new(&with_diameter(s, d)).unwrap()
 }
 
 /// A scene of the built-in material with fibre friction `c_f`, no bending,
@@ -79,18 +87,19 @@ fn yarn_scene(
 /// Downhill displacements of the top yarn's centre at the times `ts`
 /// (increasing) after settling.
 fn slips<const N: usize>(theta: f64, c_f: f64, scheme: TransferScheme, ts: [f64; N]) -> [f64; N] {
-    slips_stepped(theta, c_f, scheme, ts, EXPLICIT)
+    slips_stepped(theta, c_f, scheme, ts, EXPLICIT, None)
 }
 
-/// [`slips`] with the `[time]` lines `time`.
+/// [`slips`] with the `[time]` lines `time` and the yarn diameter `d`.
 fn slips_stepped<const N: usize>(
     theta: f64,
     c_f: f64,
     scheme: TransferScheme,
     ts: [f64; N],
     time: &str,
+    d: Option<f64>,
 ) -> [f64; N] {
-    let mut sim = incline_stepped(theta, c_f, scheme, time);
+    let mut sim = incline_stepped(theta, c_f, scheme, time, d);
     sim.advance(SETTLE).unwrap();
     let centre = |sim: &YarnSim| {
         let (a, b) = sim.yarn_endpoints(1);
@@ -282,7 +291,14 @@ fn two_field_contact_conserves_momentum_on_a_held_tightrope() {
 fn implicit_two_field_incline_holds_below_and_slides_above_its_friction() {
     let c_f: f64 = 0.2;
     let slides = |k: f64| {
-        let [s] = slips_stepped((k * c_f).atan(), c_f, TransferScheme::Flip, [0.5], IMPLICIT);
+        let [s] = slips_stepped(
+            (k * c_f).atan(),
+            c_f,
+            TransferScheme::Flip,
+            [0.5],
+            IMPLICIT,
+            None,
+        );
         eprintln!("implicit incline tan theta = {k} c_f: slip {s:.3e} m in 0.5 s");
         s > 5e-3
     };
@@ -290,7 +306,14 @@ fn implicit_two_field_incline_holds_below_and_slides_above_its_friction() {
     assert!(slides(1.1), "held at tan theta = 1.1 c_f");
     let theta = (2.0 * c_f).atan();
     let t = 0.3;
-    let [half, full] = slips_stepped(theta, c_f, TransferScheme::Flip, [0.5 * t, t], IMPLICIT);
+    let [half, full] = slips_stepped(
+        theta,
+        c_f,
+        TransferScheme::Flip,
+        [0.5 * t, t],
+        IMPLICIT,
+        None,
+    );
     let a = 4.0 * (full - 2.0 * half) / (t * t);
     let law = G * (theta.sin() - c_f * theta.cos());
     eprintln!(
@@ -307,11 +330,41 @@ fn implicit_two_fields_are_bit_identical_for_one_and_two_threads() {
     let n = if cfg!(debug_assertions) { 3 } else { 30 };
     let run = |threads: usize| {
         on_threads(threads, || {
-            let mut sim = incline_stepped(0.3f64.atan(), 0.2, TransferScheme::Flip, IMPLICIT);
+            let mut sim = incline_stepped(0.3f64.atan(), 0.2, TransferScheme::Flip, IMPLICIT, None);
             assert!(sim.has_two_fields());
             sim.steps_n(n).unwrap();
             sim.save_state()
         })
     };
     assert!(run(1) == run(2), "states differ");
+}
+
+/// The incline with a yarn diameter d = 6 mm (`material.diameter`, 0.77
+/// cells at 128^2; the bed and the top yarn are then in contact only where
+/// their centre lines are closer than d, `src/mpm/laws/fields.rs`): the
+/// top yarn, started one cell above the bed, settles d above it and keeps
+/// Coulomb's threshold: holds at tan theta = 0.85 c_f and slides at 1.15
+/// c_f (threshold within 15 % of c_f = 0.2, as without a diameter).
+#[test]
+#[cfg_attr(debug_assertions, ignore = "release-mode test (cargo test --release)")]
+fn incline_with_a_yarn_diameter_keeps_its_coulomb_threshold() {
+    let c_f: f64 = 0.2;
+    let d = 6e-3;
+    let slip = |k: f64| {
+        let theta = (k * c_f).atan();
+        let [s] = slips_stepped(theta, c_f, TransferScheme::Flip, [0.5], EXPLICIT, Some(d));
+        eprintln!("incline with d = {d} m, tan theta = {k} c_f: slip {s:.3e} m in 0.5 s");
+        s
+    };
+    // tolerance: the 5 mm slip criterion of `slides`
+    assert!(slip(0.85) <= 5e-3, "slid at tan theta = 0.85 c_f");
+    assert!(slip(1.15) > 5e-3, "held at tan theta = 1.15 c_f");
+    // the top yarn rests d above the bed, within 15 %
+    let mut sim = incline_stepped(0.0, c_f, TransferScheme::Flip, EXPLICIT, Some(d));
+    sim.advance(0.3).unwrap();
+    let p = sim.particles();
+    let top = &p.vert.x[p.yarn_vertices[1]..p.yarn_vertices[2]];
+    let gap = top.iter().map(|x| x.y - 0.4).sum::<f64>() / top.len() as f64;
+    eprintln!("incline with d = {d} m: top yarn {gap:.4e} m above the bed");
+    assert!((gap - d).abs() <= 0.15 * d, "gap {gap}, d {d}");
 }

@@ -6,27 +6,46 @@
 
 mod common;
 
-use common::{capstan_slip, capstan_threshold, scene, CAPSTAN_BUILTIN, CAPSTAN_BUILTIN_256};
+use common::{
+    capstan_slip, capstan_threshold, scene, with_diameter, CAPSTAN_BUILTIN, CAPSTAN_BUILTIN_256,
+};
 use yarnsim::math::Vec2;
 use yarnsim::scene::{SceneError, TransferScheme, WallMode, YarnScene};
 use yarnsim::testing::{
-    cantilever_setup, cantilever_toml, capstan_toml, hanging_chain_period, hanging_chain_toml,
-    two_periods_about_mean, Capstan, ZeroCrossings, CAPSTAN_PURE_STRING, CHAIN_GRAVITY,
+    cantilever_setup, cantilever_toml, capstan_drop_toml, capstan_toml, hanging_chain_period,
+    hanging_chain_toml, two_periods_about_mean, Capstan, ZeroCrossings, CAPSTAN_PURE_STRING,
+    CHAIN_GRAVITY,
 };
 use yarnsim::YarnSim;
 use yarnsim_evidence::small_yarn_scene;
 
 // ---- capstan ---------------------------------------------------------------
 
-/// The capstan scene of [`capstan_toml`] as a validated scene.
-fn capstan_scene(r: f64, l1: f64, l2: f64, mu: f64, c: &Capstan) -> YarnScene {
-    scene(&capstan_toml(r, l1, l2, mu, c))
+/// The capstan scene of [`capstan_toml`] as a validated scene; with a yarn
+/// diameter `d` (`material.diameter`) the yarn starts on the circle of
+/// radius `r + d / 2`, where its centre line rests
+/// ([`capstan_drop_toml`]).
+fn capstan_scene(r: f64, l1: f64, l2: f64, mu: f64, c: &Capstan, d: Option<f64>) -> YarnScene {
+    let Some(d) = d else {
+        return scene(&capstan_toml(r, l1, l2, mu, c));
+    };
+    with_diameter(
+        scene(&capstan_drop_toml(r, l1, l2, mu, 0.5 * d, c)),
+        Some(d),
+    )
 }
 
 /// Runs the capstan scene as [`common::capstan_slip`] does; asserts at
 /// every check that no particle is deeper than dx / 2 in the circle.
-fn capstan_slides(r: f64, l1: f64, l2: f64, mu: f64, setup: &Capstan) -> (bool, f64) {
-    let s = capstan_scene(r, l1, l2, mu, setup);
+fn capstan_slides(
+    r: f64,
+    l1: f64,
+    l2: f64,
+    mu: f64,
+    setup: &Capstan,
+    d: Option<f64>,
+) -> (bool, f64) {
+    let s = capstan_scene(r, l1, l2, mu, setup, d);
     let mut sim = YarnSim::new(&s).unwrap();
     let half_dx = 0.5 * s.dx();
     let c = Vec2::from(s.obstacles[0].center);
@@ -61,13 +80,20 @@ fn heavy_rope_capstan_ode_matches_the_documented_threshold() {
 /// threshold measured by three bisection steps between them (bracket
 /// 0.0875 mu*, so the midpoint is within 4.4 % of the measured crossing)
 /// is within 15 % of the heavy-rope mu*. Returns the printed line and
-/// whether it passed.
-fn capstan_case(r: f64, ratio: f64, setup: &Capstan, bisect: bool) -> (String, bool) {
+/// whether it passed. With a yarn diameter `d` the heavy rope lies on the
+/// circle of the yarn's centre line, radius `r + d / 2`.
+fn capstan_case(
+    r: f64,
+    ratio: f64,
+    setup: &Capstan,
+    bisect: bool,
+    d: Option<f64>,
+) -> (String, bool) {
     let l1 = 0.1;
     let l2 = ratio * l1;
-    let mu_star = capstan_threshold(r, l1, l2);
-    let (slid_low, m_low) = capstan_slides(r, l1, l2, 0.7 * mu_star, setup);
-    let (slid_high, m_high) = capstan_slides(r, l1, l2, 1.4 * mu_star, setup);
+    let mu_star = capstan_threshold(r + d.map_or(0.0, |d| 0.5 * d), l1, l2);
+    let (slid_low, m_low) = capstan_slides(r, l1, l2, 0.7 * mu_star, setup, d);
+    let (slid_high, m_high) = capstan_slides(r, l1, l2, 1.4 * mu_star, setup, d);
     let mut line = format!(
         "capstan {}^2 dt {:.0e} g {} gamma {} E {} B {} R {r} l1 {l1} l2 {l2:.2}: mu* {mu_star:.4}, \
          0.7 mu* slid {slid_low} (moved {m_low:.2e}), 1.4 mu* slid {slid_high} (moved {m_high:.2e})",
@@ -78,7 +104,7 @@ fn capstan_case(r: f64, ratio: f64, setup: &Capstan, bisect: bool) -> (String, b
         let (mut lo, mut hi) = (0.7 * mu_star, 1.4 * mu_star);
         for _ in 0..3 {
             let mid = 0.5 * (lo + hi);
-            if capstan_slides(r, l1, l2, mid, setup).0 {
+            if capstan_slides(r, l1, l2, mid, setup, d).0 {
                 lo = mid;
             } else {
                 hi = mid;
@@ -97,12 +123,13 @@ fn capstan_case(r: f64, ratio: f64, setup: &Capstan, bisect: bool) -> (String, b
 }
 
 /// Runs capstan cases `(R, l2 / l1, bisect)` in parallel threads (each
-/// simulation is deterministic for any thread count) and asserts all pass.
-fn capstan_suite(setup: &Capstan, cases: &[(f64, f64, bool)]) {
+/// simulation is deterministic for any thread count) and asserts all pass;
+/// `d`: the yarn diameter, if any.
+fn capstan_suite(setup: &Capstan, cases: &[(f64, f64, bool)], d: Option<f64>) {
     let results: Vec<(String, bool)> = std::thread::scope(|sc| {
         let handles: Vec<_> = cases
             .iter()
-            .map(|&(r, ratio, bisect)| sc.spawn(move || capstan_case(r, ratio, setup, bisect)))
+            .map(|&(r, ratio, bisect)| sc.spawn(move || capstan_case(r, ratio, setup, bisect, d)))
             .collect();
         handles.into_iter().map(|h| h.join().unwrap()).collect()
     });
@@ -126,7 +153,7 @@ const CAPSTAN_ALL: [(f64, f64, bool); 6] = [
 #[test]
 #[cfg_attr(debug_assertions, ignore = "release-mode test (cargo test --release)")]
 fn capstan_yarn_slides_below_and_holds_above_the_heavy_rope_threshold() {
-    capstan_suite(&CAPSTAN_PURE_STRING, &CAPSTAN_ALL);
+    capstan_suite(&CAPSTAN_PURE_STRING, &CAPSTAN_ALL, None);
 }
 
 /// The same oracle with the material of the built-in scenes (cross-section
@@ -134,10 +161,24 @@ fn capstan_yarn_slides_below_and_holds_above_the_heavy_rope_threshold() {
 /// the contact law's friction follows the normal impulse the obstacle
 /// delivers to the whole cross-section, so the cross-section pressure
 /// neither weakens nor strengthens the hold.
+/// The built-in material with a yarn diameter of 5 mm (0.64 cells at
+/// 128^2; the yarn's centre line rests 2.5 mm off the circle): slides at
+/// 0.7 mu* and holds at 1.4 mu* of the heavy rope on the centre line's
+/// circle, R 0.1 and 0.05 at l2 / l1 = 3.
+#[test]
+#[cfg_attr(debug_assertions, ignore = "release-mode test (cargo test --release)")]
+fn capstan_oracle_holds_with_a_yarn_diameter() {
+    capstan_suite(
+        &CAPSTAN_BUILTIN,
+        &[(0.1, 3.0, false), (0.05, 3.0, false)],
+        Some(5e-3),
+    );
+}
+
 #[test]
 #[cfg_attr(debug_assertions, ignore = "release-mode test (cargo test --release)")]
 fn capstan_oracle_holds_for_the_builtin_yarn_material() {
-    capstan_suite(&CAPSTAN_BUILTIN, &CAPSTAN_ALL);
+    capstan_suite(&CAPSTAN_BUILTIN, &CAPSTAN_ALL, None);
 }
 
 /// The built-in material at the built-in scenes' 256^2, dt 4e-5: hold and
@@ -150,7 +191,7 @@ fn capstan_oracle_holds_for_the_builtin_yarn_material_at_256() {
     for c in cases.iter_mut() {
         c.2 = c.0 == 0.1 && c.1 == 3.0;
     }
-    capstan_suite(&CAPSTAN_BUILTIN_256, &cases);
+    capstan_suite(&CAPSTAN_BUILTIN_256, &cases, None);
 }
 
 /// With the built-in scenes' bending stiffness B = 1e-3 N m (bending
@@ -165,7 +206,7 @@ fn capstan_oracle_holds_with_bending() {
         bending: 1e-3,
         ..CAPSTAN_BUILTIN
     };
-    capstan_suite(&setup, &CAPSTAN_ALL);
+    capstan_suite(&setup, &CAPSTAN_ALL, None);
 }
 
 /// A frictionless drape (mu = 0) with the built-in material slides like a
@@ -188,7 +229,7 @@ fn frictionless_drape_slides_at_the_rigid_string_rate() {
             ..CAPSTAN_BUILTIN_256
         },
     ] {
-        let s = capstan_scene(r, l1, l2, 0.0, &setup);
+        let s = capstan_scene(r, l1, l2, 0.0, &setup, None);
         let mut sim = YarnSim::new(&s).unwrap();
         let b0 = sim.yarn_endpoints(0).1;
         let t = 0.2;

@@ -49,6 +49,9 @@ pub struct YarnFlags<'a> {
 pub fn start(scene: &YarnScene, flags: YarnFlags) -> Result<YarnSim, CliError> {
     refuse_massspring_flags(flags)?;
     let sim = YarnSim::new(scene)?;
+    if let Some(warning) = scene.diameter_warning() {
+        eprintln!("warning: {warning}");
+    }
     if let Some(dt) = scene.time.dt.fixed() {
         if let Some(warning) = check_step(dt, sim.stable_dt(), flags.allow_unstable)? {
             eprintln!("warning: {warning}");

@@ -24,7 +24,7 @@ pub use massspring::MassSpringScene;
 pub use yarn::{
     AttractorSpec, ContactSpec, FieldPartition, GridSpec, Integrator, Material, Obstacle,
     PinMotionKind, PinSpec, StepSize, TimeSpec, TransferScheme, TransferSpec, WallMode, Walls,
-    YarnEnd, YarnMaterial, YarnScene, YarnSpec, DEFAULT_SAFETY,
+    YarnEnd, YarnMaterial, YarnScene, YarnSpec, DEFAULT_SAFETY, MAX_DIAMETER_CELLS,
 };
 
 /// Any scene this crate can simulate.

@@ -5,7 +5,8 @@ use yarnsim::massspring::{Integrator as MassSpringIntegrator, IntegratorOptions}
 use yarnsim::math::{perp, Mat2, Vec2};
 use yarnsim::scene::{
     AttractorSpec, GridSpec, Integrator, Material, Obstacle, PinMotionKind, PinSpec, StepSize,
-    TimeSpec, TransferScheme, TransferSpec, WallMode, Walls, YarnEnd, YarnScene, YarnSpec,
+    TimeSpec, TransferScheme, TransferSpec, WallMode, Walls, YarnEnd, YarnMaterial, YarnScene,
+    YarnSpec,
 };
 use yarnsim::testing::Capstan;
 use yarnsim::YarnSim;
@@ -476,6 +477,18 @@ pub fn solved_options(
         o.rho = 0.9;
     }
     o
+}
+
+/// `s` with the yarn diameter `d` (m, `material.diameter`) added to its
+/// material given per metre of depth (`None`: `s` as it is).
+pub fn with_diameter(mut s: YarnScene, d: Option<f64>) -> YarnScene {
+    if let Some(d) = d {
+        s.material.yarn = Some(YarnMaterial {
+            diameter: Some(d),
+            ..YarnMaterial::default()
+        });
+    }
+    s
 }
 
 /// A scene of the built-in material (k 1000, gamma 500, E 1000) with

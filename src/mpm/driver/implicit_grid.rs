@@ -141,7 +141,7 @@ impl YarnSim {
         passes: Passes,
     ) -> Result<(), SimError> {
         // the attractor is a term of the solve, not a force of the update
-        let ext = grid_forces(&self.scene, passes, self.gravity, None);
+        let ext = grid_forces(&self.scene, &self.obstacles, passes, self.gravity, None);
         let model = Model {
             energy: self.energy,
             bending: self.active_bending(passes),
@@ -271,7 +271,7 @@ fn contact_terms(
             let xi = Vec2::new((i0 + n / BLOCK) as f64, (j0 + n % BLOCK) as f64) * geom.dx;
             let touching = mc * (1.0 / m);
             for o in ext.obstacles {
-                let (share, normal, _) = normal_share(o, xi, touching);
+                let (share, normal, _) = normal_share(o, xi, touching, ext.yarn_radius);
                 if share > 0.0 {
                     let c = if share < 1.0 {
                         (share / (1.0 - share)).min(CONTACT_MAX)

@@ -71,7 +71,7 @@ impl YarnSim {
                 fixed[i] = Some((x - rod.x[i]) / dt);
             }
         }
-        let obstacles = active_obstacles(&self.scene, self.passes());
+        let obstacles = active_obstacles(&self.obstacles, self.passes());
         let settings = Settings::default();
         let out = match implicit_vertex::step(&rod, &fixed, obstacles, dt, &settings) {
             Ok(out) => out,

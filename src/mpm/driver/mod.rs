@@ -11,6 +11,7 @@ use crate::math::Vec2;
 pub use crate::mpm::error::SimError;
 use crate::mpm::laws::bending;
 use crate::mpm::laws::constitutive::YarnEnergy;
+use crate::mpm::laws::contact::with_yarn_radius;
 use crate::mpm::laws::fields::{Fields, Partition};
 use crate::mpm::laws::pins::{self, Pin};
 use crate::mpm::machinery::grid::{Grid, GridGeom};
@@ -27,8 +28,8 @@ mod substep;
 pub mod timestep;
 
 use crate::scene::{
-    FieldPartition, SceneError, StepSize, TransferScheme, TransferSpec, WallMode, YarnScene,
-    DEFAULT_SAFETY,
+    FieldPartition, Obstacle, SceneError, StepSize, TransferScheme, TransferSpec, WallMode,
+    YarnScene, DEFAULT_SAFETY,
 };
 pub use cutback::{ENERGY_TOL, MAX_CUTBACKS};
 pub use diagnostics::Diagnostics;
@@ -81,6 +82,11 @@ pub struct YarnSim {
     /// fall into more than one ([`crate::mpm::laws::fields`]); `None`: one
     /// field for all.
     fields: Option<Fields>,
+    /// The obstacles as contact sees them: the scene's, each grown by half
+    /// the yarn diameter where `material.diameter` is given (a yarn's
+    /// centre line rests `d / 2` from the surface), else the scene's as
+    /// they are ([`crate::mpm::laws::contact::with_yarn_radius`]).
+    obstacles: Vec<Obstacle>,
     /// Newton and CG iterations of the implicit substeps.
     implicit_stats: ImplicitStats,
 }
@@ -142,8 +148,10 @@ impl YarnSim {
             &particles.yarn_vertices,
             &particles.quad.left,
             &grid,
+            scene.material.diameter(),
         );
         let mut sim = YarnSim {
+            obstacles: with_yarn_radius(&scene.obstacles, scene.material.diameter()),
             pinned,
             fields,
             transfer: transfer_of(&scene.transfer),

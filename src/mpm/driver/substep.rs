@@ -18,27 +18,35 @@ use crate::mpm::laws::pins::{self, PinEntry};
 use crate::mpm::machinery::spin;
 use crate::scene::{Integrator, Obstacle, YarnScene};
 
-/// The scene's obstacles when their pass runs, none otherwise.
-pub(super) fn active_obstacles(scene: &YarnScene, passes: Passes) -> &[Obstacle] {
+/// The obstacles contact sees (`YarnSim::obstacles`) when their pass
+/// runs, none otherwise.
+pub(super) fn active_obstacles(obstacles: &[Obstacle], passes: Passes) -> &[Obstacle] {
     if passes.obstacles {
-        &scene.obstacles
+        obstacles
     } else {
         &[]
     }
 }
 
+/// Half the yarn diameter (`material.diameter`), 0 without one.
+pub(super) fn yarn_radius(scene: &YarnScene) -> f64 {
+    scene.material.diameter().map_or(0.0, |d| 0.5 * d)
+}
+
 /// The grid update's external forces: gravity, `attractor`, the active
-/// obstacles and the walls.
-pub(super) fn grid_forces(
-    scene: &YarnScene,
+/// obstacles of `obstacles` and the scene's walls.
+pub(super) fn grid_forces<'a>(
+    scene: &'a YarnScene,
+    obstacles: &'a [Obstacle],
     passes: Passes,
     gravity: Vec2,
     attractor: Option<(Vec2, f64)>,
-) -> GridForces<'_> {
+) -> GridForces<'a> {
     GridForces {
         gravity,
         attractor,
-        obstacles: active_obstacles(scene, passes),
+        obstacles: active_obstacles(obstacles, passes),
+        yarn_radius: yarn_radius(scene),
         walls: scene.walls.mode,
         wall_cells: scene.walls.cells as usize,
     }
@@ -95,7 +103,13 @@ impl YarnSim {
         passes: Passes,
     ) -> Result<(), SimError> {
         let attractor = self.active_attractor(passes);
-        let ext = grid_forces(&self.scene, passes, self.gravity, attractor);
+        let ext = grid_forces(
+            &self.scene,
+            &self.obstacles,
+            passes,
+            self.gravity,
+            attractor,
+        );
         match &mut self.fields {
             Some(f) => {
                 for (g, m, mask) in f.grids_with_masses(&mut self.grid) {
@@ -150,7 +164,8 @@ impl YarnSim {
             others,
             dt,
             bending,
-            active_obstacles(&self.scene, passes),
+            active_obstacles(&self.obstacles, passes),
+            yarn_radius(&self.scene),
             scatter_forces,
         );
         let t2 = Instant::now();
@@ -166,6 +181,7 @@ impl YarnSim {
         grid_velocities(self, dt, flip, &pin_entries, passes)?;
         if let Some(f) = &mut self.fields {
             let mu = self.scene.material.friction;
+            f.locate(&self.particles);
             f.contact(
                 &mut self.grid,
                 &pin_entries,
@@ -174,7 +190,7 @@ impl YarnSim {
                 &mut self.pin_reactions,
             );
         }
-        let obstacles = active_obstacles(&self.scene, passes);
+        let obstacles = active_obstacles(&self.obstacles, passes);
         let others = self
             .fields
             .as_ref()

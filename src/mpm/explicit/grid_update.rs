@@ -31,7 +31,11 @@ pub struct GridForces<'a> {
     pub gravity: Vec2,
     /// `(position, strength)` when the attractor acts.
     pub attractor: Option<(Vec2, f64)>,
+    /// The obstacles as contact sees them (grown by `yarn_radius`,
+    /// [`crate::mpm::laws::contact::with_yarn_radius`]).
     pub obstacles: &'a [Obstacle],
+    /// Half the yarn diameter (`material.diameter`), 0 without one.
+    pub yarn_radius: f64,
     pub walls: WallMode,
     pub wall_cells: usize,
 }
@@ -219,7 +223,9 @@ fn obstacle_contacts(
     contacts: &mut Vec<ContactNode>,
 ) {
     for (oi, o) in ext.obstacles.iter().enumerate() {
-        if let Some((normal, impulse)) = obstacle_normal(o, xi, v, m, touching, wedges.reach) {
+        if let Some((normal, impulse)) =
+            obstacle_normal(o, xi, v, m, touching, wedges.reach, ext.yarn_radius)
+        {
             contacts.push(ContactNode {
                 index,
                 ij: [ij[0] as u32, ij[1] as u32],

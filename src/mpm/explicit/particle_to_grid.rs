@@ -20,6 +20,10 @@ use crate::scene::Obstacle;
 
 /// A particle closer than this many cells to an obstacle's surface (or
 /// inside it) counts as touching it: its grid weight gets Coulomb friction.
+/// With a yarn diameter the surface is the obstacle grown by half of it
+/// and a particle touches only on or inside it (margin 0), so the yarn's
+/// rest distance does not follow the cell (`docs/obstacle-contact.md`,
+/// "Yarn diameter").
 pub const CONTACT_CELLS: f64 = 0.5;
 
 /// What one particle adds to the grid, as an affine function of the node
@@ -101,6 +105,8 @@ struct ScatterCtx<'a> {
     dt: f64,
     bending: f64,
     obstacles: &'a [Obstacle],
+    /// How far outside an obstacle a particle touches it, m.
+    margin: f64,
     /// Whether the internal forces are scattered.
     forces: bool,
     /// The field each vertex and quadrature particle scatters into (empty
@@ -135,13 +141,17 @@ fn split_chunks<T>(v: &mut [T], n: usize) -> Vec<&mut [T]> {
 /// whose contact mass is marked.
 #[cfg(feature = "testing")]
 pub fn scatter(p: &mut Particles, grid: &mut Grid, dt: f64, bending: f64, obstacles: &[Obstacle]) {
-    scatter_fields(p, grid, None, dt, bending, obstacles, true)
+    scatter_fields(p, grid, None, dt, bending, obstacles, 0.0, true)
 }
 
 /// [`scatter`] with several fields: the particles `fields` puts in field
 /// `k > 0` go into its grid `k - 1` instead (same window, same chunks). `with_forces = false`: mass and
 /// momentum only (no vertex, bending or normal force; the vertex forces
 /// `p.vert.f` are left zero), for the implicit step, whose solve adds them.
+/// `yarn_radius` (half `material.diameter`, 0 without one): a particle
+/// touches an obstacle (grown by it) within [`CONTACT_CELLS`] of its
+/// surface without one, only on or inside it with one.
+#[allow(clippy::too_many_arguments)]
 pub fn scatter_fields(
     p: &mut Particles,
     grid: &mut Grid,
@@ -149,6 +159,7 @@ pub fn scatter_fields(
     dt: f64,
     bending: f64,
     obstacles: &[Obstacle],
+    yarn_radius: f64,
     with_forces: bool,
 ) {
     // a window that holds every stencil
@@ -183,6 +194,11 @@ pub fn scatter_fields(
         dt,
         bending,
         obstacles,
+        margin: if yarn_radius > 0.0 {
+            0.0
+        } else {
+            CONTACT_CELLS * geom.dx
+        },
         forces: with_forces,
         vert_field,
         quad_field,
@@ -238,7 +254,7 @@ multiversion! {
     ) {
         let (vert, quad, geom, dt) = (ctx.vert, ctx.quad, &ctx.geom, ctx.dt);
         let dx = geom.dx;
-        let margin = crate::mpm::explicit::particle_to_grid::CONTACT_CELLS * dx;
+        let margin = ctx.margin;
         // the normal force per unit of (w_i (x_i - x_p) / dx . d2): -dt dE/dd2 4 / dx
         let normal_scale = -dt * 4.0 * geom.inv_dx;
         let mut bufs = bufs;

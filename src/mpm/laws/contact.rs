@@ -38,10 +38,35 @@
 //! `docs/obstacle-contact.md`, "Under impact"). Pooling whole nodes, the
 //! wedge's tangential momentum is that of the whole cross-section on the
 //! obstacle, as for a yarn laid on it.
+//!
+//! With a yarn diameter `d` (`material.diameter`) the laws act on the
+//! obstacles grown by `d / 2` ([`with_yarn_radius`]), a particle touches
+//! only on or inside the grown circle, and the normal part acts on the
+//! touching mass only, inside too ([`normal_share`]): a yarn's centre line
+//! rests `d / 2` from the surface whatever the cell.
 
 use crate::math::Vec2;
 pub use crate::mpm::machinery::grid::ContactNode;
 use crate::scene::{Obstacle, WallMode};
+
+/// The obstacles as contact sees them for yarns of diameter `diameter`
+/// (`material.diameter`): each grown by `d / 2`, so that the laws below,
+/// which keep a particle (a point of a yarn's centre line) outside a
+/// circle, keep the centre line `d / 2` from the obstacle's surface; the
+/// obstacles as they are without a diameter.
+pub fn with_yarn_radius(obstacles: &[Obstacle], diameter: Option<f64>) -> Vec<Obstacle> {
+    let grow = diameter.map_or(0.0, |d| 0.5 * d);
+    obstacles
+        .iter()
+        .map(|o| {
+            let mut o = o.clone();
+            if grow > 0.0 {
+                o.radius += grow;
+            }
+            o
+        })
+        .collect()
+}
 
 /// Coulomb response of velocity `v` at outward normal `n`: no inward normal
 /// velocity, tangential velocity reduced by `mu` times the removed part.
@@ -68,7 +93,7 @@ pub const FRICTION_ARC_CELLS: f64 = 2.0;
 /// Normal part of the contact of a grid node at `xi` with velocity `v` and
 /// mass `m` with obstacle `o`: `touching` is the fraction of the node's mass
 /// that belongs to particles touching an obstacle (inside the circle the
-/// law acts in full). Removes the inward velocity of that share; returns
+/// law acts in full, without a yarn diameter: see [`normal_share`]). Removes the inward velocity of that share; returns
 /// the outward normal and the normal impulse delivered, or `None` when the
 /// node is not in contact: neither inside, nor carrying touching mass, nor
 /// within `pool_reach` (m) of the surface. A node in contact joins its
@@ -81,8 +106,9 @@ pub fn obstacle_normal(
     m: f64,
     touching: f64,
     pool_reach: f64,
+    yarn_radius: f64,
 ) -> Option<(Vec2, f64)> {
-    let (share, n, dist) = normal_share(o, xi, touching);
+    let (share, n, dist) = normal_share(o, xi, touching, yarn_radius);
     if share <= 0.0 && dist >= o.radius + pool_reach {
         return None;
     }
@@ -101,10 +127,20 @@ pub fn obstacle_normal(
 /// `touching` of its mass, at most 1), the outward normal there and the
 /// node's distance from the centre. Used by [`obstacle_normal`] and by the
 /// implicit solve's contact term.
+///
+/// With a yarn diameter `d` (`yarn_radius = d / 2 > 0`) the circle `o` is
+/// the obstacle grown by `d / 2` ([`with_yarn_radius`]) and the law acts
+/// on the touching fraction everywhere, inside too: a node is in contact
+/// through the particles on or inside the grown circle (which the
+/// particle projection [`project_out`] keeps on its surface), never by
+/// where it lies, so the nodes of a yarn's stencil that reach into the
+/// circle do not stop it before its centre line reaches `d / 2` from the
+/// surface (in full inside the obstacle itself, they held it up to 0.15
+/// cells early at 256^2: `docs/obstacle-contact.md`, "Yarn diameter").
 #[inline]
-pub fn normal_share(o: &Obstacle, xi: Vec2, touching: f64) -> (f64, Vec2, f64) {
+pub fn normal_share(o: &Obstacle, xi: Vec2, touching: f64, yarn_radius: f64) -> (f64, Vec2, f64) {
     let (n, dist) = outward(o, xi);
-    let share = if dist < o.radius {
+    let share = if yarn_radius == 0.0 && dist < o.radius {
         1.0
     } else {
         touching.min(1.0)
@@ -331,6 +367,25 @@ pub fn project_out(o: &Obstacle, x: &mut Vec2, v: &mut Vec2) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// With a yarn diameter the grown circle's normal law acts on the
+    /// touching mass only, inside too; without one, in full inside; the
+    /// obstacles grow by d / 2 and stay as they are without a diameter.
+    #[test]
+    fn a_yarn_diameter_grows_the_circle_and_drops_the_full_law_inside() {
+        let o = Obstacle {
+            center: [0.5, 0.5],
+            radius: 0.1,
+            friction: 0.3,
+        };
+        let grown = with_yarn_radius(std::slice::from_ref(&o), Some(0.004));
+        assert_eq!(grown[0].radius, 0.1 + 0.002);
+        assert_eq!(with_yarn_radius(std::slice::from_ref(&o), None)[0], o);
+        let inside = Vec2::new(0.5, 0.55);
+        assert_eq!(normal_share(&o, inside, 0.0, 0.0).0, 1.0);
+        assert_eq!(normal_share(&grown[0], inside, 0.0, 0.002).0, 0.0);
+        assert_eq!(normal_share(&grown[0], inside, 0.25, 0.002).0, 0.25);
+    }
 
     #[test]
     fn polar_angle_matches_atan2_to_2e_5_rad() {

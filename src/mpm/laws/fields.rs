@@ -46,13 +46,33 @@
 //! kinematic (`v_h' = v_h`, as for infinite mass), so the contact leaves
 //! the pin constraint satisfied; the impulse it delivers there is added to
 //! that pin's reaction. `mu` is `material.friction` (the derivation in
-//! `docs/obstacle-contact.md`). Nodes are visited in the order of the
+//! `docs/obstacle-contact.md`).
+//!
+//! With a yarn diameter `d` (`material.diameter`) a pair is in contact at
+//! a node only where the two yarns' centre lines there are less than `d`
+//! apart: each field's position at the node is the mass-weighted mean of
+//! its particles' positions over the node's kernel (`sum_p w_ip m_p x_p /
+//! sum_p w_ip m_p`, [`Fields::locate`]) and the separation is the
+//! difference of the two along the contact normal (the position-based
+//! contact detection of Lemiale et al. 2010 and Nairn 2013, "Modeling
+//! imperfect interfaces in the material point method using multimaterial
+//! methods", CMES 92, with the yarns' centre lines for the particles and
+//! `d` for the sum of their half-widths). For straight parallel yarns the
+//! estimate is their centre lines' distance exactly. Two fields share a
+//! node only within the kernel support (3 cells), and a yarn pressed onto
+//! another is held only where enough of its stencil shares nodes with the
+//! other's: the scene refuses `d` above
+//! [`crate::scene::MAX_DIAMETER_CELLS`] cells. Without a diameter, contact
+//! acts wherever both fields have mass (a yarn dropped on another rests
+//! about two cells above it, whatever the grid). Nodes are visited in the order of the
 //! window's blocks, one at a time: the same bits for any thread count.
 
+use crate::math::bspline::Stencil;
 use crate::math::Vec2;
 use crate::mpm::laws::contact::coulomb;
 use crate::mpm::laws::pins::{self, PinEntry};
 use crate::mpm::machinery::grid::{Grid, GridGeom, BLOCK, DVX, DVY, VX, VY};
+use crate::mpm::machinery::particles::Particles;
 
 /// How yarns are partitioned into velocity fields (the scene's `[contact]
 /// fields`, see the module documentation).
@@ -76,6 +96,9 @@ pub const FREE_FIELDS_MAX: usize = 32;
 struct NodeMasses {
     m: Vec<f64>,
     mask: Vec<u64>,
+    /// With a diameter, per node `[sum w m, sum w m x, sum w m y]` of the
+    /// field's particles ([`Fields::locate`]); empty otherwise.
+    centre: Vec<[f64; 3]>,
     geom: Option<GridGeom>,
     written: Vec<u32>,
 }
@@ -95,6 +118,9 @@ pub struct Fields {
     /// Node masses of each field this substep (window storage), written by
     /// the grid update ([`Fields::grids_with_masses`]).
     masses: Vec<NodeMasses>,
+    /// The yarn diameter (`material.diameter`), if given: contact only
+    /// where the centre lines are closer than it.
+    diameter: Option<f64>,
     /// Per node, 1 + the pin whose vertex's stencil holds it, or 0 (zero
     /// between contacts, on the window `pinned_geom`).
     pinned_node: Vec<u32>,
@@ -114,6 +140,7 @@ impl Fields {
         yarn_vertices: &[usize],
         quad_left: &[u32],
         grid: &Grid,
+        diameter: Option<f64>,
     ) -> Option<Self> {
         let n_free = held_yarn.iter().filter(|&&h| !h).count();
         let free_fields = match partition {
@@ -143,6 +170,7 @@ impl Fields {
             quad_field,
             held,
             masses: vec![NodeMasses::default(); n],
+            diameter,
             pinned_node: Vec::new(),
             pinned_geom: None,
             block_fields: Vec::new(),
@@ -196,14 +224,43 @@ impl Fields {
         &'a mut self,
         main: &'a mut Grid,
     ) -> Vec<(&'a mut Grid, &'a mut [f64], &'a mut [u64])> {
+        let centres = self.diameter.is_some();
         std::iter::once(main)
             .chain(self.grids.iter_mut())
             .zip(self.masses.iter_mut())
             .map(|(g, m)| {
-                m.prepare(g);
+                m.prepare(g, centres);
                 (g, &mut m.m[..], &mut m.mask[..])
             })
             .collect()
+    }
+
+    /// With a diameter, each field's mass-weighted particle position at its
+    /// nodes (see the module documentation) from the particles `p` as the
+    /// scatter placed them (call after [`Fields::grids_with_masses`]'s grid
+    /// update and before [`Fields::contact`]); nothing without one. Serial,
+    /// in particle order: the same bits for any thread count.
+    pub fn locate(&mut self, p: &Particles) {
+        if self.diameter.is_none() {
+            return;
+        }
+        let items = p.vert.x.iter().zip(&p.vert.m).zip(&self.vert_field);
+        let quads = p.quad.x.iter().zip(&p.quad.m).zip(&self.quad_field);
+        for ((x, &m), &k) in items.chain(quads) {
+            let node = &mut self.masses[k as usize];
+            let geom = node.geom.expect("located after the grid update");
+            let st = Stencil::new(*x, geom.inv_dx);
+            let (bi, bj) = (st.base[0] as usize, st.base[1] as usize);
+            let rows = geom.stencil_rows_mut(&mut node.centre, bi, bj);
+            for (i, row) in rows.into_iter().enumerate() {
+                for (j, c) in row.iter_mut().enumerate() {
+                    let w = st.weight(i, j) * m;
+                    c[0] += w;
+                    c[1] += w * x.x;
+                    c[2] += w * x.y;
+                }
+            }
+        }
     }
 
     /// The contact of the fields (see the module documentation), after
@@ -294,6 +351,12 @@ impl Fields {
                         let Some(nrm) = normal else {
                             continue;
                         };
+                        if let Some(d) = self.diameter {
+                            let at = |k: u16| centre(&self.masses[k as usize].centre[idx]);
+                            if (at(f) - at(h)).dot(&nrm) >= d {
+                                continue;
+                            }
+                        }
                         let pin = if self.held == Some(h) {
                             self.pinned_node[idx]
                         } else {
@@ -326,6 +389,17 @@ impl Fields {
         if self.held.is_some() {
             pins::unmark_stencil_nodes(entries, &mut self.pinned_node);
         }
+    }
+}
+
+/// The mass-weighted particle position `[sum w m, sum w m x, sum w m y]`
+/// of a field at a node (0 where it has none).
+#[inline]
+fn centre(c: &[f64; 3]) -> Vec2 {
+    if c[0] > 0.0 {
+        Vec2::new(c[1], c[2]) / c[0]
+    } else {
+        Vec2::zeros()
     }
 }
 
@@ -379,19 +453,27 @@ impl NodeMasses {
     /// and zeroed there when the window has moved, otherwise zeroed on the
     /// blocks written last time only (with many fields the window is
     /// mostly other fields' blocks).
-    fn prepare(&mut self, grid: &Grid) {
+    /// With `centres`, the same for the mass-weighted positions.
+    fn prepare(&mut self, grid: &Grid, centres: bool) {
         let geom = grid.geom;
         if self.geom != Some(geom) {
             self.m.clear();
             self.m.resize(geom.storage(), 0.0);
             self.mask.clear();
             self.mask.resize(geom.blocks(), 0);
+            if centres {
+                self.centre.clear();
+                self.centre.resize(geom.storage(), [0.0; 3]);
+            }
             self.geom = Some(geom);
         } else {
             for &b in &self.written {
                 let first = block_first_node(&geom, b as usize);
                 for r in 0..BLOCK {
                     self.m[first + r * geom.stride..][..BLOCK].fill(0.0);
+                    if centres {
+                        self.centre[first + r * geom.stride..][..BLOCK].fill([0.0; 3]);
+                    }
                 }
                 self.mask[b as usize] = 0;
             }
@@ -455,7 +537,7 @@ mod tests {
         let fields = |p: Partition, held: &[bool]| {
             let verts: Vec<usize> = (0..=held.len()).map(|y| 2 * y).collect();
             let quads: Vec<u32> = (0..held.len() as u32).map(|y| 2 * y).collect();
-            Fields::of_yarns(p, held, &verts, &quads, &grid)
+            Fields::of_yarns(p, held, &verts, &quads, &grid, None)
         };
         let f = fields(Partition::PerYarn, &[false, true, false, true]).unwrap();
         assert_eq!(f.count(), 3);

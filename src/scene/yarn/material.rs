@@ -58,6 +58,14 @@ impl Material {
         self.per_yarn().map(|p| p.spacing)
     }
 
+    /// The yarn's diameter `d` in m, where the description (or its preset)
+    /// gives one: contact keeps a yarn's centre line `d / 2` from an
+    /// obstacle's surface and two yarns' centre lines `d` apart
+    /// (`crate::mpm::laws::contact`, `crate::mpm::laws::fields`).
+    pub fn diameter(&self) -> Option<f64> {
+        self.yarn.as_ref()?.partial().ok()?.diameter
+    }
+
     /// The yarn-on-solid friction of the description (or its preset), which
     /// obstacles without their own `friction` take.
     pub fn friction_solid(&self) -> Option<f64> {

@@ -15,6 +15,7 @@ pub mod presets;
 mod validate;
 
 pub use material::{Material, YarnMaterial};
+pub use validate::MAX_DIAMETER_CELLS;
 
 /// A complete yarn-bundle scene. See the README section "Scene files" for
 /// every field with its unit and default.

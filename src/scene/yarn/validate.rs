@@ -4,6 +4,15 @@
 
 use super::*;
 
+/// The largest yarn diameter (`material.diameter`), in cells of the grid,
+/// that yarn-on-yarn contact carries: two velocity fields share a node
+/// only within the kernel support (3 cells between the centre lines), and
+/// a yarn pressed onto another is held only where enough of its stencil
+/// shares nodes with the other's: measured, it rests within 15 % of `d`
+/// from 0.5 to 1.8 cells and at 2.3 cells sinks to 1.64 cells (-29 %;
+/// `docs/obstacle-contact.md`, "Yarn diameter").
+pub const MAX_DIAMETER_CELLS: f64 = 1.75;
+
 impl YarnScene {
     /// Checks cross-field constraints (geometry, time step against grid).
     pub fn validate(&self) -> Result<(), SceneError> {
@@ -58,8 +67,62 @@ impl YarnScene {
         self.validate_pins(text)?;
         self.validate_time(text)?;
         self.validate_gridless(text)?;
+        self.validate_diameter(text)?;
         overlap::check_yarns_clear_of_obstacles(self, text)?;
         Ok(())
+    }
+
+    /// Yarns in contact with each other (two or more yarns, in per-yarn
+    /// fields or with a held one): a diameter of at most
+    /// [`MAX_DIAMETER_CELLS`] cells; the grid follows the diameter, so the
+    /// error names the resolution that would carry it.
+    fn validate_diameter(&self, text: Option<&str>) -> Result<(), SceneError> {
+        let Some(d) = self.material.diameter() else {
+            return Ok(());
+        };
+        let cells = d / self.dx();
+        if !self.yarn_contact() || cells <= MAX_DIAMETER_CELLS {
+            return Ok(());
+        }
+        let most = (MAX_DIAMETER_CELLS * self.grid.size / d).floor();
+        Err(SceneError::Invalid {
+            field: "material.diameter".into(),
+            line: text.and_then(|t| {
+                key_line(t, "[material]", "diameter").or(key_line(t, "[material]", "preset"))
+            }),
+            message: format!(
+                "the yarn diameter {d} m is {cells:.2} cells of the grid (grid.resolution {}), \
+                 more than the {MAX_DIAMETER_CELLS} cells yarn-on-yarn contact can carry (two \
+                 yarns' velocity fields meet only within the kernel's 3 cells): set \
+                 grid.resolution to at most {most} for this diameter",
+                self.grid.resolution
+            ),
+        })
+    }
+
+    /// Whether yarns touch each other through the contact of velocity
+    /// fields: two or more yarns, each free yarn in a field of its own
+    /// (`[contact] fields = "per-yarn"`) or a held yarn next to free ones.
+    pub fn yarn_contact(&self) -> bool {
+        let yarns: u64 = self.yarns.iter().map(|y| y.count as u64).sum();
+        yarns >= 2 && (self.contact.fields == FieldPartition::PerYarn || !self.pins.is_empty())
+    }
+
+    /// A warning for a scene whose yarn diameter does not act between its
+    /// free yarns: with `[contact] fields = "held-free"` they share one
+    /// velocity field and their separation is the cross-section's, not the
+    /// diameter (which still keeps them `d / 2` off the obstacles and, with
+    /// a held yarn, `d` from it).
+    pub fn diameter_warning(&self) -> Option<String> {
+        let d = self.material.diameter()?;
+        let yarns: u64 = self.yarns.iter().map(|y| y.count as u64).sum();
+        (yarns >= 2 && self.contact.fields == FieldPartition::HeldFree).then(|| {
+            format!(
+                "material.diameter = {d} m does not act between free yarns: with [contact] \
+                 fields = \"held-free\" (the default) they share one velocity field; set \
+                 [contact] fields = \"per-yarn\" for contact at the diameter"
+            )
+        })
     }
 
     /// The grid interior a yarn must start in, in m: 1.5 cells inside the
