@@ -395,43 +395,6 @@ fn an_explicit_step_above_the_stability_bound_is_refused() {
     assert!(summary.contains("last frame"), "{summary}");
 }
 
-/// A yarn diameter with the free yarns in one field warns that it does not
-/// act between them; per-yarn fields do not warn; a diameter beyond what
-/// the grid carries between yarns is refused naming the field and the
-/// resolution that carries it.
-#[test]
-fn a_yarn_diameter_warns_under_shared_fields_and_is_refused_beyond_the_grid() {
-    let run = |sets: &[&str]| {
-        let mut args = vec!["run", "yarn-reference", "--duration", "2ms"];
-        for s in sets {
-            args.extend(["--set", s]);
-        }
-        yarnsim(&args)
-    };
-    let out = run(&["material.diameter=0.002"]);
-    assert!(out.status.success(), "{}", stderr(&out));
-    let err = stderr(&out);
-    assert!(
-        err.contains("warning: material.diameter = 0.002 m does not act between free yarns"),
-        "{err}"
-    );
-    let out = run(&["material.diameter=0.002", "contact.fields=per-yarn"]);
-    assert!(out.status.success(), "{}", stderr(&out));
-    assert!(
-        !stderr(&out).contains("material.diameter"),
-        "{}",
-        stderr(&out)
-    );
-    // 0.02 m is 5.12 cells of 256^2 over 1 m; 1.75 cells of 87^2 carry it
-    let out = run(&["material.diameter=0.02", "contact.fields=per-yarn"]);
-    assert!(!out.status.success());
-    let err = stderr(&out);
-    assert!(
-        err.contains("material.diameter") && err.contains("grid.resolution to at most 87"),
-        "{err}"
-    );
-}
-
 #[test]
 fn clamped_and_invalid_steps_say_so_briefly() {
     let out = yarnsim(&["run", "wire", "-d", "0.1", "--option", "dt=10"]);

@@ -1,8 +1,9 @@
 //! What the `yarnsim` binary says when a yarn scene cannot run as asked: a
 //! fixed `time.dt` against the stable bound (warned, refused, forced with
 //! `--allow-unstable` into the divergence, whose error carries the same
-//! hint), the mass-spring flags on a yarn scene, and field paths in the one
-//! form `--set` takes and errors print.
+//! hint), the mass-spring flags on a yarn scene, field paths in the one
+//! form `--set` takes and errors print, and a yarn diameter the contact
+//! cannot carry (warned under shared fields, refused beyond the grid).
 
 mod common;
 
@@ -253,5 +254,42 @@ fn a_yarn_outside_the_grid_is_named_in_the_file() {
          entry's 2, shifted by 1 x spacing [0, 0.4]) starts at [0.2, 1], outside the grid \
          interior: x and y must be within [0.023438, 0.976562] m, 1.5 grid cells inside the \
          domain [0, 1] m\n"
+    );
+}
+
+/// A yarn diameter with the free yarns in one field warns that it does not
+/// act between them; per-yarn fields do not warn; a diameter beyond what
+/// the grid carries between yarns is refused naming the field and the
+/// resolution that carries it.
+#[test]
+fn a_yarn_diameter_warns_under_shared_fields_and_is_refused_beyond_the_grid() {
+    let run = |sets: &[&str]| {
+        let mut args = vec!["run", "yarn-reference", "--duration", "2ms"];
+        for s in sets {
+            args.extend(["--set", s]);
+        }
+        yarnsim(&args)
+    };
+    let out = run(&["material.diameter=0.002"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let err = stderr(&out);
+    assert!(
+        err.contains("warning: material.diameter = 0.002 m does not act between free yarns"),
+        "{err}"
+    );
+    let out = run(&["material.diameter=0.002", "contact.fields=per-yarn"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(
+        !stderr(&out).contains("material.diameter"),
+        "{}",
+        stderr(&out)
+    );
+    // 0.02 m is 5.12 cells of 256^2 over 1 m; 1.75 cells of 87^2 carry it
+    let out = run(&["material.diameter=0.02", "contact.fields=per-yarn"]);
+    assert!(!out.status.success());
+    let err = stderr(&out);
+    assert!(
+        err.contains("material.diameter") && err.contains("grid.resolution to at most 87"),
+        "{err}"
     );
 }
