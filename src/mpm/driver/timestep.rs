@@ -51,6 +51,12 @@
 //! mode of angular frequency `omega` by terms in `(omega dt)^2` (measured on
 //! the hanging chain in `tests/implicit.rs`).
 //!
+//! **Axial springs implicit** (`[time] axial = "implicit"` under the
+//! explicit integrator, `crate::mpm::driver::axial`): the fibre-stretch
+//! term `k` takes a backward Euler step on the vertices, so its wave leaves
+//! the elastic bound: `c = sqrt(max(gamma, 2 mu + lambda) / rho)`
+//! ([`explicit_wave_speed`]); the bending and advection bounds stay.
+//!
 //! `[time] dt = "auto"` applies the bound in every substep instead:
 //! [`YarnSim::auto_dt`] is `min(safety * stable_dt, dt_max)` of the state
 //! the substep starts from (default safety
@@ -59,7 +65,7 @@
 
 use crate::mpm::laws::constitutive::YarnEnergy;
 use crate::mpm::YarnSim;
-use crate::scene::Material;
+use crate::scene::{Axial, Material};
 
 /// Courant number of [`stable_dt`]: 1, the cell-crossing limit itself (the
 /// measured limits lie above it, see the module docs).
@@ -68,15 +74,30 @@ pub const COURANT: f64 = 1.0;
 /// The fastest elastic wave speed `c = sqrt(max(k, gamma, 2 mu + lambda) / rho)`
 /// of a material, in m/s.
 pub fn wave_speed(m: &Material) -> f64 {
+    explicit_wave_speed(m, Axial::Explicit)
+}
+
+/// The fastest elastic wave the explicit step carries, in m/s: that of
+/// [`wave_speed`] under `axial = "explicit"`, without the fibre wave
+/// `sqrt(k / rho)` under `axial = "implicit"` (`crate::mpm::driver::axial`
+/// steps the `k` term implicitly): `sqrt(max(gamma, 2 mu + lambda) / rho)`.
+pub fn explicit_wave_speed(m: &Material, axial: Axial) -> f64 {
     let e = YarnEnergy::from_material(m);
-    (e.k.max(e.gamma).max(e.normal) / m.density).sqrt()
+    let k = if axial.is_implicit() { 0.0 } else { e.k };
+    (k.max(e.gamma).max(e.normal) / m.density).sqrt()
 }
 
 /// The largest stable substep in s for a grid spacing `dx` (m) and a largest
 /// particle speed `v_max` (m/s): `COURANT dx / (c + v_max)`, and with
 /// bending also `dx^2 sqrt(rho / B) / 2`.
 pub fn stable_dt(m: &Material, dx: f64, v_max: f64) -> f64 {
-    let elastic = COURANT * dx / (wave_speed(m) + v_max.abs());
+    explicit_stable_dt(m, Axial::Explicit, dx, v_max)
+}
+
+/// [`stable_dt`] with the wave speed of [`explicit_wave_speed`]: under
+/// `axial = "implicit"` the fibre wave does not bound the substep.
+pub fn explicit_stable_dt(m: &Material, axial: Axial, dx: f64, v_max: f64) -> f64 {
+    let elastic = COURANT * dx / (explicit_wave_speed(m, axial) + v_max.abs());
     if m.bending > 0.0 {
         elastic.min(0.5 * dx * dx * (m.density / m.bending).sqrt())
     } else {
@@ -134,8 +155,10 @@ impl YarnSim {
         if self.is_implicit() {
             return implicit_stable_dt(self.advection_length(), self.max_speed());
         }
-        stable_dt(
-            &self.scene().material,
+        let scene = self.scene();
+        explicit_stable_dt(
+            &scene.material,
+            scene.time.axial,
             self.grid_geom().dx,
             self.max_speed(),
         )
