@@ -69,9 +69,10 @@ fn round_off(rod: &Rod) -> f64 {
     100.0 * f64::EPSILON * x * stiff * rod.dt * (rod.len() as f64 / m).sqrt()
 }
 
-/// One yarn's axial step: the velocity change of each of its vertices and
-/// the Newton iterations it took.
-type YarnStep = Result<(Vec<Vec2>, usize), String>;
+/// One yarn's axial step: the velocity change of each of its vertices,
+/// the impulse each constraint delivered (`dE/dv`, zero but at the pinned
+/// vertices) and the Newton iterations it took.
+type YarnStep = Result<(Vec<Vec2>, Vec<Vec2>, usize), String>;
 
 /// The backward Euler step of the axial springs of the yarn with vertices
 /// `range` (see the module docs) from the positions `x*` the vertices have.
@@ -124,7 +125,7 @@ fn yarn_step(
         vec![Vec2::zeros(); n],
         &settings,
     )?;
-    Ok((out.v, out.newton))
+    Ok((out.v, out.gradient, out.newton))
 }
 
 impl YarnSim {
@@ -155,11 +156,13 @@ impl YarnSim {
             .map(|y| yarn_step(&self.particles, &self.pinned, k, dt, yv[y]..yv[y + 1]))
             .collect();
         let mut dv = Vec::with_capacity(self.particles.vert.x.len());
+        let mut impulse = Vec::with_capacity(self.particles.vert.x.len());
         let (mut newton, mut max_newton) = (0, 0);
         for (y, s) in steps.into_iter().enumerate() {
             match s {
-                Ok((d, it)) => {
+                Ok((d, g, it)) => {
                     dv.extend(d);
+                    impulse.extend(g);
                     newton += it as u64;
                     max_newton = max_newton.max(it as u64);
                 }
@@ -173,6 +176,14 @@ impl YarnSim {
                     return Err(e);
                 }
             }
+        }
+        // the pins hold their vertices against the springs: the impulse
+        // of their constraint, per dt, is part of their force on the yarn
+        for (pin, r) in self.pins.iter().zip(self.pin_reactions.iter_mut()) {
+            *r += pin
+                .vertices
+                .iter()
+                .fold(Vec2::zeros(), |a, &i| a + impulse[i] / dt);
         }
         let geom = self.grid.geom;
         let (lo, hi) = (geom.dx, (geom.n as f64 - 2.0) * geom.dx);
