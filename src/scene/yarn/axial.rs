@@ -23,12 +23,10 @@ impl Axial {
     /// Every value of `[time] axial`, as a scene file writes it.
     pub const NAMES: [&'static str; 2] = ["explicit", "implicit"];
 
-    /// The value as a scene file writes it (one of [`Axial::NAMES`]).
+    /// The value as a scene file writes it (one of [`Axial::NAMES`], in
+    /// the order of the variants).
     pub fn name(&self) -> &'static str {
-        match self {
-            Axial::Explicit => Self::NAMES[0],
-            Axial::Implicit => Self::NAMES[1],
-        }
+        Self::NAMES[*self as usize]
     }
 
     /// Whether the `k` term is an explicit grid force (the default).
