@@ -158,7 +158,7 @@ pub fn run_yarn(sim: &mut YarnSim, duration: f64, csv: Option<&Path>) -> Result<
     let p = sim.particles();
     Ok(Summary {
         scene: sim.scene().name.clone(),
-        model: "yarn (MPM)".into(),
+        model: yarn_model(sim.scene()),
         particles: p.len(),
         particles_detail: format!(
             "{} vertices + {} quadrature, {}",
@@ -177,6 +177,18 @@ pub fn run_yarn(sim: &mut YarnSim, duration: f64, csv: Option<&Path>) -> Result<
         forces: per_yarn_forces(sim),
         ..Summary::of_run(frames, last.time - initial.time)
     })
+}
+
+/// The model line of a yarn run's summary: under `[time] axial =
+/// "implicit"` it says which waves bound the explicit substep.
+pub fn yarn_model(scene: &YarnScene) -> String {
+    if scene.time.axial.is_implicit() {
+        "yarn (MPM), axial = \"implicit\": fibre stretch k by backward Euler on the vertices; \
+         dt bound by the shear, cross-section and bending waves, not sqrt(k / rho)"
+            .into()
+    } else {
+        "yarn (MPM)".into()
+    }
 }
 
 /// The sheet a yarn material given per yarn stands for: its spacing, the

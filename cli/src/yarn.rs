@@ -131,7 +131,8 @@ pub fn explain(sim: &YarnSim, e: SimError) -> CliError {
         Some(dt) => {
             // The bound of the scene at rest: the state that diverged has
             // no bound left to compute.
-            let bound = timestep::stable_dt(&sc.material, sc.dx(), 0.0);
+            let bound =
+                timestep::explicit_stable_dt(&sc.material, sc.time.axial, sc.dx(), 0.0, 1.0);
             let ratio = dt / bound;
             let relation = if ratio > 1.0 + 1e-9 {
                 format!("{ratio:.1}x the stability bound {bound:.6e} s of this yarn scene at rest")

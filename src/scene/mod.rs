@@ -22,7 +22,7 @@ pub use error::SceneError;
 pub use fields::{FieldDoc, MASS_SPRING_FIELDS, YARN_FIELDS};
 pub use massspring::MassSpringScene;
 pub use yarn::{
-    AttractorSpec, ContactSpec, FieldPartition, GridSpec, Integrator, Material, Obstacle,
+    AttractorSpec, Axial, ContactSpec, FieldPartition, GridSpec, Integrator, Material, Obstacle,
     PinMotionKind, PinSpec, StepSize, TimeSpec, TransferScheme, TransferSpec, WallMode, Walls,
     YarnEnd, YarnMaterial, YarnScene, YarnSpec, DEFAULT_SAFETY, MAX_DIAMETER_CELLS,
 };

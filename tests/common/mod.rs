@@ -199,6 +199,7 @@ impl SceneBuilder {
                 dt_max: None,
                 frame_dt: 1.0 / 60.0,
                 integrator: Integrator::Explicit,
+                axial: Default::default(),
             },
             material: Material {
                 k: 1000.0,

@@ -177,6 +177,7 @@ pub fn chain_scene(resolution: u32, dt: impl Into<StepSize>, transfer: TransferS
             dt_max: None,
             frame_dt: 1.0 / 60.0,
             integrator: Integrator::Explicit,
+            axial: Default::default(),
         },
         material: chain_material(),
         gravity: [0.0, -GRAVITY],

@@ -2,7 +2,8 @@
 //! simulation, and everything it does itself: stepping and the substep
 //! (`substep.rs`, where the integrator is chosen), the grid integrators'
 //! grid velocities as the substep calls them (`substep.rs`,
-//! `implicit_grid.rs`), the grid-free substep (`implicit_vertex.rs`),
+//! `implicit_grid.rs`), the axial springs' vertex step of the explicit
+//! substep (`axial.rs`), the grid-free substep (`implicit_vertex.rs`),
 //! cutback (`cutback.rs`), the stable time step ([`timestep`]), the dynamic
 //! state ([`state`]), diagnostics (`diagnostics.rs`) and statistics
 //! (`stats.rs`).
@@ -18,6 +19,7 @@ use crate::mpm::machinery::grid::{Grid, GridGeom};
 use crate::mpm::machinery::particles::Particles;
 use crate::mpm::machinery::transfer::Transfer;
 
+mod axial;
 mod cutback;
 mod diagnostics;
 mod implicit_grid;

@@ -1,7 +1,8 @@
 //! One substep of the yarn bundle: the one choice of integrator
 //! ([`YarnSim::substep_once`]), then, for the two grid integrators, the
 //! passes in order (stress, scatter, the integrator's grid velocities,
-//! field contact, gather, pins), their timings, and the checks that turn a
+//! field contact, gather, pins, under `axial = "implicit"` the axial
+//! springs' vertex step of `axial.rs`), their timings, and the checks that turn a
 //! bad state into a [`SimError`]. The explicit grid update is here
 //! ([`YarnSim::explicit_grid_velocities`]), the implicit one in
 //! `implicit_grid.rs`, the grid-free step in `implicit_vertex.rs`.
@@ -147,10 +148,11 @@ impl YarnSim {
         let bending = self.active_bending(passes);
         let transfer = self.transfer;
         let flip = transfer.needs_delta();
+        let energy = self.grid_energy();
         let t0 = Instant::now();
         if self.frames_stale {
             self.particles.quad.refresh_frames();
-            grid_to_particle::quad_stress(&mut self.particles.quad, &self.grid.geom, &self.energy);
+            grid_to_particle::quad_stress(&mut self.particles.quad, &self.grid.geom, &energy);
             self.frames_stale = false;
         }
         let t1 = Instant::now();
@@ -213,17 +215,29 @@ impl YarnSim {
                 &mut self.pin_reactions,
             );
         }
+        // `axial = "implicit"`: the fibre springs' step on the vertices
+        // (`axial.rs`), before the quadrature particles read their edges
+        let axial_dv = if self.scene.time.axial.is_implicit() && bad_v.is_none() {
+            Some(self.axial_step(dt)?)
+        } else {
+            None
+        };
         let t4 = Instant::now();
         let bad_q = grid_to_particle::gather_quads(
             &mut self.particles.quad,
             &self.particles.vert.x,
             &self.grid,
-            others.map(|(g, _, q)| (g, q)),
+            self.fields
+                .as_ref()
+                .map(|f| (&f.grids[..], &f.quad_field[..])),
             dt,
-            &self.energy,
+            &energy,
             passes.plasticity,
             transfer,
         );
+        if let Some(dv) = &axial_dv {
+            self.axial_quads(dv);
+        }
         if flip {
             spin::balance(&mut self.particles, &self.pinned);
         }

@@ -18,7 +18,7 @@
 //!   `(2 mu + lambda) (1 - log r22) / r22^2` (6.8x the rest value at
 //!   `r22 = 0.5`, 65x at 0.2), so [`YarnSim::stable_dt`] takes the normal
 //!   stiffness at the most compressed quadrature particle
-//!   ([`YarnSim::min_r22`], [`wave_speed_at`]). Without it, `dt = "auto"`
+//!   ([`YarnSim::min_r22`], [`explicit_wave_speed`]). Without it, `dt = "auto"`
 //!   stepped a bundle whose yarns were crushed against each other under
 //!   the rest bound, above the crushed one, and it diverged.
 //! * **Advection.** A particle must not move more than one cell per substep
@@ -59,6 +59,12 @@
 //! mode of angular frequency `omega` by terms in `(omega dt)^2` (measured on
 //! the hanging chain in `tests/implicit.rs`).
 //!
+//! **Axial springs implicit** (`[time] axial = "implicit"` under the
+//! explicit integrator, `crate::mpm::driver::axial`): the fibre-stretch
+//! term `k` takes a backward Euler step on the vertices, so its wave leaves
+//! the elastic bound: `c = sqrt(max(gamma, 2 mu + lambda) / rho)`
+//! ([`explicit_wave_speed`]); the bending and advection bounds stay.
+//!
 //! `[time] dt = "auto"` applies the bound in every substep instead:
 //! [`YarnSim::auto_dt`] is `min(safety * stable_dt, dt_max)` of the state
 //! the substep starts from (default safety
@@ -67,7 +73,7 @@
 
 use crate::mpm::laws::constitutive::YarnEnergy;
 use crate::mpm::YarnSim;
-use crate::scene::Material;
+use crate::scene::{Axial, Material};
 
 /// Courant number of [`stable_dt`]: 1, the cell-crossing limit itself (the
 /// measured limits lie above it, see the module docs).
@@ -76,29 +82,34 @@ pub const COURANT: f64 = 1.0;
 /// The fastest elastic wave speed `c = sqrt(max(k, gamma, 2 mu + lambda) / rho)`
 /// of a material, in m/s.
 pub fn wave_speed(m: &Material) -> f64 {
-    wave_speed_at(m, 1.0)
+    explicit_wave_speed(m, Axial::Explicit, 1.0)
 }
 
-/// [`wave_speed`] with the cross-section compressed to `r22` (its smallest
-/// value over the quadrature particles): the normal stiffness is then the
-/// tangent [`YarnEnergy::normal_tangent`], up to 65x the rest value at
-/// `r22 = 0.2`. `r22 >= 1` gives [`wave_speed`].
-pub fn wave_speed_at(m: &Material, r22: f64) -> f64 {
+/// The fastest elastic wave the explicit step carries, in m/s, with the
+/// cross-section compressed to `r22` (its smallest value over the
+/// quadrature particles; `r22 >= 1` is the cross-section at rest): the
+/// normal stiffness is the tangent [`YarnEnergy::normal_tangent`], up to
+/// 65x the rest value at `r22 = 0.2`; under `axial = "implicit"` without
+/// the fibre wave `sqrt(k / rho)` (`crate::mpm::driver::axial` steps the
+/// `k` term implicitly): `sqrt(max(gamma, n(r22)) / rho)`.
+pub fn explicit_wave_speed(m: &Material, axial: Axial, r22: f64) -> f64 {
     let e = YarnEnergy::from_material(m);
-    (e.k.max(e.gamma).max(e.normal_tangent(r22)) / m.density).sqrt()
+    let k = if axial.is_implicit() { 0.0 } else { e.k };
+    (k.max(e.gamma).max(e.normal_tangent(r22)) / m.density).sqrt()
 }
 
 /// The largest stable substep in s for a grid spacing `dx` (m) and a largest
 /// particle speed `v_max` (m/s): `COURANT dx / (c + v_max)`, and with
 /// bending also `dx^2 sqrt(rho / B) / 2`.
 pub fn stable_dt(m: &Material, dx: f64, v_max: f64) -> f64 {
-    stable_dt_at(m, dx, v_max, 1.0)
+    explicit_stable_dt(m, Axial::Explicit, dx, v_max, 1.0)
 }
 
-/// [`stable_dt`] of a state whose most compressed cross-section has
-/// `r22` ([`wave_speed_at`]).
-pub fn stable_dt_at(m: &Material, dx: f64, v_max: f64, r22: f64) -> f64 {
-    let elastic = COURANT * dx / (wave_speed_at(m, r22) + v_max.abs());
+/// [`stable_dt`] with the wave speed of [`explicit_wave_speed`]: under
+/// `axial = "implicit"` the fibre wave does not bound the substep, and a
+/// cross-section crushed to `r22 < 1` lowers the bound.
+pub fn explicit_stable_dt(m: &Material, axial: Axial, dx: f64, v_max: f64, r22: f64) -> f64 {
+    let elastic = COURANT * dx / (explicit_wave_speed(m, axial, r22) + v_max.abs());
     if m.bending > 0.0 {
         elastic.min(0.5 * dx * dx * (m.density / m.bending).sqrt())
     } else {
@@ -156,8 +167,10 @@ impl YarnSim {
         if self.is_implicit() {
             return implicit_stable_dt(self.advection_length(), self.max_speed());
         }
-        stable_dt_at(
-            &self.scene().material,
+        let scene = self.scene();
+        explicit_stable_dt(
+            &scene.material,
+            scene.time.axial,
             self.grid_geom().dx,
             self.max_speed(),
             self.min_r22(),

@@ -11,7 +11,7 @@
 //!
 //! `a_s = vol_s k` is the segment's stretch term of the yarn energy of
 //! Jiang, Gast, Teran 2017 with no shear and no cross-section term
-//! (`psi = k / 2 (r11 - 1)^2`, `r11 = |d1| / l0`), the bending is the
+//! (`psi = k / 2 (r11 - 1)^2`, `r11 = |d1| / l0`, [`crate::mpm::laws::axial`]), the bending is the
 //! discrete-elastic-rod energy of [`crate::mpm::laws::vertex_forces`], `phi` the
 //! attractor's potential of the grid solver ([`crate::mpm::implicit_grid`]).
 //! The friction of the contacts ([`super::contacts`]) adds its own term.
@@ -19,11 +19,11 @@
 use crate::math::dual::jacobian;
 use crate::math::psd::symmetrize;
 use crate::math::Vec2;
-use crate::mpm::laws::attractor;
 use crate::mpm::laws::bending::{bend_gradient_edges, curvature, project_bend, BendRest};
+use crate::mpm::laws::{attractor, axial};
 
 /// A 2x2 block, row major.
-pub type Block = [[f64; 2]; 2];
+pub use crate::mpm::laws::axial::Block;
 
 /// One yarn's step: the state it starts from and its energy terms.
 #[derive(Clone, Debug)]
@@ -88,8 +88,7 @@ impl Rod {
     pub fn potential(&self, y: &[Vec2]) -> f64 {
         let mut e = 0.0;
         for (s, &(a, l0)) in self.segments.iter().enumerate() {
-            let r = (y[s + 1] - y[s]).norm() / l0 - 1.0;
-            e += 0.5 * a * r * r;
+            e += axial::energy(a, l0, y[s + 1] - y[s]);
         }
         for j in 0..self.len() {
             if self.bends(j) {
@@ -121,13 +120,9 @@ impl Rod {
     pub fn potential_gradient(&self, y: &[Vec2]) -> Vec<Vec2> {
         let mut g = vec![Vec2::zeros(); self.len()];
         for (s, &(a, l0)) in self.segments.iter().enumerate() {
-            let e = y[s + 1] - y[s];
-            let len = e.norm();
-            if len > 0.0 {
-                let f = e * (a * (len / l0 - 1.0) / (l0 * len));
-                g[s] -= f;
-                g[s + 1] += f;
-            }
+            let f = axial::gradient(a, l0, y[s + 1] - y[s]);
+            g[s] -= f;
+            g[s + 1] += f;
         }
         for j in 0..self.len() {
             if self.bends(j) {
@@ -183,25 +178,11 @@ impl Rod {
         };
         let dt2 = self.dt * self.dt;
         for (s, &(a, l0)) in self.segments.iter().enumerate() {
-            let e = y[s + 1] - y[s];
-            let len = e.norm();
-            if len <= 0.0 {
-                continue;
+            if let Some(k) = axial::hessian(a, l0, y[s + 1] - y[s]) {
+                add(&mut h.diag[s], &k, dt2);
+                add(&mut h.diag[s + 1], &k, dt2);
+                add(&mut h.off1[s], &k, -dt2);
             }
-            let u = e / len;
-            let axial = a / (l0 * l0);
-            let transverse = (a * (len / l0 - 1.0) / (l0 * len)).max(0.0);
-            let mut k = [[0.0; 2]; 2];
-            for r in 0..2 {
-                for c in 0..2 {
-                    let uu = u[r] * u[c];
-                    let id = (r == c) as u8 as f64;
-                    k[r][c] = dt2 * (axial * uu + transverse * (id - uu));
-                }
-            }
-            add(&mut h.diag[s], &k, 1.0);
-            add(&mut h.diag[s + 1], &k, 1.0);
-            add(&mut h.off1[s], &k, -1.0);
         }
         for j in 0..n {
             if !self.bends(j) {

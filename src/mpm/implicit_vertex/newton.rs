@@ -45,6 +45,10 @@ pub struct Settings {
     /// or the line search can no longer lower the energy (round-off) with
     /// the gradient down by [`Settings::floor_tol`].
     pub rel_tol: f64,
+    /// Converged, too, when `|g|_{M^-1}` is at most this (absolute, in
+    /// sqrt(J): the square root of twice the kinetic energy of the
+    /// velocity error it stands for); 0 by default.
+    pub abs_tol: f64,
     pub step_tol: f64,
     pub floor_tol: f64,
     /// Converged, too, when the Newton step's predicted decrease `-g . d`
@@ -63,6 +67,7 @@ impl Default for Settings {
     fn default() -> Self {
         Settings {
             rel_tol: 1e-10,
+            abs_tol: 0.0,
             step_tol: 1e-13,
             floor_tol: 1e-6,
             decrease_tol: 1e-13,
@@ -208,7 +213,7 @@ pub fn solve(
                 "the step energy is not finite at Newton iteration {it}"
             ));
         }
-        if gn <= s.rel_tol * g0 || gn == 0.0 {
+        if gn <= s.rel_tol * g0 || gn <= s.abs_tol || gn == 0.0 {
             return Ok(Solved {
                 v,
                 gradient: g,

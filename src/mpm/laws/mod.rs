@@ -5,6 +5,8 @@
 //! * [`constitutive`]: the anisotropic yarn energy of Jiang, Gast, Teran
 //!   2017, its stress and Mohr-Coulomb return mapping (with its dual-number
 //!   form), and `constitutive::frames`, the same over batches of frames.
+//! * [`axial`]: the fibre-stretch (`k`) term on one segment as a spring
+//!   between its vertices: energy, gradient, PSD Hessian block.
 //! * [`bending`]: discrete-elastic-rod bending (Bergou et al. 2008): rest
 //!   state, energy, gradient, dual-number form and the PSD projection of
 //!   its Hessian blocks.
@@ -16,6 +18,7 @@
 //! * [`pins`]: pinned and driven vertices and their reaction forces.
 
 pub mod attractor;
+pub mod axial;
 pub mod bending;
 pub mod constitutive;
 pub(crate) mod contact;

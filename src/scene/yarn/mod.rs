@@ -7,6 +7,7 @@ use serde::{Deserialize, Deserializer, Serialize};
 use super::error::{from_toml_error, line_of, table_line, SceneError};
 use crate::math::Vec2;
 
+mod axial;
 mod geometry;
 mod material;
 pub mod material_units;
@@ -14,6 +15,7 @@ mod overlap;
 pub mod presets;
 mod validate;
 
+pub use axial::Axial;
 pub use material::{Material, YarnMaterial};
 pub use validate::MAX_DIAMETER_CELLS;
 
@@ -235,6 +237,11 @@ pub struct TimeSpec {
     /// its scope only, see [`Integrator`].
     #[serde(default, skip_serializing_if = "Integrator::is_explicit")]
     pub integrator: Integrator,
+    /// The fibre-stretch term under the explicit integrator: `"explicit"`
+    /// (default) or `"implicit"` (a backward Euler step of each yarn's
+    /// axial springs on its vertices, see [`Axial`]).
+    #[serde(default, skip_serializing_if = "Axial::is_explicit")]
+    pub axial: Axial,
 }
 
 /// The time integrator of the grid velocities (`[time] integrator`).

@@ -196,6 +196,24 @@ impl YarnScene {
             line: text.and_then(|text| key_line(text, "[time]", field)),
             message,
         };
+        if t.axial.is_implicit() && !t.integrator.is_explicit() {
+            return Err(invalid(
+                "axial",
+                format!(
+                    "axial = \"implicit\" applies only to integrator = \"explicit\", but integrator is \"{}\" (which treats the fibre stretch implicitly already)",
+                    t.integrator.name()
+                ),
+            ));
+        }
+        if t.axial.is_implicit() && self.transfer.scheme != TransferScheme::Apic {
+            return Err(invalid(
+                "axial",
+                "axial = \"implicit\" needs [transfer] scheme = \"apic\": a FLIP particle keeps \
+                 the vertex-scale part of the axial solve's velocity change, which its position \
+                 never follows, and the run gains energy"
+                    .into(),
+            ));
+        }
         match t.dt {
             StepSize::Fixed(dt) => {
                 if !(dt.is_finite() && dt > 0.0) {

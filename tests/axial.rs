@@ -1,0 +1,224 @@
+//! `[time] axial = "implicit"`: the fibre-stretch term of the explicit
+//! step by backward Euler on each yarn's vertices (`src/mpm/driver/axial.rs`).
+//! Against the explicit run at the seed material's k = 1e3, the reference
+//! bundle at k = 1e7 (the seed density: a 3,160 m/s fibre wave) under
+//! `dt = "auto"`, the explicit run at k = 1e7 at its own stable step, and
+//! the static tension of a hanging yarn.
+
+mod common;
+
+use common::{pin_end, same_bits_on_one_and_two_threads, straight, SceneBuilder};
+use yarnsim::math::Vec2;
+use yarnsim::scene::{
+    builtin::yarn_reference, Axial, Integrator, StepSize, TransferScheme, YarnEnd, YarnScene,
+};
+use yarnsim::YarnSim;
+
+/// The reference bundle (12 yarns x 200 vertices onto three circles) at
+/// fibre stiffness `k` (seed density 1), `dt = "auto"`, APIC (the scope
+/// of `axial = "implicit"`).
+fn reference(k: f64, axial: Axial) -> YarnScene {
+    let mut s = yarn_reference();
+    s.material.k = k;
+    s.time.dt = StepSize::Auto;
+    s.time.axial = axial;
+    s.transfer.scheme = TransferScheme::Apic;
+    s.validate().unwrap();
+    s
+}
+
+/// Total energy: kinetic, elastic (the full yarn energy, `k` term
+/// included, and bending) and gravitational.
+fn total_energy(sim: &YarnSim) -> f64 {
+    let d = sim.diagnostics();
+    d.kinetic_energy + d.elastic_energy + d.potential_energy
+}
+
+/// At the seed's k = 1e3 the axial solve changes the step, not the
+/// physics: the centre of mass of the reference bundle follows the
+/// explicit run's through free fall and the landing (to 0.25 s), within
+/// 2 mm (half a grid cell; measured 1.0 mm: the two runs differ by the
+/// splitting's O(dt) error and by the grid's smoothing of the explicit
+/// fibre force, which the vertex solve does not have), and the largest
+/// stretch at the end within 0.05 of the explicit run's (measured 1.146
+/// explicit, 1.109 axial: backward Euler damps the axial overshoot of the
+/// landing that the explicit step keeps).
+#[test]
+#[cfg_attr(debug_assertions, ignore = "release-mode test (cargo test --release)")]
+fn at_the_seed_stiffness_the_axial_solve_follows_the_explicit_run() {
+    let mut ex = YarnSim::new(&reference(1e3, Axial::Explicit)).unwrap();
+    let mut ax = YarnSim::new(&reference(1e3, Axial::Implicit)).unwrap();
+    let mut worst: f64 = 0.0;
+    for i in 1..=25 {
+        let t = 0.01 * i as f64;
+        ex.advance_to(t).unwrap();
+        ax.advance_to(t).unwrap();
+        let (a, b) = (ex.diagnostics(), ax.diagnostics());
+        worst = worst.max((a.center_of_mass - b.center_of_mass).norm());
+    }
+    let (a, b) = (ex.diagnostics(), ax.diagnostics());
+    eprintln!(
+        "centre of mass apart by at most {worst:.3e} m; max stretch {:.5} explicit, {:.5} axial",
+        a.max_stretch, b.max_stretch
+    );
+    assert!(worst < 2e-3, "{worst}");
+    assert!(
+        (a.max_stretch - b.max_stretch).abs() < 0.05,
+        "{} vs {}",
+        a.max_stretch,
+        b.max_stretch
+    );
+}
+
+/// The reference bundle at k = 1e7 with the axial solve under `dt =
+/// "auto"`: the substep is the one of the seed material (the fibre wave
+/// does not bound it), every segment's stretch stays within [0.999,
+/// 1.001] through the fall and the landing (checked every 5 ms to 0.35
+/// s), and the total energy never rises above its start by more than
+/// 1e-4 of it (backward Euler dissipates the axial vibration; the
+/// explicit forces' splitting error is what is left).
+#[test]
+#[cfg_attr(debug_assertions, ignore = "release-mode test (cargo test --release)")]
+fn stiff_bundle_keeps_its_length_and_its_energy_under_dt_auto() {
+    let s = reference(1e7, Axial::Implicit);
+    let soft = YarnSim::new(&reference(1e3, Axial::Explicit)).unwrap();
+    let mut sim = YarnSim::new(&s).unwrap();
+    assert_eq!(sim.auto_dt(), soft.auto_dt());
+    let e0 = total_energy(&sim);
+    let (mut lo, mut hi, mut rise) = (1.0f64, 1.0f64, f64::NEG_INFINITY);
+    for i in 1..=70 {
+        sim.advance_to(0.005 * i as f64).unwrap();
+        let d = sim.diagnostics();
+        lo = lo.min(d.min_stretch);
+        hi = hi.max(d.max_stretch);
+        rise = rise.max(total_energy(&sim) - e0);
+    }
+    let st = sim.implicit_stats();
+    eprintln!(
+        "stretch [{lo:.7}, {hi:.7}], largest energy rise {rise:.3e} J of {e0:.3} J, {} substeps, {:.2} Newton iterations per yarn solve",
+        sim.dt_stats().substeps,
+        st.newton as f64 / (st.substeps as f64 * 12.0)
+    );
+    assert!(lo >= 0.999 && hi <= 1.001, "[{lo}, {hi}]");
+    assert!(rise <= 1e-4 * e0, "{rise} of {e0}");
+    // the bundle has landed: its energy has gone down by the landing
+    assert!(total_energy(&sim) < 0.9 * e0, "{}", total_energy(&sim));
+}
+
+/// The centre of mass of the stiff bundle with the axial solve follows the
+/// plain explicit run at k = 1e7, which `dt = "auto"` steps 84.5 times
+/// shorter (`sqrt(1e7) / sqrt(1400)`, the fibre wave against the
+/// cross-section's), within 1 cm over 0.03 s (the most that run affords in a test:
+/// about 30,000 substeps). The landing comes later (the first contact at
+/// about 0.12 s), so this compares the free fall only, and the largest
+/// stretch of both, within 1e-6 of 1.
+#[test]
+#[cfg_attr(debug_assertions, ignore = "release-mode test (cargo test --release)")]
+fn stiff_bundle_follows_the_explicit_run_at_its_stable_step() {
+    let mut ex = YarnSim::new(&reference(1e7, Axial::Explicit)).unwrap();
+    let mut ax = YarnSim::new(&reference(1e7, Axial::Implicit)).unwrap();
+    let ratio = ax.auto_dt() / ex.auto_dt();
+    let t = 0.03;
+    ex.advance_to(t).unwrap();
+    ax.advance_to(t).unwrap();
+    let (a, b) = (ex.diagnostics(), ax.diagnostics());
+    let apart = (a.center_of_mass - b.center_of_mass).norm();
+    eprintln!(
+        "dt ratio {ratio:.1}; centre of mass apart by {apart:.3e} m; substeps {} explicit, {} axial",
+        a.steps, b.steps
+    );
+    assert!(ratio > 80.0, "{ratio}");
+    assert!(apart < 0.01, "{apart}");
+    for d in [a, b] {
+        assert!((d.max_stretch - 1.0).abs() < 1e-6, "{}", d.max_stretch);
+        assert!((d.min_stretch - 1.0).abs() < 1e-6, "{}", d.min_stretch);
+    }
+}
+
+/// A single yarn of length L = 0.5 m pinned at its top, hanging under
+/// gravity at k = 1e7 with the axial solve (dt = "auto", 84.5 times the
+/// explicit run's step), after 0.1 s (backward Euler has damped the axial
+/// waves): at rest, segment `s` carries the weight below its
+/// midpoint, tension `T = rho g (L - s)` and stretch `1 + rho g (L - s) /
+/// k`, the discrete form with the lumped masses (a vertex and half of
+/// each adjacent segment). Checked on the segments more than 3 cells below
+/// the pin (the pin holds the grid nodes of its stencil, which carry part
+/// of the weight above) to 2 % of the largest strain (measured 0.01 %),
+/// the pin's force against the yarn's weight to 1 % (measured 0.01 %),
+/// and the yarn at rest.
+#[test]
+#[cfg_attr(debug_assertions, ignore = "release-mode test (cargo test --release)")]
+fn hanging_yarn_carries_its_weight_below() {
+    let (k, rho, g, len, n) = (1e7, 1.0, 9.8, 0.5, 101u32);
+    let mut s = SceneBuilder::bare()
+        .scheme(TransferScheme::Apic)
+        .gravity([0.0, -g])
+        .material(|m| {
+            m.k = k;
+            m.density = rho;
+            m.bending = 0.0;
+            m.plasticity = false;
+        })
+        .yarn(straight([0.5, 0.9], [0.5, 0.9 - len], n))
+        .pin(pin_end(0, YarnEnd::Start, 1))
+        .build();
+    s.time.dt = StepSize::Auto;
+    s.time.axial = Axial::Implicit;
+    let mut sim = YarnSim::new(&s).unwrap();
+    let mut explicit = s.clone();
+    explicit.time.axial = Axial::Explicit;
+    let ratio = sim.auto_dt() / YarnSim::new(&explicit).unwrap().auto_dt();
+    sim.advance_to(0.1).unwrap();
+    let p = sim.particles();
+    let l0 = len / (n - 1) as f64;
+    let dx = sim.grid_geom().dx;
+    let top = 0.9;
+    let max_strain = rho * g * len / k;
+    let mut worst: f64 = 0.0;
+    for seg in 0..(n - 1) as usize {
+        let (a, b) = (p.vert.x[seg], p.vert.x[seg + 1]);
+        if top - a.y < 3.0 * dx {
+            continue;
+        }
+        let strain = (b - a).norm() / l0 - 1.0;
+        let s_mid = (seg as f64 + 0.5) * l0;
+        let want = rho * g * (len - s_mid) / k;
+        worst = worst.max((strain - want).abs());
+    }
+    let weight = rho * len * g;
+    let pin = sim.pin_reactions()[0];
+    eprintln!(
+        "dt {ratio:.1}x the explicit one; worst strain error {:.2e} of {max_strain:.2e}; pin force {pin:?} against weight {weight}",
+        worst
+    );
+    assert!(ratio > 80.0, "{ratio}");
+    assert!(worst < 0.02 * max_strain, "{worst} of {max_strain}");
+    assert!(
+        (pin - Vec2::new(0.0, weight)).norm() < 0.01 * weight,
+        "{pin:?} vs {weight}"
+    );
+    assert!(sim.diagnostics().kinetic_energy < 1e-9 * weight * len);
+}
+
+/// Same bits on 1 and 2 threads: the yarns' solves run in parallel, each
+/// sequentially (200 substeps of the stiff bundle).
+#[test]
+fn bit_identical_for_one_and_two_threads() {
+    let stats = same_bits_on_one_and_two_threads(&reference(1e7, Axial::Implicit), 200);
+    assert_eq!(stats.substeps, 200);
+}
+
+/// Outside its scope `axial = "implicit"` is refused at load, naming the
+/// field: under an implicit integrator (which takes the whole energy
+/// implicitly) and under FLIP.
+#[test]
+fn refused_outside_its_scope() {
+    let mut s = reference(1e7, Axial::Implicit);
+    s.time.integrator = Integrator::Implicit;
+    let e = s.validate().unwrap_err().to_string();
+    assert!(e.contains("time.axial") && e.contains("integrator"), "{e}");
+    let mut s = reference(1e7, Axial::Implicit);
+    s.transfer.scheme = TransferScheme::Flip;
+    let e = s.validate().unwrap_err().to_string();
+    assert!(e.contains("time.axial") && e.contains("apic"), "{e}");
+}
