@@ -52,7 +52,8 @@
 use crate::math::Vec2;
 use crate::mpm::laws::contact::coulomb;
 use crate::mpm::laws::pins::{self, PinEntry};
-use crate::mpm::machinery::grid::{Grid, GridGeom, BLOCK, DVX, DVY, VX, VY};
+use crate::mpm::machinery::grid::{Grid, GridGeom, BLOCK, CHUNKS, DVX, DVY, VX, VY};
+use crate::mpm::machinery::simd::chunk_range;
 
 /// How yarns are partitioned into velocity fields (the scene's `[contact]
 /// fields`, see the module documentation).
@@ -113,7 +114,7 @@ impl Fields {
         held_yarn: &[bool],
         yarn_vertices: &[usize],
         quad_left: &[u32],
-        grid: &Grid,
+        grid: &mut Grid,
     ) -> Option<Self> {
         let n_free = held_yarn.iter().filter(|&&h| !h).count();
         let free_fields = match partition {
@@ -136,9 +137,29 @@ impl Fields {
             };
             vert_field[yarn_vertices[y]..yarn_vertices[y + 1]].fill(f as u16);
         }
-        let quad_field = quad_left.iter().map(|&l| vert_field[l as usize]).collect();
+        let quad_field: Vec<u16> = quad_left.iter().map(|&l| vert_field[l as usize]).collect();
+        // the scatter chunks each field's particles fall in
+        let mut used = vec![[false; CHUNKS]; n];
+        for (of, len) in [
+            (&vert_field, vert_field.len()),
+            (&quad_field, quad_field.len()),
+        ] {
+            for k in 0..CHUNKS {
+                for &f in &of[chunk_range(len, k)] {
+                    used[f as usize][k] = true;
+                }
+            }
+        }
+        grid.use_chunks(used[0]);
+        let grids = (1..n)
+            .map(|f| {
+                let mut g = grid.clone();
+                g.use_chunks(used[f]);
+                g
+            })
+            .collect();
         Some(Fields {
-            grids: vec![grid.clone(); n - 1],
+            grids,
             vert_field,
             quad_field,
             held,
@@ -377,8 +398,9 @@ fn add_velocity(node: &mut [f64; 4], dv: Vec2) {
 impl NodeMasses {
     /// Ready for `grid`'s active blocks to be written: sized to its window
     /// and zeroed there when the window has moved, otherwise zeroed on the
-    /// blocks written last time only (with many fields the window is
-    /// mostly other fields' blocks).
+    /// nodes with mass last time only (the grid update writes the nodes
+    /// the scatter touched, and those without mass it writes 0; with many
+    /// fields the window is mostly other fields' blocks).
     fn prepare(&mut self, grid: &Grid) {
         let geom = grid.geom;
         if self.geom != Some(geom) {
@@ -390,10 +412,12 @@ impl NodeMasses {
         } else {
             for &b in &self.written {
                 let first = block_first_node(&geom, b as usize);
-                for r in 0..BLOCK {
-                    self.m[first + r * geom.stride..][..BLOCK].fill(0.0);
+                let mut bits = std::mem::take(&mut self.mask[b as usize]);
+                while bits != 0 {
+                    let bit = bits.trailing_zeros() as usize;
+                    bits &= bits - 1;
+                    self.m[first + (bit / BLOCK) * geom.stride + bit % BLOCK] = 0.0;
                 }
-                self.mask[b as usize] = 0;
             }
         }
         self.written.clear();
@@ -455,7 +479,7 @@ mod tests {
         let fields = |p: Partition, held: &[bool]| {
             let verts: Vec<usize> = (0..=held.len()).map(|y| 2 * y).collect();
             let quads: Vec<u32> = (0..held.len() as u32).map(|y| 2 * y).collect();
-            Fields::of_yarns(p, held, &verts, &quads, &grid)
+            Fields::of_yarns(p, held, &verts, &quads, &mut grid.clone())
         };
         let f = fields(Partition::PerYarn, &[false, true, false, true]).unwrap();
         assert_eq!(f.count(), 3);
