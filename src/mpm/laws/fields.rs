@@ -258,8 +258,8 @@ impl Fields {
         }
         let rows = geom.nbi * BLOCK;
         let s = geom.stride;
-        let grad = |m: &[f64], idx: usize| {
-            let (i, j) = (idx / s, idx % s);
+        // the central difference at node `idx`, row `i`, column `j` of the window
+        let grad = |m: &[f64], idx: usize, i: usize, j: usize| {
             let at = |ok: bool, k: usize| if ok { m[k] } else { 0.0 };
             Vec2::new(
                 at(i + 1 < rows, idx + s) - at(i > 0, idx.wrapping_sub(s)),
@@ -284,12 +284,13 @@ impl Fields {
                     one |= mk;
                 }
             }
-            let first = block_first_node(&geom, b);
+            let (bi, bj) = (b / geom.nbj * BLOCK, b % geom.nbj * BLOCK);
             let mut nodes = two;
             while nodes != 0 {
                 let bit = nodes.trailing_zeros() as usize;
                 nodes &= nodes - 1;
-                let idx = first + (bit / BLOCK) * s + bit % BLOCK;
+                let (ni, nj) = (bi + bit / BLOCK, bj + bit % BLOCK);
+                let idx = ni * s + nj;
                 here.clear();
                 here.extend(
                     in_block
@@ -305,8 +306,8 @@ impl Fields {
                             self.masses[f as usize].m[idx],
                             self.masses[h as usize].m[idx],
                         );
-                        let gf = grad(&self.masses[f as usize].m, idx);
-                        let gh = grad(&self.masses[h as usize].m, idx);
+                        let gf = grad(&self.masses[f as usize].m, idx, ni, nj);
+                        let gh = grad(&self.masses[h as usize].m, idx, ni, nj);
                         let normal = if self.held == Some(h) {
                             contact_normal(gf, gh)
                         } else {

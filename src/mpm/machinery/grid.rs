@@ -575,6 +575,36 @@ mod tests {
         }
     }
 
+    /// The node masks a stencil touches are its nine nodes, over the one,
+    /// two or four blocks it covers, for every base in a window.
+    #[test]
+    fn touched_nodes_are_the_stencils_nodes() {
+        let g = GridGeom::new(37, 1.0).with_window(1, 2, 3, 2);
+        let mut buf = ScatterBuffer::new(&g);
+        for bi in 8..30 {
+            for bj in 16..30 {
+                buf.clear();
+                buf.touch_stencil(&g, [bi as i32, bj as i32]);
+                let mut marked = Vec::new();
+                for &b in &buf.touched_list {
+                    let (i0, j0) = g.block_origin(b as usize);
+                    let m = buf.touched_nodes[b as usize];
+                    assert_ne!(m, 0, "block {b} touched without nodes");
+                    for bit in (0..64).filter(|k| m >> k & 1 != 0) {
+                        marked.push((i0 + bit / BLOCK, j0 + bit % BLOCK));
+                    }
+                }
+                marked.sort_unstable();
+                let want: Vec<_> = (0..3)
+                    .flat_map(|i| (0..3).map(move |j| (bi + i, bj + j)))
+                    .collect();
+                assert_eq!(marked, want, "base ({bi}, {bj})");
+            }
+        }
+        buf.clear();
+        assert!(buf.touched_nodes.iter().all(|&m| m == 0));
+    }
+
     #[test]
     #[should_panic]
     fn stencil_rows_past_the_window_panic() {
