@@ -95,16 +95,31 @@ pub fn grid_update_masses(
 ) {
     let geom = grid.geom;
     let band_len = geom.stride * BLOCK;
-    let mut bands: Vec<Vec<BandSrc>> = (0..geom.nbi).map(|_| Vec::with_capacity(CHUNKS)).collect();
-    for buf in grid.buffers.iter_mut() {
-        let ScatterBuffer {
-            node,
-            touched,
-            touched_nodes,
-            ..
-        } = buf;
-        for (band, node) in bands.iter_mut().zip(node.chunks_mut(band_len)) {
-            band.push(BandSrc {
+    // per band, the used buffers' parts of it in chunk order (one
+    // allocation: many fields run this every substep)
+    let mut parts: Vec<_> = grid
+        .buffers
+        .iter_mut()
+        .filter(|b| b.used)
+        .map(|b| {
+            let ScatterBuffer {
+                node,
+                touched,
+                touched_nodes,
+                ..
+            } = b;
+            (node.chunks_mut(band_len), &*touched, &*touched_nodes)
+        })
+        .collect();
+    let nsrc = parts.len();
+    if nsrc == 0 {
+        return; // no particle scatters into this grid: nothing is active
+    }
+    let mut srcs = Vec::with_capacity(nsrc * geom.nbi);
+    for _ in 0..geom.nbi {
+        for (nodes, touched, touched_nodes) in parts.iter_mut() {
+            let node = nodes.next().expect("a used buffer holds the window");
+            srcs.push(BandSrc {
                 node,
                 touched,
                 touched_nodes,
@@ -132,11 +147,11 @@ pub fn grid_update_masses(
     };
     grid.node
         .par_chunks_mut(band_len)
-        .zip(bands)
+        .zip(srcs.par_chunks_mut(nsrc))
         .zip(contacts.par_iter_mut())
         .zip(band_masses)
         .enumerate()
-        .for_each(|(bi, (((band, mut srcs), contacts), mut masses))| {
+        .for_each(|(bi, (((band, srcs), contacts), mut masses))| {
             contacts.clear();
             let out = BandOut {
                 node: band,
@@ -144,9 +159,9 @@ pub fn grid_update_masses(
                 contacts,
             };
             if flip {
-                grid_band::<true>(bi, out, &mut srcs, ctx)
+                grid_band::<true>(bi, out, srcs, ctx)
             } else {
-                grid_band::<false>(bi, out, &mut srcs, ctx)
+                grid_band::<false>(bi, out, srcs, ctx)
             }
         });
     pooled_friction(ext, &wedges, &contacts, &mut grid.node, geom.n, flip);

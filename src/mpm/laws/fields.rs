@@ -66,8 +66,9 @@ pub enum Partition {
 }
 
 /// Most fields the free yarns get under [`Partition::PerYarn`]: each
-/// field stores the grid window (a node and four scatter buffers, 224
-/// bytes per node), so a bundle of many yarns shares them.
+/// field stores the grid window (a node, 32 bytes, and a scatter buffer of
+/// 48 bytes for each scatter chunk that holds some of its particles, per
+/// node), so a bundle of many yarns shares them.
 pub const FREE_FIELDS_MAX: usize = 32;
 
 /// One field's node masses on the window `geom` (zero off the blocks
