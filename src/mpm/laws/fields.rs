@@ -269,6 +269,7 @@ impl Fields {
         };
         let n = self.count();
         let (mut in_block, mut here) = (Vec::with_capacity(n), Vec::with_capacity(n));
+        let mut grads: Vec<Vec2> = Vec::with_capacity(n);
         for b in 0..geom.blocks() {
             if self.block_fields[b] < 2 {
                 continue;
@@ -298,17 +299,25 @@ impl Fields {
                         .iter()
                         .filter(|&&k| self.masses[k as usize].mask[b] >> bit & 1 != 0),
                 );
+                // each field's mass gradient, once for all its pairs
+                grads.clear();
+                grads.extend(
+                    here.iter()
+                        .map(|&k| grad(&self.masses[k as usize].m, idx, ni, nj)),
+                );
                 for a in 0..here.len() {
                     for c in a + 1..here.len() {
                         let (i, j) = (here[a], here[c]);
                         // h: the held field in a pair with it, else the lower index
-                        let (f, h) = if self.held == Some(j) { (i, j) } else { (j, i) };
+                        let ((f, gf), (h, gh)) = if self.held == Some(j) {
+                            ((i, grads[a]), (j, grads[c]))
+                        } else {
+                            ((j, grads[c]), (i, grads[a]))
+                        };
                         let (m_f, m_h) = (
                             self.masses[f as usize].m[idx],
                             self.masses[h as usize].m[idx],
                         );
-                        let gf = grad(&self.masses[f as usize].m, idx, ni, nj);
-                        let gh = grad(&self.masses[h as usize].m, idx, ni, nj);
                         let normal = if self.held == Some(h) {
                             contact_normal(gf, gh)
                         } else {
@@ -414,11 +423,11 @@ impl NodeMasses {
         } else {
             for &b in &self.written {
                 let first = block_first_node(&geom, b as usize);
-                let mut bits = std::mem::take(&mut self.mask[b as usize]);
-                while bits != 0 {
-                    let bit = bits.trailing_zeros() as usize;
-                    bits &= bits - 1;
-                    self.m[first + (bit / BLOCK) * geom.stride + bit % BLOCK] = 0.0;
+                let bits = std::mem::take(&mut self.mask[b as usize]);
+                // whole rows of the block (one line each): the other nodes
+                // of a row hold 0 already
+                for r in (0..BLOCK).filter(|r| (bits >> (r * BLOCK)) & 0xff != 0) {
+                    self.m[first + r * geom.stride..][..BLOCK].fill(0.0);
                 }
             }
         }
