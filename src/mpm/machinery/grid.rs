@@ -210,7 +210,9 @@ impl GridGeom {
 /// a few cells wide fills a fraction of each of its blocks, and the grid
 /// update works on the touched nodes only. Nodes outside the masks are
 /// zero. A buffer that no particle of its grid's field scatters into
-/// (`used` false: its chunk holds none of them) stores no nodes.
+/// (`used` false: its chunk holds none of them) stores no nodes. Without
+/// `track_nodes` (the single grid: its blocks are mostly full) a touched
+/// block is marked whole.
 #[derive(Clone, Debug)]
 pub struct ScatterBuffer {
     pub node: LinePool<P2gNode>,
@@ -218,6 +220,7 @@ pub struct ScatterBuffer {
     pub touched_list: Vec<u32>,
     pub touched_nodes: Vec<u64>,
     pub used: bool,
+    pub track_nodes: bool,
 }
 
 impl ScatterBuffer {
@@ -228,6 +231,7 @@ impl ScatterBuffer {
             touched_list: Vec::new(),
             touched_nodes: vec![0; geom.blocks()],
             used: true,
+            track_nodes: false,
         }
     }
 
@@ -246,6 +250,20 @@ impl ScatterBuffer {
     pub fn touch_stencil(&mut self, geom: &GridGeom, base: [i32; 2]) {
         let (ri, rj) = (base[0] as usize - geom.i0, base[1] as usize - geom.j0);
         let (i0, j0) = (ri >> BLOCK_SHIFT, rj >> BLOCK_SHIFT);
+        if !self.track_nodes {
+            let (i1, j1) = ((ri + 2) >> BLOCK_SHIFT, (rj + 2) >> BLOCK_SHIFT);
+            self.touch(i0 * geom.nbj + j0, !0);
+            if j1 != j0 {
+                self.touch(i0 * geom.nbj + j1, !0);
+            }
+            if i1 != i0 {
+                self.touch(i1 * geom.nbj + j0, !0);
+                if j1 != j0 {
+                    self.touch(i1 * geom.nbj + j1, !0);
+                }
+            }
+            return;
+        }
         // the stencil's rows and columns from the block's first, over this
         // block and the next (bits 8 and up)
         let rows = 0b111u32 << (ri & (BLOCK - 1));
@@ -429,10 +447,13 @@ impl Grid {
 
     /// Marks the chunks whose particles scatter into this grid
     /// (`used[k]`: chunk `k` has some) and gives back the node storage of
-    /// the others' buffers, which the scatter never writes.
+    /// the others' buffers, which the scatter never writes; the buffers
+    /// mark the nodes they touch (a field's grid: one yarn's blocks are
+    /// mostly empty).
     pub fn use_chunks(&mut self, used: [bool; CHUNKS]) {
         for (buf, &u) in self.buffers.iter_mut().zip(&used) {
             buf.used = u;
+            buf.track_nodes = true;
             if !u {
                 buf.node = LinePool::default();
             }
@@ -581,6 +602,7 @@ mod tests {
     fn touched_nodes_are_the_stencils_nodes() {
         let g = GridGeom::new(37, 1.0).with_window(1, 2, 3, 2);
         let mut buf = ScatterBuffer::new(&g);
+        buf.track_nodes = true;
         for bi in 8..30 {
             for bj in 16..30 {
                 buf.clear();
@@ -603,6 +625,19 @@ mod tests {
         }
         buf.clear();
         assert!(buf.touched_nodes.iter().all(|&m| m == 0));
+        // untracked (the single grid): the same blocks, each whole
+        let mut whole = ScatterBuffer::new(&g);
+        for base in [[8, 16], [13, 21], [14, 22], [15, 23], [29, 29]] {
+            buf.clear();
+            whole.clear();
+            buf.touch_stencil(&g, base);
+            whole.touch_stencil(&g, base);
+            assert_eq!(buf.touched_list, whole.touched_list, "base {base:?}");
+            assert!(whole
+                .touched_list
+                .iter()
+                .all(|&b| whole.touched_nodes[b as usize] == !0));
+        }
     }
 
     #[test]
