@@ -140,7 +140,7 @@ impl YarnSim {
         for pin in &pins {
             held_yarn[pin.yarn] = true;
         }
-        let grid = Grid::new(geom);
+        let mut grid = Grid::new(geom);
         let fields = Fields::of_yarns(
             match scene.contact.fields {
                 FieldPartition::PerYarn => Partition::PerYarn,
@@ -149,7 +149,7 @@ impl YarnSim {
             &held_yarn,
             &particles.yarn_vertices,
             &particles.quad.left,
-            &grid,
+            &mut grid,
             scene.material.diameter(),
         );
         let mut sim = YarnSim {

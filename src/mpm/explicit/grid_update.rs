@@ -61,6 +61,7 @@ impl GridForces<'_> {
 struct BandSrc<'a> {
     node: &'a mut [P2gNode],
     touched: &'a [bool],
+    touched_nodes: &'a [u64],
 }
 
 /// What every band of the grid update reads.
@@ -98,11 +99,35 @@ pub fn grid_update_masses(
 ) {
     let geom = grid.geom;
     let band_len = geom.stride * BLOCK;
-    let mut bands: Vec<Vec<BandSrc>> = (0..geom.nbi).map(|_| Vec::with_capacity(CHUNKS)).collect();
-    for buf in grid.buffers.iter_mut() {
-        let ScatterBuffer { node, touched, .. } = buf;
-        for (band, node) in bands.iter_mut().zip(node.chunks_mut(band_len)) {
-            band.push(BandSrc { node, touched });
+    // per band, the used buffers' parts of it in chunk order (one
+    // allocation: many fields run this every substep)
+    let mut parts: Vec<_> = grid
+        .buffers
+        .iter_mut()
+        .filter(|b| b.used)
+        .map(|b| {
+            let ScatterBuffer {
+                node,
+                touched,
+                touched_nodes,
+                ..
+            } = b;
+            (node.chunks_mut(band_len), &*touched, &*touched_nodes)
+        })
+        .collect();
+    let nsrc = parts.len();
+    if nsrc == 0 {
+        return; // no particle scatters into this grid: nothing is active
+    }
+    let mut srcs = Vec::with_capacity(nsrc * geom.nbi);
+    for _ in 0..geom.nbi {
+        for (nodes, touched, touched_nodes) in parts.iter_mut() {
+            let node = nodes.next().expect("a used buffer holds the window");
+            srcs.push(BandSrc {
+                node,
+                touched,
+                touched_nodes,
+            });
         }
     }
     let wedges = WedgeTable::new(ext.obstacles, geom.dx);
@@ -126,11 +151,11 @@ pub fn grid_update_masses(
     };
     grid.node
         .par_chunks_mut(band_len)
-        .zip(bands)
+        .zip(srcs.par_chunks_mut(nsrc))
         .zip(contacts.par_iter_mut())
         .zip(band_masses)
         .enumerate()
-        .for_each(|(bi, (((band, mut srcs), contacts), mut masses))| {
+        .for_each(|(bi, (((band, srcs), contacts), mut masses))| {
             contacts.clear();
             let out = BandOut {
                 node: band,
@@ -138,9 +163,9 @@ pub fn grid_update_masses(
                 contacts,
             };
             if flip {
-                grid_band::<true>(bi, out, &mut srcs, ctx)
+                grid_band::<true>(bi, out, srcs, ctx)
             } else {
-                grid_band::<false>(bi, out, &mut srcs, ctx)
+                grid_band::<false>(bi, out, srcs, ctx)
             }
         });
     pooled_friction(ext, &wedges, &contacts, &mut grid.node, geom.n, flip);
@@ -339,16 +364,17 @@ multiversion! {
             }
             let (i0, j0) = geom.block_origin(b);
             let mut srcs: [usize; CHUNKS] = [0; CHUNKS];
-            let mut nsrc = 0;
+            let (mut nsrc, mut nodes) = (0, 0u64);
             for (k, s) in buffers.iter().enumerate() {
                 if s.touched[b] {
                     srcs[nsrc] = k;
                     nsrc += 1;
+                    nodes |= s.touched_nodes[b];
                 }
             }
             let srcs = &srcs[..nsrc];
             let (near_obstacle, near_wall) = block_near(geom, ext, b);
-            let blk = BlockAt { bj, i0, j0, near_wall };
+            let blk = BlockAt { bj, i0, j0, nodes, near_wall };
             let mass = masses.as_mut().map(|m| &mut *m.0);
             let mask = if near_obstacle {
                 update_block::<FLIP, true>(&blk, band_base, band, mass, buffers, srcs, ctx, contacts)
@@ -362,18 +388,20 @@ multiversion! {
     }
 }
 
-/// Where a block sits: its column in the band, first node and
-/// whether the walls reach it.
+/// Where a block sits: its column in the band, first node, the nodes the
+/// scatter touched (bit `8 r + c`) and whether the walls reach it.
 struct BlockAt {
     bj: usize,
     i0: usize,
     j0: usize,
+    nodes: u64,
     near_wall: bool,
 }
 
-/// The grid update of one active block, with its nodes' masses written to
-/// `mass` (the band's) if given; returns the block's mask of nodes with
-/// mass ([`MassOut`]). `NEAR`: an obstacle is within reach, so the
+/// The grid update of the touched nodes of one active block (no other
+/// node has mass: the others keep what they hold, which no particle's
+/// stencil reads), with their masses written to `mass` (the band's) if
+/// given; returns the block's mask of nodes with mass ([`MassOut`]). `NEAR`: an obstacle is within reach, so the
 /// contact law runs and contact nodes are recorded (a separate instance
 /// keeps the common loop free of it).
 #[inline(always)]
@@ -399,6 +427,7 @@ fn update_block<const FLIP: bool, const NEAR: bool>(
         bj,
         i0,
         j0,
+        nodes,
         near_wall,
     } = *blk;
     let cells = ext.wall_cells;
@@ -407,7 +436,10 @@ fn update_block<const FLIP: bool, const NEAR: bool>(
     for r in 0..BLOCK {
         let i = i0 + r;
         let row = r * geom.stride + bj * BLOCK;
-        for c in 0..BLOCK {
+        let mut cols = (nodes >> (r * BLOCK)) & 0xff;
+        while cols != 0 {
+            let c = cols.trailing_zeros() as usize;
+            cols &= cols - 1;
             let j = j0 + c;
             let mut acc = [0.0; P2G_LANES];
             for &k in srcs {

@@ -71,8 +71,9 @@ use crate::math::bspline::Stencil;
 use crate::math::Vec2;
 use crate::mpm::laws::contact::coulomb;
 use crate::mpm::laws::pins::{self, PinEntry};
-use crate::mpm::machinery::grid::{Grid, GridGeom, BLOCK, DVX, DVY, VX, VY};
+use crate::mpm::machinery::grid::{Grid, GridGeom, BLOCK, CHUNKS, DVX, DVY, VX, VY};
 use crate::mpm::machinery::particles::Particles;
+use crate::mpm::machinery::simd::chunk_range;
 
 /// How yarns are partitioned into velocity fields (the scene's `[contact]
 /// fields`, see the module documentation).
@@ -85,8 +86,9 @@ pub enum Partition {
 }
 
 /// Most fields the free yarns get under [`Partition::PerYarn`]: each
-/// field stores the grid window (a node and four scatter buffers, 224
-/// bytes per node), so a bundle of many yarns shares them.
+/// field stores the grid window (a node, 32 bytes, and a scatter buffer of
+/// 48 bytes for each scatter chunk that holds some of its particles, per
+/// node), so a bundle of many yarns shares them.
 pub const FREE_FIELDS_MAX: usize = 32;
 
 /// One field's node masses on the window `geom` (zero off the blocks
@@ -139,7 +141,7 @@ impl Fields {
         held_yarn: &[bool],
         yarn_vertices: &[usize],
         quad_left: &[u32],
-        grid: &Grid,
+        grid: &mut Grid,
         diameter: Option<f64>,
     ) -> Option<Self> {
         let n_free = held_yarn.iter().filter(|&&h| !h).count();
@@ -163,9 +165,29 @@ impl Fields {
             };
             vert_field[yarn_vertices[y]..yarn_vertices[y + 1]].fill(f as u16);
         }
-        let quad_field = quad_left.iter().map(|&l| vert_field[l as usize]).collect();
+        let quad_field: Vec<u16> = quad_left.iter().map(|&l| vert_field[l as usize]).collect();
+        // the scatter chunks each field's particles fall in
+        let mut used = vec![[false; CHUNKS]; n];
+        for (of, len) in [
+            (&vert_field, vert_field.len()),
+            (&quad_field, quad_field.len()),
+        ] {
+            for k in 0..CHUNKS {
+                for &f in &of[chunk_range(len, k)] {
+                    used[f as usize][k] = true;
+                }
+            }
+        }
+        grid.use_chunks(used[0]);
+        let grids = (1..n)
+            .map(|f| {
+                let mut g = grid.clone();
+                g.use_chunks(used[f]);
+                g
+            })
+            .collect();
         Some(Fields {
-            grids: vec![grid.clone(); n - 1],
+            grids,
             vert_field,
             quad_field,
             held,
@@ -294,8 +316,8 @@ impl Fields {
         }
         let rows = geom.nbi * BLOCK;
         let s = geom.stride;
-        let grad = |m: &[f64], idx: usize| {
-            let (i, j) = (idx / s, idx % s);
+        // the central difference at node `idx`, row `i`, column `j` of the window
+        let grad = |m: &[f64], idx: usize, i: usize, j: usize| {
             let at = |ok: bool, k: usize| if ok { m[k] } else { 0.0 };
             Vec2::new(
                 at(i + 1 < rows, idx + s) - at(i > 0, idx.wrapping_sub(s)),
@@ -304,6 +326,7 @@ impl Fields {
         };
         let n = self.count();
         let (mut in_block, mut here) = (Vec::with_capacity(n), Vec::with_capacity(n));
+        let mut grads: Vec<Vec2> = Vec::with_capacity(n);
         for b in 0..geom.blocks() {
             if self.block_fields[b] < 2 {
                 continue;
@@ -320,29 +343,38 @@ impl Fields {
                     one |= mk;
                 }
             }
-            let first = block_first_node(&geom, b);
+            let (bi, bj) = (b / geom.nbj * BLOCK, b % geom.nbj * BLOCK);
             let mut nodes = two;
             while nodes != 0 {
                 let bit = nodes.trailing_zeros() as usize;
                 nodes &= nodes - 1;
-                let idx = first + (bit / BLOCK) * s + bit % BLOCK;
+                let (ni, nj) = (bi + bit / BLOCK, bj + bit % BLOCK);
+                let idx = ni * s + nj;
                 here.clear();
                 here.extend(
                     in_block
                         .iter()
                         .filter(|&&k| self.masses[k as usize].mask[b] >> bit & 1 != 0),
                 );
+                // each field's mass gradient, once for all its pairs
+                grads.clear();
+                grads.extend(
+                    here.iter()
+                        .map(|&k| grad(&self.masses[k as usize].m, idx, ni, nj)),
+                );
                 for a in 0..here.len() {
                     for c in a + 1..here.len() {
                         let (i, j) = (here[a], here[c]);
                         // h: the held field in a pair with it, else the lower index
-                        let (f, h) = if self.held == Some(j) { (i, j) } else { (j, i) };
+                        let ((f, gf), (h, gh)) = if self.held == Some(j) {
+                            ((i, grads[a]), (j, grads[c]))
+                        } else {
+                            ((j, grads[c]), (i, grads[a]))
+                        };
                         let (m_f, m_h) = (
                             self.masses[f as usize].m[idx],
                             self.masses[h as usize].m[idx],
                         );
-                        let gf = grad(&self.masses[f as usize].m, idx);
-                        let gh = grad(&self.masses[h as usize].m, idx);
                         let normal = if self.held == Some(h) {
                             contact_normal(gf, gh)
                         } else {
@@ -451,8 +483,9 @@ fn add_velocity(node: &mut [f64; 4], dv: Vec2) {
 impl NodeMasses {
     /// Ready for `grid`'s active blocks to be written: sized to its window
     /// and zeroed there when the window has moved, otherwise zeroed on the
-    /// blocks written last time only (with many fields the window is
-    /// mostly other fields' blocks).
+    /// nodes with mass last time only (the grid update writes the nodes
+    /// the scatter touched, and those without mass it writes 0; with many
+    /// fields the window is mostly other fields' blocks).
     /// With `centres`, the same for the mass-weighted positions.
     fn prepare(&mut self, grid: &Grid, centres: bool) {
         let geom = grid.geom;
@@ -469,13 +502,15 @@ impl NodeMasses {
         } else {
             for &b in &self.written {
                 let first = block_first_node(&geom, b as usize);
-                for r in 0..BLOCK {
+                let bits = std::mem::take(&mut self.mask[b as usize]);
+                // whole rows of the block (one line each): the other nodes
+                // of a row hold 0 already
+                for r in (0..BLOCK).filter(|r| (bits >> (r * BLOCK)) & 0xff != 0) {
                     self.m[first + r * geom.stride..][..BLOCK].fill(0.0);
                     if centres {
                         self.centre[first + r * geom.stride..][..BLOCK].fill([0.0; 3]);
                     }
                 }
-                self.mask[b as usize] = 0;
             }
         }
         self.written.clear();
@@ -537,7 +572,7 @@ mod tests {
         let fields = |p: Partition, held: &[bool]| {
             let verts: Vec<usize> = (0..=held.len()).map(|y| 2 * y).collect();
             let quads: Vec<u32> = (0..held.len() as u32).map(|y| 2 * y).collect();
-            Fields::of_yarns(p, held, &verts, &quads, &grid, None)
+            Fields::of_yarns(p, held, &verts, &quads, &mut grid.clone(), None)
         };
         let f = fields(Partition::PerYarn, &[false, true, false, true]).unwrap();
         assert_eq!(f.count(), 3);

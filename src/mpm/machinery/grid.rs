@@ -205,12 +205,22 @@ impl GridGeom {
 }
 
 /// One chunk's scatter target: a [`P2gNode`] per node, plus the blocks it
-/// touched.
+/// touched and, per window block, the nodes it touched (bit `8 r + c` for
+/// row `r`, column `c` of the block, as the field contact's masks): a yarn
+/// a few cells wide fills a fraction of each of its blocks, and the grid
+/// update works on the touched nodes only. Nodes outside the masks are
+/// zero. A buffer that no particle of its grid's field scatters into
+/// (`used` false: its chunk holds none of them) stores no nodes. Without
+/// `track_nodes` (the single grid: its blocks are mostly full) a touched
+/// block is marked whole.
 #[derive(Clone, Debug)]
 pub struct ScatterBuffer {
     pub node: LinePool<P2gNode>,
     pub touched: Vec<bool>,
     pub touched_list: Vec<u32>,
+    pub touched_nodes: Vec<u64>,
+    pub used: bool,
+    pub track_nodes: bool,
 }
 
 impl ScatterBuffer {
@@ -219,6 +229,9 @@ impl ScatterBuffer {
             node: LinePool::zeroed(geom.storage()),
             touched: vec![false; geom.blocks()],
             touched_list: Vec::new(),
+            touched_nodes: vec![0; geom.blocks()],
+            used: true,
+            track_nodes: false,
         }
     }
 
@@ -227,35 +240,69 @@ impl ScatterBuffer {
     pub fn clear(&mut self) {
         for &b in &self.touched_list {
             self.touched[b as usize] = false;
+            self.touched_nodes[b as usize] = 0;
         }
         self.touched_list.clear();
     }
 
-    /// Marks the blocks covered by the 3x3 stencil at `base`.
+    /// Marks the blocks and nodes covered by the 3x3 stencil at `base`.
     #[inline(always)]
     pub fn touch_stencil(&mut self, geom: &GridGeom, base: [i32; 2]) {
         let (ri, rj) = (base[0] as usize - geom.i0, base[1] as usize - geom.j0);
         let (i0, j0) = (ri >> BLOCK_SHIFT, rj >> BLOCK_SHIFT);
-        let (i1, j1) = ((ri + 2) >> BLOCK_SHIFT, (rj + 2) >> BLOCK_SHIFT);
-        self.touch(i0 * geom.nbj + j0);
-        if j1 != j0 {
-            self.touch(i0 * geom.nbj + j1);
-        }
-        if i1 != i0 {
-            self.touch(i1 * geom.nbj + j0);
+        if !self.track_nodes {
+            let (i1, j1) = ((ri + 2) >> BLOCK_SHIFT, (rj + 2) >> BLOCK_SHIFT);
+            self.touch(i0 * geom.nbj + j0, !0);
             if j1 != j0 {
-                self.touch(i1 * geom.nbj + j1);
+                self.touch(i0 * geom.nbj + j1, !0);
+            }
+            if i1 != i0 {
+                self.touch(i1 * geom.nbj + j0, !0);
+                if j1 != j0 {
+                    self.touch(i1 * geom.nbj + j1, !0);
+                }
+            }
+            return;
+        }
+        // the stencil's rows and columns from the block's first, over this
+        // block and the next (bits 8 and up)
+        let rows = 0b111u32 << (ri & (BLOCK - 1));
+        let cols = 0b111u64 << (rj & (BLOCK - 1));
+        let b = i0 * geom.nbj + j0;
+        let (left, right) = (cols & 0xff, cols >> BLOCK);
+        self.touch(b, stencil_mask(rows & 0xff, left));
+        if right != 0 {
+            self.touch(b + 1, stencil_mask(rows & 0xff, right));
+        }
+        if rows >> BLOCK != 0 {
+            self.touch(b + geom.nbj, stencil_mask(rows >> BLOCK, left));
+            if right != 0 {
+                self.touch(b + geom.nbj + 1, stencil_mask(rows >> BLOCK, right));
             }
         }
     }
 
     #[inline(always)]
-    fn touch(&mut self, b: usize) {
+    fn touch(&mut self, b: usize, nodes: u64) {
         if !self.touched[b] {
             self.touched[b] = true;
             self.touched_list.push(b as u32);
         }
+        self.touched_nodes[b] |= nodes;
     }
+}
+
+/// The node mask (bit `8 r + c`) of the block's rows `rows` (bit `r`) and
+/// columns `cols` (bit `c`).
+#[inline(always)]
+fn stencil_mask(rows: u32, cols: u64) -> u64 {
+    let mut m = 0;
+    let mut rs = rows;
+    while rs != 0 {
+        m |= cols << (BLOCK as u32 * rs.trailing_zeros());
+        rs &= rs - 1;
+    }
+    m
 }
 
 /// The summed grid: a [`Node`] per node of the window (meaningful on the
@@ -391,9 +438,25 @@ impl Grid {
         // summed), so the pools need no clearing wherever the window moved
         self.node.fit(geom.storage());
         fit(&mut self.is_active, geom.blocks(), false);
-        for buf in &mut self.buffers {
-            buf.node.fit(geom.storage());
+        for buf in self.buffers.iter_mut() {
+            buf.node.fit(if buf.used { geom.storage() } else { 0 });
             fit(&mut buf.touched, geom.blocks(), false);
+            fit(&mut buf.touched_nodes, geom.blocks(), 0);
+        }
+    }
+
+    /// Marks the chunks whose particles scatter into this grid
+    /// (`used[k]`: chunk `k` has some) and gives back the node storage of
+    /// the others' buffers, which the scatter never writes; the buffers
+    /// mark the nodes they touch (a field's grid: one yarn's blocks are
+    /// mostly empty).
+    pub fn use_chunks(&mut self, used: [bool; CHUNKS]) {
+        for (buf, &u) in self.buffers.iter_mut().zip(&used) {
+            buf.used = u;
+            buf.track_nodes = true;
+            if !u {
+                buf.node = LinePool::default();
+            }
         }
     }
 
@@ -406,7 +469,8 @@ impl Grid {
         for buf in &self.buffers {
             b += buf.node.capacity_bytes()
                 + buf.touched.capacity()
-                + buf.touched_list.capacity() * size_of::<u32>();
+                + buf.touched_list.capacity() * size_of::<u32>()
+                + buf.touched_nodes.capacity() * size_of::<u64>();
         }
         b
     }
@@ -529,6 +593,50 @@ mod tests {
                 assert_eq!(written.len(), 9);
                 assert!(written.iter().all(|&k| marks[k] == k + 1));
             }
+        }
+    }
+
+    /// The node masks a stencil touches are its nine nodes, over the one,
+    /// two or four blocks it covers, for every base in a window.
+    #[test]
+    fn touched_nodes_are_the_stencils_nodes() {
+        let g = GridGeom::new(37, 1.0).with_window(1, 2, 3, 2);
+        let mut buf = ScatterBuffer::new(&g);
+        buf.track_nodes = true;
+        for bi in 8..30 {
+            for bj in 16..30 {
+                buf.clear();
+                buf.touch_stencil(&g, [bi as i32, bj as i32]);
+                let mut marked = Vec::new();
+                for &b in &buf.touched_list {
+                    let (i0, j0) = g.block_origin(b as usize);
+                    let m = buf.touched_nodes[b as usize];
+                    assert_ne!(m, 0, "block {b} touched without nodes");
+                    for bit in (0..64).filter(|k| m >> k & 1 != 0) {
+                        marked.push((i0 + bit / BLOCK, j0 + bit % BLOCK));
+                    }
+                }
+                marked.sort_unstable();
+                let want: Vec<_> = (0..3)
+                    .flat_map(|i| (0..3).map(move |j| (bi + i, bj + j)))
+                    .collect();
+                assert_eq!(marked, want, "base ({bi}, {bj})");
+            }
+        }
+        buf.clear();
+        assert!(buf.touched_nodes.iter().all(|&m| m == 0));
+        // untracked (the single grid): the same blocks, each whole
+        let mut whole = ScatterBuffer::new(&g);
+        for base in [[8, 16], [13, 21], [14, 22], [15, 23], [29, 29]] {
+            buf.clear();
+            whole.clear();
+            buf.touch_stencil(&g, base);
+            whole.touch_stencil(&g, base);
+            assert_eq!(buf.touched_list, whole.touched_list, "base {base:?}");
+            assert!(whole
+                .touched_list
+                .iter()
+                .all(|&b| whole.touched_nodes[b as usize] == !0));
         }
     }
 
