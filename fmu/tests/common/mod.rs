@@ -330,6 +330,12 @@ impl Fmu {
         unsafe { fmi2SetString(self.c, &vr, 1, &p) }
     }
 
+    pub fn set_integer(&self, vr: u32, v: c_int) -> fmi2Status {
+        // SAFETY: `self.c` came from `fmi2Instantiate` and lives until its `Fmu` drops; every
+        // pointer argument is a local that outlives the call.
+        unsafe { fmi2SetInteger(self.c, &vr, 1, &v) }
+    }
+
     pub fn get_string(&self, vr: u32) -> String {
         let mut p: fmi2String = std::ptr::null();
         // SAFETY: `self.c` came from `fmi2Instantiate` and lives until its `Fmu` drops; every
