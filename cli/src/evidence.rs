@@ -11,7 +11,8 @@ use std::ffi::OsString;
 use std::path::{Path, PathBuf};
 
 use clap::Subcommand;
-use yarnsim_evidence::{precision, roofline, skip, stress, write_report};
+use yarnsim_evidence::trajectory::Trajectory;
+use yarnsim_evidence::{bundle_precision, precision, roofline, skip, stress, write_report};
 
 use crate::error::CliError;
 
@@ -42,6 +43,18 @@ pub enum BenchStudy {
         /// Leave out the yarn hanging-chain study (mass-spring scenes only).
         #[arg(long)]
         no_chain: bool,
+        /// Instead: the reference bundle (yarn-reference) over a ladder of
+        /// settings against a reference trajectory; writes
+        /// bundle_precision.csv, .svg, .txt (--quick: 0.1 s, coarse steps).
+        #[arg(long)]
+        bundle: bool,
+        /// With --bundle: the reference trajectory CSV (default: the shipped
+        /// docs/performance/bundle_reference.csv).
+        #[arg(long, value_name = "FILE", requires = "bundle")]
+        reference: Option<PathBuf>,
+        /// With --bundle: only the settings whose name contains this (repeatable).
+        #[arg(long, value_name = "NAME", requires = "bundle")]
+        setting: Vec<String>,
     },
     /// Skip what a scene doesn't need: optional passes on/off, 256^2 vs
     /// 1024^2 grid, per-pass breakdown of the reference scene.
@@ -98,6 +111,18 @@ impl EvidenceCommand {
     /// "Performance and accuracy evidence"), for the spinner.
     pub fn label(&self) -> (&'static str, &'static str) {
         match self {
+            EvidenceCommand::Bench(BenchStudy::Precision {
+                bundle: true,
+                quick,
+                ..
+            }) => (
+                "bench precision --bundle",
+                if *quick {
+                    "about 20 s"
+                } else {
+                    "tens of minutes"
+                },
+            ),
             EvidenceCommand::Bench(BenchStudy::Precision { quick: false, .. }) => {
                 ("bench precision", "about 40 s")
             }
@@ -148,8 +173,30 @@ pub fn execute(cmd: &EvidenceCommand) -> Result<(String, Vec<String>), CliError>
         EvidenceCommand::Bench(BenchStudy::Precision {
             out,
             quick,
+            bundle: true,
+            reference,
+            setting,
+            ..
+        }) => {
+            let reference = match reference {
+                Some(p) => std::fs::read_to_string(p)
+                    .map_err(|e| CliError::Usage(format!("--reference {}: {e}", p.display())))?,
+                None => bundle_precision::SHIPPED_REFERENCE.to_string(),
+            };
+            let reference = Trajectory::from_csv(&reference)
+                .map_err(|e| CliError::Usage(format!("--reference: {e}")))?;
+            let (duration, implicit) = if *quick { (0.1, 0.1) } else { (1.0, 0.1) };
+            let ladder = bundle_precision::ladder(duration, implicit, *quick);
+            let r =
+                bundle_precision::run(&ladder, &reference, setting).map_err(CliError::Failed)?;
+            Ok((r.to_text(), write(out, &r.files())?))
+        }
+        EvidenceCommand::Bench(BenchStudy::Precision {
+            out,
+            quick,
             yarn_reference,
             no_chain,
+            ..
         }) => {
             let r = precision::run(&precision::PrecisionOptions {
                 quick: *quick,
@@ -252,6 +299,9 @@ mod tests {
             quick: true,
             yarn_reference: false,
             no_chain: false,
+            bundle: false,
+            reference: None,
+            setting: Vec::new(),
         }))
         .unwrap();
         assert!(text.contains("Fastest method per error level"));
@@ -264,6 +314,54 @@ mod tests {
         assert!(files.iter().any(|f| f.ends_with("precision.csv")));
         let svg = std::fs::read_to_string(dir.join("precision_wire.svg")).unwrap();
         assert!(svg.starts_with("<svg") && svg.contains("polyline"));
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    /// `--bundle --quick` against the shipped reference given as a file:
+    /// the CSV has one row per quick setting, each 0.1 s long; every run,
+    /// at dt 4e-5 or `auto` (16x or more the reference's 2.5e-6), is a
+    /// nonzero distance from it, and the reference against itself is
+    /// exactly 0.
+    #[test]
+    #[cfg_attr(debug_assertions, ignore = "runs the quick studies; release only")]
+    fn quick_bundle_writes_csv_svg_and_compares() {
+        use yarnsim_evidence::bundle_precision::{ladder, measure, SHIPPED_REFERENCE};
+        let dir = std::env::temp_dir().join(format!("yarnsim-bundle-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let reference = dir.join("reference.csv");
+        std::fs::write(&reference, SHIPPED_REFERENCE).unwrap();
+        let (text, files) = execute(&EvidenceCommand::Bench(BenchStudy::Precision {
+            out: dir.clone(),
+            quick: true,
+            yarn_reference: false,
+            no_chain: false,
+            bundle: true,
+            reference: Some(reference),
+            setting: Vec::new(),
+        }))
+        .unwrap();
+        assert!(text.contains("compared over 1.0000e-1 s only"), "{text}");
+        assert_eq!(files.len(), 3);
+        let csv = std::fs::read_to_string(dir.join("bundle_precision.csv")).unwrap();
+        let mut lines = csv.lines();
+        let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+        let col = |name: &str| header.iter().position(|h| *h == name).unwrap();
+        let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
+        assert_eq!(rows.len(), ladder(0.1, 0.1, true).len());
+        for r in &rows {
+            let window: f64 = r[col("window_s")].parse().unwrap();
+            assert!((window - 0.1).abs() < 1e-3, "{r:?}");
+            let com: f64 = r[col("com_max_m")].parse().unwrap();
+            let ends: f64 = r[col("ends_max_m")].parse().unwrap();
+            let wall: f64 = r[col("wall_s_per_sim_s")].parse().unwrap();
+            assert!(com > 0.0 && ends > 0.0 && wall > 0.0, "{r:?}");
+        }
+        let svg = std::fs::read_to_string(dir.join("bundle_precision.svg")).unwrap();
+        assert!(svg.starts_with("<svg") && svg.contains("flip per-yarn 4e-5 com"));
+        let r = Trajectory::from_csv(SHIPPED_REFERENCE).unwrap();
+        let s = &ladder(1.0, 0.1, false)[0];
+        let same = measure(s, &r, &r).unwrap();
+        assert_eq!((same.com_max, same.ends_max), (0.0, 0.0));
         let _ = std::fs::remove_dir_all(&dir);
     }
 }

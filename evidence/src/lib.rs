@@ -22,6 +22,7 @@
 //! directory. Wall times are measured in this build on this machine; errors
 //! and stability limits are deterministic.
 
+pub mod bundle_precision;
 pub mod chain;
 pub mod plot;
 pub mod precision;

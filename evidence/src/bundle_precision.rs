@@ -1,0 +1,257 @@
+//! Work-precision of the reference bundle (`yarn-reference`: 12 yarns
+//! falling onto three circles, 256^2): each setting of a ladder (transfer
+//! scheme, contact fields, step size, integrator) is recorded with
+//! [`trajectory::record`] and compared with a reference trajectory with
+//! [`trajectory::compare`] over the common time window: the largest
+//! distance over the frames of the centre of mass (the converging
+//! observable) and of the 24 yarn ends (measured; they are sensitive to a
+//! 1e-9 perturbation, `/docs/performance/bundle-convergence.md`), against
+//! the wall time per simulated second. Whole trajectories are compared
+//! (Hairer, Norsett, Wanner, "Solving Ordinary Differential Equations I",
+//! 2nd ed., Springer 1993, section II.4).
+
+use crate::plot::{LinePlot, Marker, Series};
+use crate::trajectory::{compare, record, Trajectory};
+use crate::{num, Table};
+
+/// The scene every setting runs.
+pub const SCENE: &str = "yarn-reference";
+
+/// The measured reference trajectory shipped with the repository
+/// (per-yarn fields, FLIP, dt 2.5e-6, 1 s).
+pub const SHIPPED_REFERENCE: &str = include_str!("../../docs/performance/bundle_reference.csv");
+
+/// One rung of the ladder.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Setting {
+    /// Short name, e.g. `flip per-yarn 1e-5`.
+    pub name: String,
+    /// The scene overrides (`KEY=VALUE`, as `--set` takes them).
+    pub overrides: Vec<String>,
+    /// `time.dt` as written (`auto` or a number).
+    pub dt: String,
+    /// Simulated time, s (shorter for the slow grid implicit integrator).
+    pub duration: f64,
+}
+
+fn setting(scheme: &str, fields: &str, dt: &str, integrator: &str, duration: f64) -> Setting {
+    let name = if integrator == "explicit" {
+        format!("{scheme} {fields} {dt}")
+    } else {
+        format!("{integrator} {scheme} {fields} {dt}")
+    };
+    Setting {
+        name,
+        overrides: vec![
+            format!("transfer.scheme={scheme}"),
+            format!("contact.fields={fields}"),
+            format!("time.dt={dt}"),
+            format!("time.integrator={integrator}"),
+        ],
+        dt: dt.to_string(),
+        duration,
+    }
+}
+
+/// The ladder: explicit FLIP held-free and per-yarn at dt 4e-5, 2e-5, 1e-5
+/// and `auto`, APIC per-yarn at 4e-5 and 1e-5, and the grid implicit
+/// integrator at `auto` over `implicit_duration` s only (it is slow on this
+/// scene). `quick`: 0.1 s, and only the two coarse explicit steps and
+/// `auto` (a run of seconds, for tests).
+pub fn ladder(duration: f64, implicit_duration: f64, quick: bool) -> Vec<Setting> {
+    let dts: &[&str] = if quick {
+        &["4e-5", "auto"]
+    } else {
+        &["4e-5", "2e-5", "1e-5", "auto"]
+    };
+    let mut v = Vec::new();
+    for fields in ["held-free", "per-yarn"] {
+        for dt in dts {
+            v.push(setting("flip", fields, dt, "explicit", duration));
+        }
+    }
+    if !quick {
+        for dt in ["4e-5", "1e-5"] {
+            v.push(setting("apic", "per-yarn", dt, "explicit", duration));
+        }
+        v.push(setting(
+            "flip",
+            "held-free",
+            "auto",
+            "implicit",
+            implicit_duration,
+        ));
+    }
+    v
+}
+
+/// One setting's result.
+#[derive(Clone, Debug, PartialEq)]
+pub struct BundleRun {
+    pub setting: Setting,
+    pub steps: u64,
+    pub wall_per_second: f64,
+    /// End of the compared window, s.
+    pub window: f64,
+    pub com_max: f64,
+    pub ends_max: f64,
+    /// Kinetic, elastic, potential, dissipated energy at the end, J per m.
+    pub energy: [f64; 4],
+}
+
+/// The whole study.
+#[derive(Clone, Debug, PartialEq)]
+pub struct BundleReport {
+    /// The reference's label (its first `#` line).
+    pub reference: String,
+    pub runs: Vec<BundleRun>,
+}
+
+/// Compares `run` (of `setting`) with `reference` over their common window.
+pub fn measure(
+    setting: &Setting,
+    run: &Trajectory,
+    reference: &Trajectory,
+) -> Result<BundleRun, String> {
+    let c = compare(run, reference).map_err(|e| format!("{}: {e}", setting.name))?;
+    let last = run
+        .frames
+        .last()
+        .ok_or_else(|| format!("{}: no frames", setting.name))?;
+    Ok(BundleRun {
+        setting: setting.clone(),
+        steps: run.steps,
+        wall_per_second: run.wall_per_second(),
+        window: c.curve.last().map_or(0.0, |p| p.0),
+        com_max: c.com_max,
+        ends_max: c.ends_max,
+        energy: last.energy,
+    })
+}
+
+/// Runs every setting (whose name contains one of `only`, if any is given)
+/// and compares it with `reference`.
+pub fn run(
+    settings: &[Setting],
+    reference: &Trajectory,
+    only: &[String],
+) -> Result<BundleReport, String> {
+    let mut runs = Vec::new();
+    for s in settings {
+        if !only.is_empty() && !only.iter().any(|o| s.name.contains(o.as_str())) {
+            continue;
+        }
+        let t = record(SCENE, &s.overrides, s.duration, 1.0 / 60.0)
+            .map_err(|e| format!("{}: {e}", s.name))?;
+        runs.push(measure(s, &t, reference)?);
+    }
+    Ok(BundleReport {
+        reference: reference.label.clone(),
+        runs,
+    })
+}
+
+impl BundleReport {
+    pub fn table(&self) -> Table {
+        let mut t = Table::new(&[
+            "setting",
+            "dt_s",
+            "substeps",
+            "window_s",
+            "wall_s_per_sim_s",
+            "com_max_m",
+            "ends_max_m",
+            "kinetic_J",
+            "elastic_J",
+            "potential_J",
+            "dissipated_J",
+        ]);
+        for r in &self.runs {
+            let mut row = vec![
+                r.setting.name.clone(),
+                r.setting.dt.clone(),
+                r.steps.to_string(),
+                num(r.window),
+                num(r.wall_per_second),
+                num(r.com_max),
+                num(r.ends_max),
+            ];
+            row.extend(r.energy.iter().map(|&e| num(e)));
+            t.push(row);
+        }
+        t
+    }
+
+    /// Centre-of-mass (circles) and yarn-end (squares) error against wall
+    /// time per simulated second, log-log, one colour per setting.
+    pub fn plot(&self) -> String {
+        let mut series = Vec::new();
+        for (i, r) in self.runs.iter().enumerate() {
+            for (what, err, marker) in [
+                ("com", r.com_max, Marker::Circle),
+                ("ends", r.ends_max, Marker::Square),
+            ] {
+                series.push(Series {
+                    name: format!("{} {what}", r.setting.name),
+                    points: vec![(r.wall_per_second, err)],
+                    markers_only: true,
+                    color: Some(i),
+                    marker,
+                    ..Default::default()
+                });
+            }
+        }
+        LinePlot {
+            title: "yarn-reference: error against cost".into(),
+            x_label: "wall s per simulated s".into(),
+            y_label: "largest distance from the reference, m".into(),
+            log_x: true,
+            log_y: true,
+            series,
+        }
+        .to_svg()
+    }
+
+    pub fn to_text(&self) -> String {
+        let mut s = format!(
+            "Reference bundle ({SCENE}) against the reference trajectory \"{}\": \
+             largest distance over the frames (1/60 s) of the centre of mass \
+             and of the 24 yarn ends, over each run's window.\n",
+            self.reference
+        );
+        for r in self.runs.iter().filter(|r| r.setting.duration < 0.999) {
+            s += &format!(
+                "{} ran and was compared over {} s only.\n",
+                r.setting.name,
+                num(r.setting.duration)
+            );
+        }
+        s + &self.table().to_text()
+    }
+
+    /// `bundle_precision.csv`, `bundle_precision.svg`, `bundle_precision.txt`.
+    pub fn files(&self) -> Vec<(String, String)> {
+        vec![
+            ("bundle_precision.csv".into(), self.table().to_csv()),
+            ("bundle_precision.svg".into(), self.plot()),
+            ("bundle_precision.txt".into(), self.to_text()),
+        ]
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The shipped reference parses: 61 frames (1 s at 1/60 s), 24 ends,
+    /// and its comparison with itself is exactly 0.
+    #[test]
+    fn shipped_reference_parses_and_matches_itself() {
+        let r = Trajectory::from_csv(SHIPPED_REFERENCE).unwrap();
+        assert_eq!(r.frames.len(), 61);
+        assert_eq!(r.frames[0].ends.len(), 24);
+        let s = setting("flip", "per-yarn", "2.5e-6", "explicit", 1.0);
+        let m = measure(&s, &r, &r).unwrap();
+        assert_eq!((m.com_max, m.ends_max), (0.0, 0.0));
+    }
+}
