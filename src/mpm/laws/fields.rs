@@ -67,7 +67,6 @@
 //! about two cells above it, whatever the grid). Nodes are visited in the order of the
 //! window's blocks, one at a time: the same bits for any thread count.
 
-use crate::math::bspline::Stencil;
 use crate::math::Vec2;
 use crate::mpm::laws::contact::coulomb;
 use crate::mpm::laws::pins::{self, PinEntry};
@@ -259,19 +258,23 @@ impl Fields {
 
     /// With a diameter, each field's mass-weighted particle position at its
     /// nodes (see the module documentation) from the particles `p` as the
-    /// scatter placed them (call after [`Fields::grids_with_masses`]'s grid
-    /// update and before [`Fields::contact`]); nothing without one. Serial,
-    /// in particle order: the same bits for any thread count.
+    /// scatter placed them, over the stencils it stored (call after
+    /// [`Fields::grids_with_masses`]'s grid update and before
+    /// [`Fields::contact`]); nothing without one. Serial, in particle
+    /// order: the same bits for any thread count.
     pub fn locate(&mut self, p: &Particles) {
         if self.diameter.is_none() {
             return;
         }
-        let items = p.vert.x.iter().zip(&p.vert.m).zip(&self.vert_field);
-        let quads = p.quad.x.iter().zip(&p.quad.m).zip(&self.quad_field);
-        for ((x, &m), &k) in items.chain(quads) {
+        let items = (p.vert.x.iter().zip(&p.vert.stencil))
+            .zip(&p.vert.m)
+            .zip(&self.vert_field);
+        let quads = (p.quad.x.iter().zip(&p.quad.stencil))
+            .zip(&p.quad.m)
+            .zip(&self.quad_field);
+        for (((x, st), &m), &k) in items.chain(quads) {
             let node = &mut self.masses[k as usize];
             let geom = node.geom.expect("located after the grid update");
-            let st = Stencil::new(*x, geom.inv_dx);
             let (bi, bj) = (st.base[0] as usize, st.base[1] as usize);
             let rows = geom.stencil_rows_mut(&mut node.centre, bi, bj);
             for (i, row) in rows.into_iter().enumerate() {
@@ -435,13 +438,6 @@ fn centre(c: &[f64; 3]) -> Vec2 {
     }
 }
 
-/// Storage index of the first node of window block `b` (its row `r` starts
-/// `r * geom.stride` after it).
-#[inline]
-fn block_first_node(geom: &GridGeom, b: usize) -> usize {
-    (b / geom.nbj) * BLOCK * geom.stride + (b % geom.nbj) * BLOCK
-}
-
 /// The contact normal from the held to the free field at a node, from the
 /// two fields' mass gradients `gf`, `gh`: along the held field's gradient
 /// (perpendicular to the held yarn's surface, so that the free yarn's own
@@ -501,7 +497,8 @@ impl NodeMasses {
             self.geom = Some(geom);
         } else {
             for &b in &self.written {
-                let first = block_first_node(&geom, b as usize);
+                let (i, j) = geom.block_origin(b as usize);
+                let first = geom.index(i, j);
                 let bits = std::mem::take(&mut self.mask[b as usize]);
                 // whole rows of the block (one line each): the other nodes
                 // of a row hold 0 already
