@@ -100,12 +100,17 @@ impl YarnScene {
         })
     }
 
+    /// How many yarns the scene makes: every `[[yarns]]` entry's copies.
+    pub fn yarn_count(&self) -> u64 {
+        self.yarns.iter().map(|y| y.count as u64).sum()
+    }
+
     /// Whether yarns touch each other through the contact of velocity
     /// fields: two or more yarns, each free yarn in a field of its own
     /// (`[contact] fields = "per-yarn"`) or a held yarn next to free ones.
     pub fn yarn_contact(&self) -> bool {
-        let yarns: u64 = self.yarns.iter().map(|y| y.count as u64).sum();
-        yarns >= 2 && (self.contact.fields == FieldPartition::PerYarn || !self.pins.is_empty())
+        self.yarn_count() >= 2
+            && (self.contact.fields == FieldPartition::PerYarn || !self.pins.is_empty())
     }
 
     /// A warning for a scene whose yarn diameter does not act between its
@@ -115,8 +120,7 @@ impl YarnScene {
     /// a held yarn, `d` from it).
     pub fn diameter_warning(&self) -> Option<String> {
         let d = self.material.diameter()?;
-        let yarns: u64 = self.yarns.iter().map(|y| y.count as u64).sum();
-        (yarns >= 2 && self.contact.fields == FieldPartition::HeldFree).then(|| {
+        (self.yarn_count() >= 2 && self.contact.fields == FieldPartition::HeldFree).then(|| {
             format!(
                 "material.diameter = {d} m does not act between free yarns: with [contact] \
                  fields = \"held-free\" (the default) they share one velocity field; set \
@@ -265,7 +269,7 @@ impl YarnScene {
             line: text.and_then(|t| key_line(t, header, key)),
             message: format!("{message} ({why}; integrator = \"implicit\" runs this scene)"),
         };
-        let yarns: u64 = self.yarns.iter().map(|y| y.count as u64).sum();
+        let yarns = self.yarn_count();
         if yarns != 1 {
             return Err(SceneError::Invalid {
                 field: "yarns".into(),
