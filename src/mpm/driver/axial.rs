@@ -43,7 +43,7 @@ use crate::math::Vec2;
 use crate::mpm::implicit_vertex::newton::{self, Constraint};
 use crate::mpm::implicit_vertex::{Rod, Settings};
 use crate::mpm::laws::constitutive::YarnEnergy;
-use crate::mpm::laws::contact::{clamp_to_grid, project_out};
+use crate::mpm::laws::contact::{grid_bounds, keep_in_domain};
 use crate::mpm::machinery::particles::Particles;
 
 /// 100 times the round-off of the step's gradient `|g|_{M^-1}` (the
@@ -191,7 +191,7 @@ impl YarnSim {
                 .fold(Vec2::zeros(), |a, &i| a + impulse[i] / dt);
         }
         let geom = self.grid.geom;
-        let (lo, hi) = (geom.dx, (geom.n as f64 - 2.0) * geom.dx);
+        let bounds = grid_bounds(geom.dx, geom.n);
         let obstacles = super::substep::active_obstacles(&self.obstacles, self.passes());
         let vert = &mut self.particles.vert;
         for ((x, v), d) in vert.x.iter_mut().zip(vert.v.iter_mut()).zip(&dv) {
@@ -199,10 +199,7 @@ impl YarnSim {
             *v += d;
             // as the gather leaves a vertex: outside the obstacles, inside
             // the grid
-            for o in obstacles {
-                project_out(o, x, v);
-            }
-            clamp_to_grid(x, v, lo, hi);
+            keep_in_domain(obstacles, bounds, x, v);
         }
         let st = &mut self.implicit_stats;
         st.substeps += 1;

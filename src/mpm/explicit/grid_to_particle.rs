@@ -12,7 +12,7 @@ use crate::math::qr::Qr2;
 use crate::math::{cross, Mat2, Vec2};
 use crate::mpm::laws::constitutive::frames::{update_frames, Frames};
 use crate::mpm::laws::constitutive::{frame_gradient_qr, YarnEnergy};
-use crate::mpm::laws::contact::{clamp_to_grid, project_out};
+use crate::mpm::laws::contact::{grid_bounds, keep_in_domain};
 use crate::mpm::machinery::grid::GridGeom;
 use crate::mpm::machinery::grid::{Grid, DVX, DVY, VX, VY};
 use crate::mpm::machinery::particles::Quads;
@@ -260,7 +260,7 @@ multiversion! {
         let geom = g.grid.geom;
         let (dt, ratio) = (g.dt, g.transfer.flip_ratio());
         let avx = kernels() >= Kernels::Avx2;
-        let (lo, hi) = (geom.dx, (geom.n as f64 - 2.0) * geom.dx);
+        let bounds = grid_bounds(geom.dx, geom.n);
         let mut bad = None;
         let it = xs.iter_mut().zip(vs).zip(cs).zip(sts).zip(spins);
         for (k, ((((x, v), c), st), spin)) in it.enumerate() {
@@ -272,10 +272,7 @@ multiversion! {
                 // for APIC, which moves with its own velocity)
                 *spin = dt * cross(nv, *v);
             }
-            for o in g.obstacles {
-                project_out(o, x, v);
-            }
-            clamp_to_grid(x, v, lo, hi);
+            keep_in_domain(g.obstacles, bounds, x, v);
             // Finite, and no faster than one cell per substep (CFL): beyond
             // that the transfer is meaningless and the run is diverging.
             let ok = x.x.is_finite()

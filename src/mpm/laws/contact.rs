@@ -331,6 +331,24 @@ pub fn wall_velocity(
     }
 }
 
+/// Where a particle ends its move of a substep: outside every obstacle of
+/// `obstacles` ([`project_out`]), then where its stencil stays on the grid
+/// ([`clamp_to_grid`] within [`grid_bounds`]).
+#[inline(always)]
+pub fn keep_in_domain(obstacles: &[Obstacle], bounds: (f64, f64), x: &mut Vec2, v: &mut Vec2) {
+    for o in obstacles {
+        project_out(o, x, v);
+    }
+    clamp_to_grid(x, v, bounds.0, bounds.1);
+}
+
+/// The coordinates, m, a particle of the grid `n` cells of `dx` a side may
+/// take on each axis (its 3x3 stencil stays on the grid): `[dx, (n - 2) dx]`.
+#[inline]
+pub fn grid_bounds(dx: f64, n: usize) -> (f64, f64) {
+    (dx, (n as f64 - 2.0) * dx)
+}
+
 /// Keeps a particle where its stencil stays on the grid; removes outward velocity there.
 #[inline(always)]
 pub fn clamp_to_grid(x: &mut Vec2, v: &mut Vec2, lo: f64, hi: f64) {
