@@ -7,7 +7,7 @@
 //! cargo run --release -p yarnsim-evidence --example peers_chain -- chain VERTICES GRID DT [INTEGRATOR [K]]
 //! cargo run --release -p yarnsim-evidence --example peers_chain -- cantilever VERTICES [INTEGRATOR [DT]]
 //! cargo run --release -p yarnsim-evidence --example peers_chain -- capstan R L1 L2 MU [INTEGRATOR [DT]]
-//! cargo run --release -p yarnsim-evidence --example peers_chain -- bundle DURATION [INTEGRATOR [DT]]
+//! cargo run --release -p yarnsim-evidence --example peers_chain -- bundle DURATION [INTEGRATOR [DT [OPTION...]]]
 //! ```
 //!
 //! `INTEGRATOR` is `explicit` (the default) or `implicit` (the scene's
@@ -35,7 +35,11 @@
 //!   wall time of two windows (`windows`: `[start, end, wall]` for the fall
 //!   and landing up to 0.2 s, then the rest) and the seconds spent in each
 //!   pass of the substep (`passes`, from `YarnSim::timings`); `DT`
-//!   replaces the substep (4e-5): a number or `auto`.
+//!   replaces the substep (4e-5): a number or `auto`. `frames`: every
+//!   yarn's vertices every 0.1 s (not timed). `OPTION`s: `preset=NAME`
+//!   (the `[material]` table replaced by `preset = NAME`, return mapping
+//!   on), `apic`, `per-yarn` (`[contact] fields`), `axial-implicit`
+//!   (`[time] axial = "implicit"`).
 //!
 //! Threads: set `RAYON_NUM_THREADS=1` for one thread. The whole run steps
 //! on one rayon worker (`yarnsim::pool::on_pool`), as a program's own
@@ -45,8 +49,9 @@
 
 use std::time::Instant;
 
-use yarnsim::scene::builtin::yarn_reference;
-use yarnsim::scene::{Integrator, StepSize, YarnScene};
+use yarnsim::scene::{
+    builtin_toml, Axial, FieldPartition, Integrator, StepSize, TransferScheme, YarnScene,
+};
 use yarnsim::testing::{
     cantilever_setup, cantilever_toml, capstan_toml, capstan_vertices, hanging_chain_period,
     hanging_chain_toml, two_periods_about_mean, ZeroCrossings, CAPSTAN_PURE_STRING,
@@ -237,8 +242,64 @@ fn capstan(r: f64, l1: f64, l2: f64, mu: f64, integ: Integrator, dt: Option<f64>
 /// (`BUNDLE["landed"]` in `tools/bench/peers/oracles.py`).
 const BUNDLE_LANDED: f64 = 0.2;
 
-fn bundle(duration: f64, integ: Integrator, dt: Option<&str>) -> String {
-    let mut s = yarn_reference();
+/// Every yarn's vertex positions as a JSON array of `[x, y]` arrays.
+fn yarn_positions(sim: &YarnSim) -> String {
+    let p = sim.particles();
+    let r = &p.yarn_vertices;
+    (0..sim.num_yarns())
+        .map(|y| {
+            let xs = p.vert.x[r[y]..r[y + 1]]
+                .iter()
+                .map(|x| format!("[{:.6}, {:.6}]", x.x, x.y))
+                .collect::<Vec<_>>()
+                .join(", ");
+            format!("[{xs}]")
+        })
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+/// The reference bundle's scene with the trailing `OPTION`s of `bundle`:
+/// `preset=NAME` replaces the `[material]` table by the preset (return
+/// mapping on, as in the reference), `apic` the transfer, `per-yarn` the
+/// contact fields, `axial-implicit` the fibre stretch solve.
+fn bundle_scene(options: &[String]) -> YarnScene {
+    let mut text = builtin_toml("yarn-reference")
+        .expect("built-in yarn-reference")
+        .to_string();
+    for o in options {
+        if let Some(name) = o.strip_prefix("preset=") {
+            let start = text.find("[material]").expect("[material] table");
+            let end = start + text[start..].find("\n\n").expect("end of [material]");
+            text.replace_range(
+                start..end,
+                &format!("[material]\npreset = {}\nplasticity = true", json_str(name)),
+            );
+        }
+    }
+    let mut s = scene(&text);
+    for o in options {
+        match o.as_str() {
+            "apic" => s.transfer.scheme = TransferScheme::Apic,
+            "per-yarn" => s.contact.fields = FieldPartition::PerYarn,
+            "axial-implicit" => s.time.axial = Axial::Implicit,
+            x if x.starts_with("preset=") => {}
+            x => {
+                eprintln!(
+                    "OPTION must be preset=NAME, apic, per-yarn or axial-implicit, got {x:?}"
+                );
+                std::process::exit(2)
+            }
+        }
+    }
+    s
+}
+
+/// Seconds between the bundle's recorded frames (every yarn's vertices).
+const BUNDLE_FRAME: f64 = 0.1;
+
+fn bundle(duration: f64, integ: Integrator, dt: Option<&str>, options: &[String]) -> String {
+    let mut s = bundle_scene(options);
     match dt {
         None => {}
         Some("auto") => s.time.dt = StepSize::Auto,
@@ -253,6 +314,8 @@ fn bundle(duration: f64, integ: Integrator, dt: Option<&str>) -> String {
     let mut sim = sim_with(s, integ);
     // wall time per window: the fall and landing (to 0.2 s), then the rest
     let mut windows = Vec::new();
+    let mut frames = vec![format!("[{}, [{}]]", sim.time(), yarn_positions(&sim))];
+    let mut untimed = 0.0;
     let t0 = Instant::now();
     let mut ok = true;
     for end in [BUNDLE_LANDED.min(duration), duration] {
@@ -261,30 +324,27 @@ fn bundle(duration: f64, integ: Integrator, dt: Option<&str>) -> String {
         }
         let w0 = Instant::now();
         let start = sim.time();
-        ok = sim.advance(end - start).is_ok();
+        // to each recorded frame in turn (the frames are not timed)
+        let mut frame_wall = 0.0;
+        while ok && sim.time() < end - 1e-12 {
+            let next = ((sim.time() / BUNDLE_FRAME + 1e-6).floor() + 1.0) * BUNDLE_FRAME;
+            ok = sim.advance(next.min(end) - sim.time()).is_ok();
+            let f0 = Instant::now();
+            frames.push(format!("[{}, [{}]]", sim.time(), yarn_positions(&sim)));
+            frame_wall += f0.elapsed().as_secs_f64();
+        }
         windows.push(format!(
             "[{start}, {}, {}]",
             sim.time(),
-            w0.elapsed().as_secs_f64()
+            w0.elapsed().as_secs_f64() - frame_wall
         ));
+        untimed += frame_wall;
         if !ok {
             break;
         }
     }
-    let wall = t0.elapsed().as_secs_f64();
-    let p = sim.particles();
-    let r = &p.yarn_vertices;
-    let yarns = (0..sim.num_yarns())
-        .map(|y| {
-            let xs = p.vert.x[r[y]..r[y + 1]]
-                .iter()
-                .map(|x| format!("[{:.6}, {:.6}]", x.x, x.y))
-                .collect::<Vec<_>>()
-                .join(", ");
-            format!("[{xs}]")
-        })
-        .collect::<Vec<_>>()
-        .join(", ");
+    let wall = t0.elapsed().as_secs_f64() - untimed;
+    let yarns = yarn_positions(&sim);
     let d = sim.diagnostics();
     // where a substep's time goes (the passes of `YarnSim::timings`)
     let passes = sim
@@ -296,12 +356,14 @@ fn bundle(duration: f64, integ: Integrator, dt: Option<&str>) -> String {
         .join(", ");
     format!(
         "{{\"ok\": {ok}, \"wall_s\": {wall}, \"sim_s\": {}, \"steps\": {}, \"min_stretch\": {}, \
-         \"max_stretch\": {}, \"windows\": [{}], \"passes\": [{passes}], \"yarns\": [{yarns}]}}",
+         \"max_stretch\": {}, \"windows\": [{}], \"passes\": [{passes}], \"yarns\": [{yarns}], \
+         \"frames\": [{}]}}",
         sim.time(),
         sim.steps(),
         d.min_stretch,
         d.max_stretch,
-        windows.join(", ")
+        windows.join(", "),
+        frames.join(", ")
     )
 }
 
@@ -333,6 +395,7 @@ fn main() {
             arg(&args, 1, "DURATION"),
             integrator(&args, 2),
             args.get(3).map(String::as_str),
+            args.get(4..).unwrap_or(&[]),
         ),
         _ => {
             eprintln!("usage: peers_chain chain|cantilever|capstan|bundle ARGS (see the source)");

@@ -285,6 +285,112 @@ def bundle(rows, duration, implicit_duration, rounds):
                           "see README"))
 
 
+def _bundle_row(case, tool, integ, setting, rs, extra=""):
+    """One bundle row from the runs `rs` of one set-up (the median by wall
+    time, its windows and what the bundle did at the end)."""
+    res = sorted(rs, key=lambda x: x["wall_s"])[len(rs) // 2]
+    note = _windows(res) + "; " + bundle_metrics.describe(res["yarns"], O.BUNDLE)
+    if "out_of_plane" in res:
+        note += f"; out-of-plane drift {res['out_of_plane']:.2e} m"
+    if res.get("steps"):
+        note += f"; {res['steps']} substeps (mean dt {res['sim_s'] / res['steps']:.3g} s)"
+    if "solver_iterations" in res:
+        note += "; CG iterations per step: " + ", ".join(
+            f"{a:g}-{b:.2g} s {it:.1f}" for (a, b, _), it in
+            zip(res["windows"], res["solver_iterations"]))
+    note += extra
+    print(f"  {case} {tool:10s} {setting}: median {res['wall_s']:.2f} s wall for "
+          f"{res['sim_s']:.3f} s over {len(rs)} round(s); {note}", flush=True)
+    return res, dict(tool=tool, integrator=integ, case=case, setting=setting, error=float("nan"),
+                     wall_s_per_sim_s=res["wall_s"] / res["sim_s"], wall_s=res["wall_s"],
+                     sim_s=res["sim_s"], rounds=len(rs), ok=all(x["ok"] for x in rs), note=note)
+
+
+def _distances(a, b):
+    """Text: how far the frames of two bundle runs lie apart."""
+    d = bundle_metrics.frame_distances(a["frames"], b["frames"])
+    if d is None:
+        return "no common frames"
+    return (f"centre of mass {100 * d['com_end']:.2f} cm apart at the end, at most "
+            f"{100 * d['com_max']:.2f} cm; ends {100 * d['ends_end']:.1f} cm at the end, at most "
+            f"{100 * d['ends_max']:.1f} cm ({d['frames']} frames, every 0.1 s)")
+
+
+def nylon(rows, rounds):
+    raise NotImplementedError
+
+
+def bundle_preset(rows, duration, rounds, presets):
+    """The reference bundle with one real yarn of each preset per yarn:
+    yarnsim with the preset (`[time] axial = "implicit"`, APIC, dt auto)
+    against MuJoCo's planar armature set-up with the preset's mass per
+    rope (tex 1e-6 kg/m, see `oracles.preset_bundle`), its EI and yarn
+    friction; the two alternate over `rounds` rounds (order swapped each
+    round)."""
+    for name in presets:
+        mat = O.preset_bundle(name)
+        runs = [
+            ("yarnsim", "mpm-axial-implicit", f"{name}, 256^2, APIC, axial implicit, dt auto",
+             lambda: yarnsim_rope.bundle(duration, "explicit", "auto", options=(
+                 f"preset={name}", "apic", "axial-implicit"))),
+            ("mujoco", "discrete", f"{name}, CG, dt 1e-3, r 1.9 mm, planar (y armature "
+             f"{1e6 * mat['rho']:.3g})", lambda: mujoco_rope.bundle(duration, material=mat)),
+        ]
+        results = [[], []]
+        for r in range(rounds):
+            for i in ([0, 1] if r % 2 == 0 else [1, 0]):
+                res = runs[i][3]()
+                results[i].append(res)
+                print(f"  round {r + 1} bundle-preset {runs[i][0]:10s} {name}: "
+                      f"{res['wall_s']:.2f} s wall for {res['sim_s']:.3f} s; {_windows(res)}",
+                      flush=True)
+        ys, row_y = _bundle_row("bundle-preset", *runs[0][:3], results[0])
+        mj, row_m = _bundle_row("bundle-preset", *runs[1][:3], results[1])
+        ratio = row_m["wall_s_per_sim_s"] / row_y["wall_s_per_sim_s"]
+        d = _distances(ys, mj)
+        row_m["note"] += f"; against yarnsim: {d}; MuJoCo / yarnsim wall {ratio:.3g}"
+        print(f"  bundle-preset {name}: MuJoCo / yarnsim {ratio:.3g}; {d}", flush=True)
+        rows += [row_y, row_m]
+
+
+def bundle_converged(rows, duration):
+    """MuJoCo's bundle (planar armature set-up) at dt 1e-3 and 5e-4 and
+    yarnsim's converged setting (per-yarn FLIP at dt 1e-5), each run once
+    (MuJoCo, yarnsim, MuJoCo): MuJoCo's own convergence (the two steps'
+    frames apart) and the tools' centres of mass apart."""
+    mj1 = mujoco_rope.bundle(duration, dt=1e-3)
+    ys = yarnsim_rope.bundle(duration, "explicit", "1e-5", options=("per-yarn",))
+    mj2 = mujoco_rope.bundle(duration, dt=5e-4)
+    _, row_y = _bundle_row("bundle-converged", "yarnsim", "mpm-explicit",
+                           "256^2, per-yarn FLIP, dt 1e-5", [ys])
+    own = _distances(mj1, mj2)
+    _, row_1 = _bundle_row("bundle-converged", "mujoco", "discrete",
+                           "CG, dt 1e-3, r 1.9 mm, planar (y armature 1e6)", [mj1],
+                           f"; against yarnsim: {_distances(ys, mj1)}")
+    _, row_2 = _bundle_row("bundle-converged", "mujoco", "discrete",
+                           "CG, dt 5e-4, r 1.9 mm, planar (y armature 1e6)", [mj2],
+                           f"; against dt 1e-3: {own}; against yarnsim: {_distances(ys, mj2)}")
+    print(f"  bundle-converged MuJoCo dt 1e-3 against 5e-4: {own}", flush=True)
+    rows += [row_y, row_1, row_2]
+
+
+def merge_rows(path, rows):
+    """The rows of `path` whose case is not among `rows`' cases, then
+    `rows` (a partial run replaces its own cases only)."""
+    cases = {r["case"] for r in rows}
+    old = []
+    if os.path.exists(path):
+        with open(path) as f:
+            for r in csv.DictReader(f):
+                if r["case"] in cases:
+                    continue
+                for k in ("error", "wall_s_per_sim_s", "wall_vs_yarnsim", "wall_s", "sim_s"):
+                    r[k] = float(r[k])
+                r["ok"] = r["ok"] == "True"
+                old.append(r)
+    return old + rows
+
+
 TITLE = "Rod peers against analytic oracles, one thread ({date})"
 
 
@@ -311,6 +417,11 @@ def main():
     ap.add_argument("--bundle-implicit-duration", type=float, default=0.2,
                     help="simulated seconds of the grid implicit bundle run (~500 s/s)")
     ap.add_argument("--replot", metavar="CSV", help="only redraw the SVG next to CSV")
+    ap.add_argument("--only", metavar="GROUPS",
+                    help="comma-separated: bundle-preset, bundle-converged, nylon; runs only "
+                         "those and replaces their cases' rows in the existing CSV")
+    ap.add_argument("--presets", default="polyester-167dtex,nylon66-mono-0.30mm",
+                    help="the presets of bundle-preset (comma-separated)")
     a = ap.parse_args()
     if a.replot:
         replot(a.replot)
@@ -326,6 +437,20 @@ def main():
     if not a.quick:
         elastica_rope.capstan_slides(8, 0.3, load=1e-3, hold=1e-3)
     t_start = time.time()
+    if a.only:
+        groups = a.only.split(",")
+        unknown = set(groups) - {"bundle-preset", "bundle-converged", "nylon"}
+        if unknown:
+            ap.error(f"--only: unknown group(s) {', '.join(sorted(unknown))}")
+        rows = []
+        if "nylon" in groups:
+            nylon(rows, rounds)
+        if "bundle-preset" in groups:
+            bundle_preset(rows, a.bundle_duration, rounds, a.presets.split(","))
+        if "bundle-converged" in groups:
+            bundle_converged(rows, a.bundle_duration)
+        write(out, stem, merge_rows(os.path.join(out, stem + ".csv"), rows), t_start)
+        return
     cs = cases(a.quick)
     res = interleave(cs, rounds)
     rows = []
@@ -356,10 +481,17 @@ def main():
                     f"{n} elements, dt 1e-3", "discrete", rows)
         if not a.skip_bundle:
             bundle(rows, a.bundle_duration, a.bundle_implicit_duration, rounds)
-    # ratios against yarnsim's first explicit setting of the same case (same run)
+    write(out, stem, rows, t_start)
+
+
+def write(out, stem, rows, t_start):
+    """The CSV and the SVG of `rows`, with `wall_vs_yarnsim`."""
+    # ratios against yarnsim's first explicit setting of the same case (same
+    # run), or its first row of the case where it has no explicit one
     for r in rows:
-        ref = next((x for x in rows if x["tool"] == "yarnsim" and x["integrator"] == "mpm-explicit"
-                    and x["case"] == r["case"]), None)
+        ours = [x for x in rows if x["tool"] == "yarnsim" and x["case"] == r["case"]]
+        ref = next((x for x in ours if x["integrator"] == "mpm-explicit"),
+                   ours[0] if ours else None)
         r["wall_vs_yarnsim"] = (r["wall_s_per_sim_s"] / ref["wall_s_per_sim_s"]
                                 if ref and ref["wall_s_per_sim_s"] > 0 else float("nan"))
     os.makedirs(out, exist_ok=True)

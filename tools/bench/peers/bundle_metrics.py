@@ -40,3 +40,33 @@ def describe(yarns, b):
     return (f"{m['touching']}/{len(yarns)} yarns within 1 cm of a cylinder; mean height "
             f"{m['mean_y']:.3f} m, lowest {m['min_y']:.3f} m; {m['crossings']} yarn-yarn "
             f"segment crossings; {pen}; stretch {m['stretch'][0]:.3f}..{m['stretch'][1]:.3f}")
+
+
+def centre_of_mass(yarns):
+    """The centre of mass of uniform polylines of equal mass per length and
+    equal rest lengths (each vertex the mass of its segment halves: the
+    ends half an interior vertex), as yarnsim's and MuJoCo's yarns are."""
+    w = np.ones(len(yarns[0]))
+    w[[0, -1]] = 0.5
+    return np.mean([np.average(y, axis=0, weights=w) for y in yarns], axis=0)
+
+
+def frame_distances(fa, fb):
+    """Between two runs' frames ([time, yarns] lists, matched by time
+    within 1e-6 s): the largest distance of the centres of mass and of
+    any yarn end (m) over the matched frames, and those at the last one;
+    the matched count."""
+    tb = {round(t, 6): ys for t, ys in fb}
+    com, ends, n = [], [], 0
+    for t, ya in fa:
+        yb = tb.get(round(t, 6))
+        if yb is None:
+            continue
+        n += 1
+        com.append(float(np.linalg.norm(centre_of_mass(ya) - centre_of_mass(yb))))
+        ends.append(max(float(np.linalg.norm(a[k] - b[k])) for a, b in zip(ya, yb)
+                        for k in (0, -1)))
+    if not n:
+        return None
+    return dict(com_max=max(com), ends_max=max(ends), com_end=com[-1], ends_end=ends[-1],
+                frames=n)

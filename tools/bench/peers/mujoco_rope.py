@@ -151,7 +151,8 @@ def capstan_slides(elements, dt, mu, radius=1e-3):
     return slid, time.perf_counter() - t0, d.time
 
 
-def bundle(duration, dt=1e-3, radius=0.0019, planar="armature", tolerance=1e-8):
+def bundle(duration, dt=1e-3, radius=0.0019, planar="armature", tolerance=1e-8, material=None,
+           frame=0.1):
     """The reference bundle: 12 ropes x 200 points falling onto three
     cylinders, rope-rope and rope-cylinder friction, floor and side walls,
     CG solver. Two ways to keep it in the x-z plane (free 3D drifts out):
@@ -163,8 +164,13 @@ def bundle(duration, dt=1e-3, radius=0.0019, planar="armature", tolerance=1e-8):
     took the most), the share of steps at the iteration cap and the mean
     contacts per step, the wall time per window (`windows`: [start, end,
     wall] for the fall and landing up to `BUNDLE["landed"]` s, then the
-    rest) and every rope's points in yarnsim's plane."""
-    b = O.BUNDLE
+    rest), every rope's points in yarnsim's plane at the end and every
+    `frame` s (`frames`: [time, ropes], not timed). `material` overrides
+    `rho` (kg/m per rope), `bending` (N m^2) and `yarn_friction` of
+    `BUNDLE` (a preset's yarn: `oracles.preset_bundle`); the armature of
+    the planar set-up scales with `rho` (1e6 kg at 1 kg/m), so the model is
+    the reference one with its masses scaled, as far as the masses enter."""
+    b = dict(O.BUNDLE, **(material or {}))
     n = b["vertices"] - 1
     seg = b["length"] / n
     young = 4.0 * b["bending"] / (math.pi * radius ** 4)
@@ -203,7 +209,7 @@ def bundle(duration, dt=1e-3, radius=0.0019, planar="armature", tolerance=1e-8):
     if planar == "armature":
         for j in range(m.njnt):
             if abs(m.jnt_axis[j][1]) > 0.5:
-                m.dof_armature[m.jnt_dofadr[j]] = 1e6
+                m.dof_armature[m.jnt_dofadr[j]] = 1e6 * b["rho"]
     _refresh(m)
     d = mujoco.MjData(m)
     windows = []
@@ -211,12 +217,22 @@ def bundle(duration, dt=1e-3, radius=0.0019, planar="armature", tolerance=1e-8):
     # is an island of its own until they touch) and contacts per step,
     # summed per window
     iters, contacts, steps, capped = [], [], [], []
+    mujoco.mj_forward(m, d)  # the positions of the first frame
+
+    def ropes():
+        x = d.flexvert_xpos
+        return [np.column_stack([x[a:a + k, 0], x[a:a + k, 2]]) for a, k in spans]
+
+    frames = [[0.0, ropes()]]
+    every = max(1, int(round(frame / dt)))
+    untimed = 0.0
     t0 = time.perf_counter()
     start = 0.0
     cap = int(m.opt.iterations)
     for end in sorted({min(b["landed"], duration), duration}):
         w0 = time.perf_counter()
         it = con = nsteps = at_cap = 0
+        w_untimed = 0.0
         for _ in range(int(round((end - start) / dt))):
             mujoco.mj_step(m, d)
             k = int(d.solver_niter[:max(1, min(d.nisland, len(d.solver_niter)))].max())
@@ -224,18 +240,23 @@ def bundle(duration, dt=1e-3, radius=0.0019, planar="armature", tolerance=1e-8):
             at_cap += k >= cap
             con += d.ncon
             nsteps += 1
-        windows.append([start, d.time, time.perf_counter() - w0])
+            if int(round(d.time / dt)) % every == 0:
+                f0 = time.perf_counter()
+                frames.append([d.time, ropes()])
+                w_untimed += time.perf_counter() - f0
+        windows.append([start, d.time, time.perf_counter() - w0 - w_untimed])
+        untimed += w_untimed
         iters.append(it)
         contacts.append(con)
         steps.append(nsteps)
         capped.append(at_cap)
         start = end
-    wall_s = time.perf_counter() - t0
+    wall_s = time.perf_counter() - t0 - untimed
     x = d.flexvert_xpos
-    yarns = [np.column_stack([x[a:a + k, 0], x[a:a + k, 2]]) for a, k in spans]
+    yarns = ropes()
     drift = float(np.max(np.abs(x[:, 1])))
     return dict(ok=bool(np.all(np.isfinite(x))) and d.time > 0.99 * duration, wall_s=wall_s,
-                sim_s=d.time, yarns=yarns, out_of_plane=drift, windows=windows,
+                sim_s=d.time, yarns=yarns, out_of_plane=drift, windows=windows, frames=frames,
                 solver_iterations=[i / max(n, 1) for i, n in zip(iters, steps)],
                 contacts=[c / max(n, 1) for c, n in zip(contacts, steps)],
                 at_cap=[c / max(n, 1) for c, n in zip(capped, steps)], iteration_cap=cap)

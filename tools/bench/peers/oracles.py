@@ -3,6 +3,7 @@
 Euler-Bernoulli cantilever and the heavy-rope capstan threshold."""
 
 import math
+import os
 
 J01 = 2.404825557695773  # first zero of J0
 
@@ -141,3 +142,29 @@ if __name__ == "__main__":
     print("chain period", chain_period())
     print("mu*(0.1, 0.1, 0.3) =", capstan_threshold(0.1, 0.1, 0.3))
     print("mu*(1e-4, 0.1, 0.3) =", capstan_threshold(1e-4, 0.1, 0.3), math.log(3) / math.pi)
+
+
+def preset(name):
+    """A yarn preset's tex (g/km), diameter (m), EA (N), EI (N m^2) and
+    friction on yarn and on solids, as `yarnsim materials` lists them (the
+    one table: `src/scene/yarn/presets.rs`)."""
+    import subprocess
+    root = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", "..", ".."))
+    out = subprocess.run([os.path.join(root, "target", "release", "yarnsim"), "materials"],
+                         check=True, capture_output=True, text=True).stdout
+    for line in out.splitlines():
+        f = line.split()
+        if f and f[0] == name:
+            return dict(tex=float(f[1]), diameter=float(f[2]) * 1e-3, ea=float(f[3]),
+                        ei=float(f[4]), friction=float(f[5]), friction_solid=float(f[6]))
+    raise KeyError(f"no preset {name!r} in `yarnsim materials`")
+
+
+def preset_bundle(name):
+    """The reference bundle's `BUNDLE` overrides for one real yarn of
+    preset `name` per rope: line density tex 1e-6 kg/m (yarnsim's
+    `density = tex 1e-6 / s` per metre of depth is 1 / s such yarns, so
+    one yarn is the sheet's mass times s), bending EI and the yarn-on-yarn
+    friction of the preset; the circles keep the scene's 0.3."""
+    p = preset(name)
+    return dict(rho=p["tex"] * 1e-6, bending=p["ei"], yarn_friction=p["friction"])

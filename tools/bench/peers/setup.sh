@@ -15,5 +15,5 @@ if ! "$venv/bin/python" -c "$want" 2>/dev/null; then
     "$venv/bin/pip" install --quiet mujoco==4.0.0 pyelastica==1.0.0 numpy
     "$venv/bin/python" -c "$want"
 fi
-(cd "$here/../../.." && cargo build --release -p yarnsim-evidence --example peers_chain)
+(cd "$here/../../.." && cargo build --workspace --release --example peers_chain)
 echo "peers ready: $venv/bin/python $here/bench.py"

@@ -14,7 +14,7 @@ BIN = os.path.join(ROOT, "target", "release", "examples", "peers_chain")
 
 
 def build():
-    subprocess.run(["cargo", "build", "--release", "-p", "yarnsim-evidence", "--example", "peers_chain"], cwd=ROOT,
+    subprocess.run(["cargo", "build", "--workspace", "--release", "--example", "peers_chain"], cwd=ROOT,
                    check=True)
 
 
@@ -72,12 +72,16 @@ def capstan_slides(r, l1, l2, mu, integrator="explicit", dt=None):
     return res.get("slid", False) or not res["ok"], res["wall_s"], res["sim_s"]
 
 
-def bundle(duration, integrator="explicit", dt=None, threads=1):
+def bundle(duration, integrator="explicit", dt=None, threads=1, options=()):
     """The built-in `yarn-reference` for `duration` s; `dt` a number or
     "auto" (default: the scene's 4e-5); `windows` in the result: [start,
-    end, wall] for the fall and landing (to 0.2 s), then the rest."""
-    res = _refused(_run("bundle", duration, *_opt(integrator, dt), threads=threads))
+    end, wall] for the fall and landing (to 0.2 s), then the rest;
+    `frames`: [time, yarns] every 0.1 s. `options`: the example's
+    `preset=NAME`, `apic`, `per-yarn`, `axial-implicit` (they need `dt`)."""
+    args = _opt(integrator, dt) if not options else [integrator, dt or "4e-5", *options]
+    res = _refused(_run("bundle", duration, *args, threads=threads))
     if "yarns" in res:
         import numpy as np
         res["yarns"] = [np.array(y) for y in res["yarns"]]
+        res["frames"] = [[t, [np.array(y) for y in ys]] for t, ys in res.get("frames", [])]
     return res
