@@ -5,6 +5,7 @@
 //!
 //! ```text
 //! cargo run --release -p yarnsim-evidence --example peers_chain -- chain VERTICES GRID DT [INTEGRATOR [K]]
+//! cargo run --release -p yarnsim-evidence --example peers_chain -- chain-preset PRESET VERTICES GRID DT
 //! cargo run --release -p yarnsim-evidence --example peers_chain -- cantilever VERTICES [INTEGRATOR [DT]]
 //! cargo run --release -p yarnsim-evidence --example peers_chain -- capstan R L1 L2 MU [INTEGRATOR [DT]]
 //! cargo run --release -p yarnsim-evidence --example peers_chain -- bundle DURATION [INTEGRATOR [DT [OPTION...]]]
@@ -22,6 +23,9 @@
 //!   within the substep). `DT` is a TOML value (`1e-4` or `"auto"`); `K`
 //!   replaces the fibre stiffness (e.g. `2e5`: a nearly inextensible
 //!   rope, strain at the top 0.004 %).
+//! * `chain-preset`: the same chain as one yarn of `[material] preset =
+//!   PRESET` (its EA, EI, mass and cross-section), APIC, `[time] axial =
+//!   "implicit"`; `period` is to be compared with the hanging beam's.
 //! * `cantilever`: the Euler-Bernoulli cantilever of the oracle test
 //!   (L = 0.5 m, B = 1, rho = 1, 64^2, dt 5e-5, two vertices pinned), the tip
 //!   deflection averaged over two measured periods of the first mode;
@@ -125,6 +129,26 @@ fn chain(vertices: u32, grid: u32, dt: &str, integ: Integrator, k: Option<f64>) 
     if let Some(k) = k {
         s.material.k = k;
     }
+    chain_run(s, integ)
+}
+
+/// The hanging chain of [`chain`] as one real yarn: the `[material]` lines
+/// replaced by `preset = NAME` (its EA, EI, mass and cross-section, no
+/// return mapping), APIC and `[time] axial = "implicit"`. The `error` is
+/// against the string's oracle; the driver compares `period` with the
+/// hanging beam's (the bending shortens it).
+fn chain_preset(preset: &str, vertices: u32, grid: u32, dt: &str) -> String {
+    let text = hanging_chain_toml(vertices, grid, dt);
+    let material = "k = 2000.0\ngamma = 0.0\nyoungs_modulus = 0.0\nfriction = 0.0\nbending = 0.0\n";
+    assert!(text.contains(material), "the chain's [material] lines");
+    let mut s = scene(&text.replace(material, &format!("preset = {}\n", json_str(preset))));
+    s.transfer.scheme = TransferScheme::Apic;
+    s.time.axial = Axial::Implicit;
+    chain_run(s, Integrator::Explicit)
+}
+
+/// The chain's run: the period from the free end's zero crossings.
+fn chain_run(s: YarnScene, integ: Integrator) -> String {
     let mut sim = sim_with(s, integ);
     let duration = 3.4;
     let mut crossings = ZeroCrossings::new(sim.yarn_endpoints(0).1.x - 0.5);
@@ -377,6 +401,12 @@ fn main() {
             &arg::<String>(&args, 3, "DT"),
             integrator(&args, 4),
             opt(&args, 5, "K"),
+        ),
+        Some("chain-preset") => chain_preset(
+            &arg::<String>(&args, 1, "PRESET"),
+            arg(&args, 2, "VERTICES"),
+            arg(&args, 3, "GRID"),
+            &arg::<String>(&args, 4, "DT"),
         ),
         Some("cantilever") => cantilever(
             arg(&args, 1, "VERTICES"),

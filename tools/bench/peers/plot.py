@@ -8,9 +8,12 @@ COLORS = {"yarnsim": "#1f77b4", "mujoco": "#d62728", "pyelastica": "#2ca02c"}
 INTEGRATOR_COLORS = {("yarnsim", "mpm-implicit"): "#9467bd",
                      ("yarnsim", "mpm-implicit-k2e5"): "#ff7f0e",
                      ("yarnsim", "vertices-implicit"): "#8c564b",
-                     ("yarnsim", "vertices-midpoint"): "#e377c2"}
-DASH = {"chain": "", "cantilever": "6,3", "capstan": "2,2"}
-MARK = {"chain": "circle", "cantilever": "square", "capstan": "diamond"}
+                     ("yarnsim", "vertices-midpoint"): "#e377c2",
+                     ("yarnsim", "mpm-axial-implicit"): "#17becf"}
+# the single-yarn cases (the bundles have no oracle: not drawn)
+DASH = {"chain": "", "cantilever": "6,3", "capstan": "2,2", "chain-nylon": "10,3,2,3"}
+MARK = {"chain": "circle", "cantilever": "square", "capstan": "diamond",
+        "chain-nylon": "circle"}
 
 
 def _ticks(lo, hi):

@@ -50,6 +50,15 @@ def chain(vertices, grid, dt, integrator="explicit", k=None):
     return _refused(_run("chain", vertices, grid, dt, *_opt(integrator, k)))
 
 
+def chain_preset(preset, vertices, grid, dt, oracle):
+    """The hanging chain as one yarn of `preset` (APIC, `[time] axial =
+    "implicit"`): `error` against the period `oracle` (s)."""
+    res = _refused(_run("chain-preset", preset, vertices, grid, dt))
+    if "period" in res:
+        res["error"] = (res["period"] - oracle) / oracle
+    return res
+
+
 def cantilever(vertices, integrator="explicit", dt=None):
     return _refused(_run("cantilever", vertices, *_opt(integrator, dt)))
 
