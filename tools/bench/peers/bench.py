@@ -384,8 +384,11 @@ def bundle_preset(rows, duration, rounds, presets):
         ys, row_y = _bundle_row("bundle-preset", *runs[0][:3], results[0])
         mj, row_m = _bundle_row("bundle-preset", *runs[1][:3], results[1])
         ratio = row_m["wall_s_per_sim_s"] / row_y["wall_s_per_sim_s"]
+        per_round = ", ".join(f"{m['wall_s'] / y['wall_s']:.3g}"
+                              for y, m in zip(results[0], results[1]))
         d = _distances(ys, mj)
-        row_m["note"] += f"; against yarnsim: {d}; MuJoCo / yarnsim wall {ratio:.3g}"
+        row_m["note"] += (f"; against yarnsim: {d}; MuJoCo / yarnsim wall {ratio:.3g} (medians; "
+                          f"per round {per_round})")
         print(f"  bundle-preset {name}: MuJoCo / yarnsim {ratio:.3g}; {d}", flush=True)
         rows += [row_y, row_m]
 

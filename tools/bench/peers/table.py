@@ -8,9 +8,11 @@
 cantilever, capstan), the cheapest row of yarnsim's implicit integrators
 (the goal is theirs: every integrator but `mpm-explicit`) of the same case
 whose |error| is at or below the peer's (the capstan: the threshold
-bracket's midpoint), and the ratio of their wall times per simulated
-second; for the bundle (no oracle), every yarnsim row against every
-MuJoCo row over the same simulated time.
+bracket's midpoint; `chain-nylon`: yarnsim's only rows, the grid with the
+axial solve), and the ratio of their wall times per simulated second;
+for the bundles (no oracle; `bundle`, `bundle-preset` per preset,
+`bundle-converged`), every yarnsim row against every MuJoCo row over
+the same simulated time.
 """
 
 import csv
@@ -55,7 +57,7 @@ def at_peer_error(path):
     print("| case | peer at its error (wall s per simulated s) | yarnsim cheapest at or below "
           "that error | yarnsim / peer |")
     print("|---|---|---|---|")
-    for case in ("chain", "cantilever", "capstan"):
+    for case in ("chain", "cantilever", "capstan", "chain-nylon"):
         ours = [r for r in rows if r["tool"] == "yarnsim" and r["case"] == case
                 and r["integrator"] != "mpm-explicit" and math.isfinite(r["error"])]
         for p in (r for r in rows if r["tool"] != "yarnsim" and r["case"] == case):
@@ -69,15 +71,19 @@ def at_peer_error(path):
             print(f"| {case} | {name(p)}: {fmt(p['error'], True)}, {fmt(p['wall_s_per_sim_s'])} | "
                   f"{name(best)}: {fmt(best['error'], True)}, {fmt(best['wall_s_per_sim_s'])} | "
                   f"{best['wall_s_per_sim_s'] / p['wall_s_per_sim_s']:.3g} |")
-    ours = [r for r in rows if r["tool"] == "yarnsim" and r["case"] == "bundle"]
-    for p in (r for r in rows if r["tool"] == "mujoco" and r["case"] == "bundle"):
-        # only runs over the same simulated time (the grid implicit row
-        # covers the first 0.2 s only)
-        for r in (r for r in ours if abs(float(r["sim_s"]) - float(p["sim_s"]))
-                  <= 0.01 * float(p["sim_s"])):
-            ratio = r["wall_s_per_sim_s"] / p["wall_s_per_sim_s"]
-            print(f"| bundle | {name(p)}: {fmt(p['wall_s_per_sim_s'])} | {name(r)}: "
-                  f"{fmt(r['wall_s_per_sim_s'])} | {ratio:.3g} ({1 / ratio:.3g}x faster) |")
+    for case in ("bundle", "bundle-preset", "bundle-converged"):
+        ours = [r for r in rows if r["tool"] == "yarnsim" and r["case"] == case]
+        for p in (r for r in rows if r["tool"] == "mujoco" and r["case"] == case):
+            # only runs over the same simulated time (the grid implicit row
+            # covers the first 0.2 s only) and, with a preset, of the same
+            # preset (the setting's first word)
+            for r in (r for r in ours if abs(float(r["sim_s"]) - float(p["sim_s"]))
+                      <= 0.01 * float(p["sim_s"]) and (case != "bundle-preset" or
+                      r["setting"].split(",")[0] == p["setting"].split(",")[0])):
+                ratio = r["wall_s_per_sim_s"] / p["wall_s_per_sim_s"]
+                how = f"{1 / ratio:.3g}x faster" if ratio < 1 else f"{ratio:.3g}x slower"
+                print(f"| {case} | {name(p)}: {fmt(p['wall_s_per_sim_s'])} | {name(r)}: "
+                      f"{fmt(r['wall_s_per_sim_s'])} | {ratio:.3g} ({how}) |")
 
 
 if __name__ == "__main__":
