@@ -483,13 +483,16 @@ def main():
         if unknown:
             ap.error(f"--only: unknown group(s) {', '.join(sorted(unknown))}")
         rows = []
-        if "nylon" in groups:
-            nylon(rows, rounds)
-        if "bundle-preset" in groups:
-            bundle_preset(rows, a.bundle_duration, rounds, a.presets.split(","))
-        if "bundle-converged" in groups:
-            bundle_converged(rows, a.bundle_duration)
-        write(out, stem, merge_rows(os.path.join(out, stem + ".csv"), rows), t_start)
+        try:
+            if "nylon" in groups:
+                nylon(rows, rounds)
+            if "bundle-preset" in groups:
+                bundle_preset(rows, a.bundle_duration, rounds, a.presets.split(","))
+            if "bundle-converged" in groups:
+                bundle_converged(rows, a.bundle_duration)
+        finally:
+            # the rows of the groups that ran, also when a later one fails
+            write(out, stem, merge_rows(os.path.join(out, stem + ".csv"), rows), t_start)
         return
     cs = cases(a.quick)
     res = interleave(cs, rounds)
