@@ -530,8 +530,9 @@ def main():
 def write(out, stem, rows, t_start):
     """The CSV and the SVG of `rows`, with `wall_vs_yarnsim`."""
     # ratios against yarnsim's first explicit setting of the same case (same
-    # run), or its first row of the case where it has no explicit one
-    for r in rows:
+    # run), or its first row of the case where it has no explicit one; the
+    # rows kept from an earlier run (`merge_rows`) keep theirs
+    for r in (r for r in rows if "wall_vs_yarnsim" not in r):
         ours = [x for x in rows if x["tool"] == "yarnsim" and x["case"] == r["case"]]
         ref = next((x for x in ours if x["integrator"] == "mpm-explicit"),
                    ours[0] if ours else None)
