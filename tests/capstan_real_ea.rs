@@ -159,3 +159,47 @@ fn incline_with_a_preset_holds_below_and_slides_above_its_friction() {
         assert!(slid > 5e-3, "{name}: held ({slid:.3e} m) at 1.15 c_f");
     }
 }
+
+/// The capstan rows of `docs/performance/softened.md` at the measured EA:
+/// per preset, radius and drop (and laid on the bare circle, inside the
+/// grown one: drop `-d / 2`), the outcome at 1.4 and 0.7 mu* and the
+/// grid's normal force on the drum at the end of the hold (the normal
+/// impulse of its last substep over the substep) against the resting
+/// rope's, `pi w l1 + 2 w R` to `pi w l2 + 2 w R` (the tension over R
+/// along the arc, between the strands' weights, plus the weight's normal
+/// part); `--ignored --nocapture`.
+#[test]
+#[ignore = "measurement: cargo test --release --test capstan_real_ea -- --ignored --nocapture"]
+fn real_ea_table() {
+    for name in ["polyester-167dtex", "nylon66-mono-0.30mm"] {
+        let bare = -0.5 * preset(name).unwrap().diameter;
+        for (r, drop) in [
+            (0.1, bare),
+            (0.1, 0.0),
+            (0.1, 0.003),
+            (0.1, 0.01),
+            (0.05, 0.0),
+            (0.05, 0.003),
+            (0.05, 0.01),
+        ] {
+            let mut row = format!("| {name} | {r} | {:.2} |", drop * 1e3);
+            for factor in [1.4, 0.7] {
+                let mut sim = capstan_sim(name, r, drop, factor);
+                let (slid, rel) = capstan_slip(&mut sim, 0.1, 0.3, |_| {});
+                row += &format!(" {} ({rel:.2e}) |", if slid { "slid" } else { "held" });
+                if factor == 1.4 {
+                    let w = sim.gravity().norm() * preset(name).unwrap().tex * 1e-6
+                        / sim.scene().material.per_yarn().unwrap().spacing;
+                    let rest = |l: f64| std::f64::consts::PI * w * l + 2.0 * w * r;
+                    row += &format!(
+                        " {:.3e} ({:.3e} to {:.3e}) |",
+                        sim.obstacle_normal_impulse() / sim.dt(),
+                        rest(0.1),
+                        rest(0.3)
+                    );
+                }
+            }
+            eprintln!("{row}");
+        }
+    }
+}
