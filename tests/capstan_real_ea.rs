@@ -15,9 +15,8 @@
 
 mod common;
 
-use common::{capstan_slip, pin_end, preset_capstan_toml, scene, straight, yarns_and_pins_toml};
+use common::{capstan_slip, incline_yarns_toml, preset_capstan_toml, scene};
 use yarnsim::scene::presets::preset;
-use yarnsim::scene::YarnEnd;
 use yarnsim::YarnSim;
 
 /// The axial solve's `[time]` lines under `dt = "auto"`.
@@ -104,20 +103,8 @@ const SLIDE: f64 = 0.25;
 /// solve: the top yarn's downhill slip in [`SLIDE`] after it settled for
 /// [`SETTLE`].
 fn incline_slip(name: &str, theta: f64) -> f64 {
-    let res: u32 = std::env::var("RES")
-        .map(|s| s.parse().unwrap())
-        .unwrap_or(64);
-    let dx = 1.0 / res as f64;
-    let bed_n = (0.8 / (0.5 * dx)).round() as u32 + 1;
-    let top_n = (0.3 / (0.5 * dx)).round() as u32 + 1;
-    let y = 0.4 + dx;
-    let yarns = yarns_and_pins_toml(
-        &[
-            straight([0.1, 0.4], [0.9, 0.4], bed_n),
-            straight([0.3, y], [0.6, y], top_n),
-        ],
-        &[pin_end(0, YarnEnd::Start, bed_n)],
-    );
+    let res = 64;
+    let yarns = incline_yarns_toml(res);
     let gravity = [G * theta.sin(), -G * theta.cos()];
     let text = format!(
         "gravity = [{}, {}]\n[grid]\nresolution = {res}\n[time]\n{AXIAL}\n[transfer]\n\

@@ -447,6 +447,23 @@ pub fn preset_capstan_toml(name: &str, r: f64, drop: f64, factor: f64) -> String
     .replace("dt = 0.0001\n", "dt = \"auto\"\n")
 }
 
+/// The `[[yarns]]` and `[[pins]]` of the incline of `yarn_friction.rs` on
+/// `res`^2: a bed yarn of 0.8 m along x at y = 0.4, all vertices pinned,
+/// and a free yarn of 0.3 m one cell above it, both at dx / 2 spacing.
+pub fn incline_yarns_toml(res: u32) -> String {
+    let dx = 1.0 / res as f64;
+    let bed_n = (0.8 / (0.5 * dx)).round() as u32 + 1;
+    let top_n = (0.3 / (0.5 * dx)).round() as u32 + 1;
+    let y = 0.4 + dx;
+    yarns_and_pins_toml(
+        &[
+            straight([0.1, 0.4], [0.9, 0.4], bed_n),
+            straight([0.3, y], [0.6, y], top_n),
+        ],
+        &[pin_end(0, YarnEnd::Start, bed_n)],
+    )
+}
+
 /// Time the capstan runs load before the slip is measured: the yarn starts
 /// unstretched at rest, and until the tension wave has loaded it (a few
 /// 0.01 s) the friction that needs that tension is missing and it slips
