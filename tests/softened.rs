@@ -8,10 +8,10 @@
 
 mod common;
 
-use common::{capstan_slip, capstan_threshold, scene, CAPSTAN_BUILTIN};
+use common::{capstan_slip, preset_capstan_toml, scene};
 use yarnsim::scene::material_units::per_yarn;
 use yarnsim::scene::presets::preset;
-use yarnsim::testing::{capstan_toml, hanging_preset_yarn_toml, CHAIN_GRAVITY, CHAIN_LENGTH};
+use yarnsim::testing::{hanging_preset_yarn_toml, CHAIN_GRAVITY, CHAIN_LENGTH};
 use yarnsim::YarnSim;
 
 /// The axial solve's lines: `[time] axial = "implicit"` under APIC.
@@ -96,25 +96,14 @@ fn hanging_yarn_strain_scales_as_one_over_ea_and_its_pin_force_does_not() {
 }
 
 /// The preset `name` at EA / `soften` on the heavy-rope capstan of
-/// [`capstan_toml`] (R 0.1, l1 0.1, l2 0.3, the circle's friction `factor`
-/// times the threshold mu*), with the axial solve at `dt = "auto"`: whether
-/// it slid and the largest relative end displacement ([`capstan_slip`]).
+/// [`preset_capstan_toml`] (R 0.1, l1 0.1, l2 0.3, laid on the circle, the
+/// circle's friction `factor` times the threshold mu*), with the axial
+/// solve at `dt = "auto"`: whether it slid and the largest relative end
+/// displacement ([`capstan_slip`]).
 fn capstan(name: &str, soften: f64, factor: f64) -> (bool, f64) {
-    let (r, l1, l2) = (0.1, 0.1, 0.3);
-    let mu = factor * capstan_threshold(r, l1, l2);
-    let text = capstan_toml(r, l1, l2, mu, &CAPSTAN_BUILTIN);
-    let (a, b) = (
-        text.find("[material]\n").unwrap(),
-        text.find("[walls]").unwrap(),
-    );
-    let text = format!(
-        "{}[material]\npreset = \"{name}\"\nplasticity = true\n{}",
-        &text[..a],
-        &text[b..]
-    )
-    .replace("dt = 0.0001\n", "dt = \"auto\"\n");
+    let text = preset_capstan_toml(name, 0.1, 0.0, factor);
     let mut sim = YarnSim::new(&scene(&softened(&text, name, soften))).unwrap();
-    capstan_slip(&mut sim, l1, l2, |_| {})
+    capstan_slip(&mut sim, 0.1, 0.3, |_| {})
 }
 
 /// The measurement of `docs/performance/softened.md`: per preset and

@@ -21,8 +21,8 @@
 mod common;
 
 use common::{
-    friction_scene as yarn_scene_stepped, on_threads, pin_end, straight, with_diameter,
-    worst_momentum_balance, yarns_and_pins_toml,
+    friction_scene as yarn_scene_stepped, incline_yarns_toml, on_threads, pin_end, straight,
+    with_diameter, worst_momentum_balance, yarns_and_pins_toml,
 };
 use yarnsim::scene::{TransferScheme, YarnEnd};
 use yarnsim::YarnSim;
@@ -55,17 +55,7 @@ fn incline_stepped(
     d: Option<f64>,
 ) -> YarnSim {
     let res = 128;
-    let dx = 1.0 / res as f64;
-    let bed_n = (0.8 / (0.5 * dx)).round() as u32 + 1;
-    let top_n = (0.3 / (0.5 * dx)).round() as u32 + 1;
-    let y = 0.4 + dx;
-    let yarns = yarns_and_pins_toml(
-        &[
-            straight([0.1, 0.4], [0.9, 0.4], bed_n),
-            straight([0.3, y], [0.6, y], top_n),
-        ],
-        &[pin_end(0, YarnEnd::Start, bed_n)],
-    );
+    let yarns = incline_yarns_toml(res);
     let gravity = [G * theta.sin(), -G * theta.cos()];
     let s = yarn_scene_stepped(gravity, res, scheme, c_f, &yarns, time);
     YarnSim::new(&with_diameter(s, d)).unwrap()

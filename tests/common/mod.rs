@@ -420,6 +420,50 @@ pub const CAPSTAN_BUILTIN_256: Capstan = Capstan {
     ..CAPSTAN_BUILTIN
 };
 
+/// The heavy-rope capstan of [`yarnsim::testing::capstan_drop_toml`]
+/// (R `r`, l1 0.1, l2 0.3, the circle's friction `factor` times the
+/// threshold mu*, [`CAPSTAN_BUILTIN`]'s grid and g) with the yarn of the
+/// preset `name` (`EI = 0`: the oracle's rope is flexible; plasticity on)
+/// at `dt = "auto"`, its centre line `d / 2 + drop` from the circle: on
+/// the circle that contact sees, grown by half the preset's diameter `d`,
+/// or `drop` above it. Laid on the bare circle instead, the yarn starts
+/// inside the grown one, and its first step out of it stretches the
+/// wrapped arc by `d / (2 R)`, at a real `EA` a tension thousands of times
+/// the strands' weight (`docs/performance/softened.md`).
+pub fn preset_capstan_toml(name: &str, r: f64, drop: f64, factor: f64) -> String {
+    let (l1, l2) = (0.1, 0.3);
+    let mu = factor * capstan_threshold(r, l1, l2);
+    let lay = 0.5 * yarnsim::scene::presets::preset(name).unwrap().diameter;
+    let text = yarnsim::testing::capstan_drop_toml(r, l1, l2, mu, lay + drop, &CAPSTAN_BUILTIN);
+    let (a, b) = (
+        text.find("[material]\n").unwrap(),
+        text.find("[walls]").unwrap(),
+    );
+    format!(
+        "{}[material]\npreset = \"{name}\"\nEI = 0.0\nplasticity = true\n{}",
+        &text[..a],
+        &text[b..]
+    )
+    .replace("dt = 0.0001\n", "dt = \"auto\"\n")
+}
+
+/// The `[[yarns]]` and `[[pins]]` of the incline of `yarn_friction.rs` on
+/// `res`^2: a bed yarn of 0.8 m along x at y = 0.4, all vertices pinned,
+/// and a free yarn of 0.3 m one cell above it, both at dx / 2 spacing.
+pub fn incline_yarns_toml(res: u32) -> String {
+    let dx = 1.0 / res as f64;
+    let bed_n = (0.8 / (0.5 * dx)).round() as u32 + 1;
+    let top_n = (0.3 / (0.5 * dx)).round() as u32 + 1;
+    let y = 0.4 + dx;
+    yarns_and_pins_toml(
+        &[
+            straight([0.1, 0.4], [0.9, 0.4], bed_n),
+            straight([0.3, y], [0.6, y], top_n),
+        ],
+        &[pin_end(0, YarnEnd::Start, bed_n)],
+    )
+}
+
 /// Time the capstan runs load before the slip is measured: the yarn starts
 /// unstretched at rest, and until the tension wave has loaded it (a few
 /// 0.01 s) the friction that needs that tension is missing and it slips

@@ -348,6 +348,14 @@ impl YarnSim {
     pub fn pin_reactions(&self) -> &[Vec2] {
         &self.pin_reactions
     }
+    /// The normal impulse (N s per m of depth) the obstacles' contact law
+    /// of the grid update delivered over the last substep, summed over the
+    /// contact nodes of the grid (the impulse that bounds the obstacle
+    /// friction, [`crate::mpm::laws::contact`]); divided by the substep,
+    /// the total normal force on the obstacles.
+    pub fn obstacle_normal_impulse(&self) -> f64 {
+        self.grid.contacts.iter().flatten().map(|c| c.impulse).sum()
+    }
 
     /// Sets the target of the `motion = "input"` pin `pin` (index in
     /// `[[pins]]` order) from now on: its first vertex at
