@@ -212,3 +212,30 @@ fn a_diameter_with_shared_fields_warns() {
     );
     assert_eq!(scene(256, None, Start::Laid, true).diameter_warning(), None);
 }
+
+/// A yarn laid on the bare circle starts inside the circle that contact
+/// sees (grown by d / 2): the scene warns, naming the obstacle and the
+/// radius to lay it at; laid at R + d / 2 (and without a diameter) it
+/// does not.
+#[test]
+fn a_yarn_laid_inside_half_its_diameter_warns() {
+    let d = yarnsim::scene::presets::preset("polyester-167dtex")
+        .unwrap()
+        .diameter;
+    let on = |drop: f64| {
+        let text = common::preset_capstan_toml("polyester-167dtex", 0.1, drop, 1.4);
+        yarnsim::scene::YarnScene::from_toml_str(&text).unwrap()
+    };
+    let w = on(-0.5 * d).start_gap_warning().expect("a warning");
+    assert!(
+        w.contains("obstacle 0") && w.contains("material.diameter / 2") && w.contains("0.10008"),
+        "{w}"
+    );
+    assert_eq!(on(-0.5 * d).warnings(), vec![w]);
+    assert_eq!(on(0.0).start_gap_warning(), None);
+    assert_eq!(on(0.0).warnings(), Vec::<String>::new());
+    assert_eq!(
+        scene(256, None, Start::Laid, true).start_gap_warning(),
+        None
+    );
+}

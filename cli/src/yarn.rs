@@ -49,7 +49,7 @@ pub struct YarnFlags<'a> {
 pub fn start(scene: &YarnScene, flags: YarnFlags) -> Result<YarnSim, CliError> {
     refuse_massspring_flags(flags)?;
     let sim = YarnSim::new(scene)?;
-    if let Some(warning) = scene.diameter_warning() {
+    for warning in scene.warnings() {
         eprintln!("warning: {warning}");
     }
     if let Some(dt) = scene.time.dt.fixed() {

@@ -248,3 +248,57 @@ fn scene_parameter_refuses_devices_directories_and_huge_files() {
     assert_eq!(set_scene(&f, "missing.toml"), fmi2Error);
     f.assert_error_contains("missing.toml");
 }
+
+/// A yarn of the `nylon66-mono-0.30mm` preset (d 0.3 mm) laid on a circle
+/// of radius 0.1 m at `radius` from its center (a half circle of 41
+/// vertices), no bending, dt "auto".
+fn laid_nylon(radius: f64) -> yarnsim::scene::YarnScene {
+    let points: Vec<String> = (0..=40)
+        .map(|k| {
+            let a = std::f64::consts::PI * k as f64 / 40.0;
+            format!("[{}, {}]", 0.5 + radius * a.cos(), 0.5 + radius * a.sin())
+        })
+        .collect();
+    let text = format!(
+        "kind = \"yarn\"\ngravity = [0.0, -9.8]\n[grid]\nresolution = 64\n[time]\n\
+         dt = \"auto\"\naxial = \"implicit\"\n[transfer]\nscheme = \"apic\"\n\
+         [material]\npreset = \"nylon66-mono-0.30mm\"\nEI = 0.0\n\
+         [[obstacles]]\ncenter = [0.5, 0.5]\nradius = 0.1\n\
+         [[yarns]]\npoints = [{}]\nvertices = 41\n",
+        points.join(", ")
+    );
+    yarnsim::scene::YarnScene::from_toml_str(&text).unwrap()
+}
+
+/// fmi2ExitInitializationMode warns when a yarn starts closer to an
+/// obstacle than half its diameter (contact keeps the centre line d / 2
+/// off the surface and its first substep would push the yarn out,
+/// stretching it): the line names the obstacle, `material.diameter` and
+/// the radius to lay it at; laid at R + d / 2 it does not warn.
+#[test]
+fn a_yarn_laid_inside_its_diameter_warns_at_initialization() {
+    let d = 0.3e-3;
+    let f = Fmu::new(&laid_nylon(0.1));
+    assert_eq!(f.init_warned(), fmi2Warning);
+    let line = f
+        .lines()
+        .into_iter()
+        .find(|l| l.0 == fmi2Warning)
+        .expect("a warning line");
+    assert_eq!(line.1, "logStatusWarning");
+    for what in [
+        "fmi2ExitInitializationMode",
+        "obstacle 0",
+        "material.diameter / 2 = 0.00015 m",
+        "half of",
+        "radius 0.10015 m",
+    ] {
+        assert!(line.2.contains(what), "{what}: {}", line.2);
+    }
+    // a warning is not an error: the instance steps
+    assert_eq!(f.do_step(0.0, 1e-3), fmi2OK);
+
+    let f = Fmu::new(&laid_nylon(0.1 + 0.5 * d));
+    assert_eq!(f.init_warned(), fmi2OK, "{:?}", f.lines());
+    assert!(!f.lines().iter().any(|l| l.0 == fmi2Warning));
+}

@@ -420,6 +420,14 @@ impl Instance {
                 self.model.physics.dt()
             ),
         );
+        let warnings = self.model.physics.warnings();
+        for w in &warnings {
+            self.log(
+                Status::Warning,
+                LOG_WARNING,
+                &format!("{}: {w}", self.op_name(Operation::ExitInitializationMode)),
+            );
+        }
         let dt = self.model.physics.dt();
         if let Some(bound) = self.model.physics.stable_dt().filter(|&b| dt > b) {
             self.log(
@@ -435,7 +443,11 @@ impl Instance {
             );
             return Ok(Status::Warning);
         }
-        Ok(Status::Ok)
+        Ok(if warnings.is_empty() {
+            Status::Ok
+        } else {
+            Status::Warning
+        })
     }
 
     pub fn terminate(&mut self) -> Res {

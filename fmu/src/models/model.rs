@@ -119,6 +119,13 @@ pub trait FmuModel: fmt::Debug + Send {
     fn dt(&self) -> f64;
     /// The library's stability bound on the substep in s (`None`: none).
     fn stable_dt(&self) -> Option<f64>;
+    /// What the scene does that likely is not meant (the library's scene
+    /// warnings: a yarn diameter under shared fields, a yarn laid closer
+    /// than its radius to an obstacle); logged at the end of
+    /// initialisation with a warning status.
+    fn warnings(&self) -> Vec<String> {
+        Vec::new()
+    }
     /// Rebuilds the simulation from the scene and the parameters; it must
     /// have `count` output objects.
     fn rebuild(&mut self, count: usize) -> ModelResult;

@@ -308,6 +308,19 @@ impl Fmu {
         }
     }
 
+    /// Setup at 0, enter and exit initialization, which may warn (a scene
+    /// warning, `YarnScene::warnings`); returns the exit status.
+    pub fn init_warned(&self) -> fmi2Status {
+        assert_eq!(self.setup(0.0, None), fmi2OK);
+        // SAFETY: `self.c` came from `fmi2Instantiate` and lives until its `Fmu` drops.
+        unsafe {
+            assert_eq!(fmi2EnterInitializationMode(self.c), fmi2OK);
+            let status = fmi2ExitInitializationMode(self.c);
+            assert!(status <= fmi2Warning, "{status}: {:?}", self.lines());
+            status
+        }
+    }
+
     pub fn set_real(&self, vr: &[u32], v: &[f64]) -> fmi2Status {
         assert_eq!(vr.len(), v.len());
         // SAFETY: `self.c` came from `fmi2Instantiate` and lives until its `Fmu` drops; every

@@ -104,6 +104,56 @@ pub fn check_yarns_clear_of_obstacles(
     Ok(())
 }
 
+/// A warning when a yarn starts closer to an obstacle's surface than
+/// `material.diameter / 2` (`d`: the diameter in m): contact keeps a yarn's
+/// centre line `d / 2` off every obstacle (`docs/obstacle-contact.md`, "Yarn
+/// diameter"), so the first substep pushes such a vertex out, which
+/// stretches a yarn laid on the bare surface by about `d / (2 R)` (at a
+/// real yarn's EA a tension far above its weight: the capstan of
+/// `tests/capstan_real_ea.rs` sprang off its drum laid so). Vertices
+/// only: a chord between two vertices on the grown circle cuts it by its
+/// sagitta, as every polyline on a circle does, and the vertices of a
+/// yarn given by `points` lie on the chords between those points, so only
+/// a vertex closer than `d / 4` warns (the capstan of
+/// `tests/capstan_real_ea.rs`, laid at `R + d / 2` by points about 5 mm
+/// apart, comes within 0.05 mm of a 0.16 mm yarn's surface, 0.6 d / 2,
+/// and holds). Names the deepest such vertex, its yarn and obstacle, and
+/// the radius to lay it at.
+pub fn start_gap_warning(scene: &YarnScene, d: f64) -> Option<String> {
+    // (depth inside the grown circle, yarn, entry, vertex, obstacle, gap)
+    let mut deepest: Option<(f64, usize, usize, usize, usize, f64)> = None;
+    let mut yarn = 0;
+    for (entry, spec) in scene.yarns.iter().enumerate() {
+        let Ok(curves) = spec.curves() else {
+            continue;
+        };
+        for curve in &curves {
+            for (j, o) in scene.obstacles.iter().enumerate() {
+                let c = Vec2::from(o.center);
+                for (vertex, &x) in curve.iter().enumerate() {
+                    let gap = (x - c).norm() - o.radius;
+                    let depth = 0.5 * d - gap;
+                    if gap < 0.25 * d && deepest.map_or(true, |b| depth > b.0) {
+                        deepest = Some((depth, yarn, entry, vertex, j, gap));
+                    }
+                }
+            }
+            yarn += 1;
+        }
+    }
+    let (_, yarn, entry, vertex, j, gap) = deepest?;
+    let r = scene.obstacles[j].radius;
+    Some(format!(
+        "yarn {yarn} (`yarns[{entry}]`) starts with vertex {vertex} {} m from the surface of \
+         obstacle {j}, less than half of material.diameter / 2 = {} m, where contact holds the \
+         centre line: the first substep pushes the yarn out and stretches it; lay it at radius \
+         {} m from the obstacle's center (radius + d / 2)",
+        short_to(gap, 6),
+        short_to(0.5 * d, 6),
+        short_to(r + 0.5 * d, 6)
+    ))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

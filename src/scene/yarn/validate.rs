@@ -129,6 +129,22 @@ impl YarnScene {
         })
     }
 
+    /// A yarn that starts within `material.diameter / 2` of an obstacle's
+    /// surface ([`overlap::start_gap_warning`]); `None` without a diameter.
+    pub fn start_gap_warning(&self) -> Option<String> {
+        overlap::start_gap_warning(self, self.material.diameter()?)
+    }
+
+    /// The warnings of a scene that runs but likely not as meant
+    /// ([`YarnScene::diameter_warning`], [`YarnScene::start_gap_warning`]):
+    /// the CLI prints them, the FMU logs them when it is initialised.
+    pub fn warnings(&self) -> Vec<String> {
+        self.diameter_warning()
+            .into_iter()
+            .chain(self.start_gap_warning())
+            .collect()
+    }
+
     /// The grid interior a yarn must start in, in m: 1.5 cells inside the
     /// domain `[0, size]^2` on every side.
     fn grid_interior(&self) -> (f64, f64) {

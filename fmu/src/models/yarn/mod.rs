@@ -592,6 +592,9 @@ impl FmuModel for YarnModel {
     fn stable_dt(&self) -> Option<f64> {
         Some(self.sim.stable_dt())
     }
+    fn warnings(&self) -> Vec<String> {
+        self.sim.scene().warnings()
+    }
     fn adaptive(&self) -> bool {
         self.sim.is_auto()
     }
