@@ -133,7 +133,7 @@ pub fn start_gap_warning(scene: &YarnScene, d: f64) -> Option<String> {
                 for (vertex, &x) in curve.iter().enumerate() {
                     let gap = (x - c).norm() - o.radius;
                     let depth = 0.5 * d - gap;
-                    if gap < 0.25 * d && deepest.map_or(true, |b| depth > b.0) {
+                    if gap < 0.25 * d && deepest.is_none_or(|b| depth > b.0) {
                         deepest = Some((depth, yarn, entry, vertex, j, gap));
                     }
                 }
