@@ -13,12 +13,12 @@
 //! ```
 //! `YARNS`: that many of the reference's 12 yarns (the lowest ones).
 //! `OBSTACLE_FRICTION=MU` in the environment sets every circle's friction
-//! (0.3), `YARN_FRICTION=MU` the yarns' (`material.friction`, 0.05).
+//! (0.3), `YARN_FRICTION=MU` the yarns' (`material.friction`, 0.05),
+//! `FLIP_RATIO=R` the transfer's (`transfer.flip_ratio`, 1).
 
 use std::time::Instant;
 
-use yarnsim::scene::builtin::yarn_reference;
-use yarnsim::scene::{Integrator, StepSize};
+use yarnsim::testing::implicit_pile_scene;
 use yarnsim::YarnSim;
 
 fn total(sim: &YarnSim) -> f64 {
@@ -30,10 +30,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let a: Vec<String> = std::env::args().collect();
     let k: f64 = a.get(1).map_or(Ok(1e3), |s| s.parse())?;
     let until: f64 = a.get(2).map_or(Ok(0.25), |s| s.parse())?;
-    let mut s = yarn_reference();
-    s.material.k = k;
-    s.time.integrator = Integrator::Implicit;
-    s.time.dt = StepSize::Auto;
+    let yarns = a.get(3).map_or(Ok(12), |n| n.parse())?;
+    let mut s = implicit_pile_scene(k, yarns);
     if let Ok(mu) = std::env::var("OBSTACLE_FRICTION") {
         let mu: f64 = mu.parse()?;
         s.obstacles.iter_mut().for_each(|o| o.friction = mu);
@@ -41,8 +39,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     if let Ok(mu) = std::env::var("YARN_FRICTION") {
         s.material.friction = mu.parse()?;
     }
-    if let Some(n) = a.get(3) {
-        s.yarns[0].count = n.parse()?;
+    if let Ok(r) = std::env::var("FLIP_RATIO") {
+        s.transfer.flip_ratio = r.parse()?;
     }
     let band = if k < 1e4 { 0.1 } else { 0.01 };
     let mut sim = YarnSim::new(&s)?;
