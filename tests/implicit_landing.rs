@@ -15,6 +15,12 @@
 //! the energy (friction acting after the solve) are cut back
 //! (`src/mpm/driver/cutback.rs`, `ENERGY_TOL`) or, where `dt / 32` does not
 //! suffice, kept and counted.
+//!
+//! The reference bundle's lowest four yarns (`implicit_pile_scene`) land
+//! on a circle and on one another: every substep taken keeps the energy
+//! and the stretch bands, and a substep that would leave the band of
+//! `material.k` at every cutback is refused with that reason
+//! (`cutback.rs`, stretch).
 
 use yarnsim::scene::YarnScene;
 use yarnsim::testing::{implicit_landing_scene, implicit_pile_scene};
