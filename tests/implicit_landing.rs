@@ -17,8 +17,8 @@
 //! suffice, kept and counted.
 //!
 //! The reference bundle's lowest four yarns (`implicit_pile_scene`) land
-//! on a circle and on one another: every substep taken keeps the energy
-//! and the stretch bands, and a substep that would leave the band of
+//! on a circle and on one another: after every outer substep the energy
+//! and the stretch keep their bounds, and a substep that would leave the band of
 //! `material.k` at every cutback is refused with that reason
 //! (`cutback.rs`, stretch).
 
@@ -222,7 +222,7 @@ fn very_stiff_yarns_land_without_friction_without_creating_energy() {
 const PILE_CONTACT: f64 = 0.114;
 
 /// Four yarns of the reference bundle ([`implicit_pile_scene`]) at fibre
-/// stiffness `k` and `dt = "auto"`, to `until`: on every substep taken
+/// stiffness `k` and `dt = "auto"`, to `until`: after every outer substep
 /// the total energy stays below its start plus [`ENERGY_BOUND`] of it and
 /// every stretch within `[lo, hi]` (the bands of the grid implicit
 /// integrator's requirement); the run gets past the first contact

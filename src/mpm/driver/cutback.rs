@@ -33,15 +33,15 @@
 //! work (the attractor on, or a pin that moves), nor on the first substep
 //! of a new, loaded or edited state.
 //!
-//! **Stretch.** Under the same conditions a substep is also undone when
-//! it takes a segment's stretch `|x_r - x_l| / l0` out of the band
-//! `1 +- w` that the scene's fibre stiffness implies ([`stretch_band`]:
+//! **Stretch.** Under the same conditions and `dt = "auto"` a substep is
+//! also undone when it takes a segment's stretch `|x_r - x_l| / l0` out
+//! of the band `1 +- w` that the scene's fibre stiffness implies ([`stretch_band`]:
 //! the strain `v / c` of a yarn stopped from [`IMPACT_SPEED`], `c =
 //! sqrt(k / rho)` its fibre wave speed, at least [`STRETCH_FLOOR`]), or
 //! further out than the farthest segment at its start. At the deepest
-//! cutback such a substep is refused under `dt = "auto"`
-//! ([`SimError::Refused`], naming `time.integrator` and `material.k`),
-//! kept and counted (`ImplicitStats::stretch_kept`) under a fixed `dt`.
+//! cutback such a substep is refused ([`SimError::Refused`], naming
+//! `time.integrator` and `material.k`). A fixed `dt` is not checked: its
+//! runs keep every bit.
 //!
 //! The explicit integrator has no cutback: there a failed substep is a
 //! diverging run, and the stable step is known before it.
@@ -221,7 +221,9 @@ impl YarnSim {
         if depth == MAX_CUTBACKS {
             let checked = self.energy_checked();
             let ledger = checked.then(|| Ledger::of(self));
-            let guard = checked.then(|| StretchGuard::of(self));
+            let guard = self
+                .stretch_checked(checked)
+                .then(|| StretchGuard::of(self));
             self.substep_once(dt).map_err(|e| self.exhausted(e, dt))?;
             if let Some(l) = ledger {
                 let (rise, tol) = l.rise(&Ledger::of(self));
@@ -234,12 +236,7 @@ impl YarnSim {
             }
             if let Some(g) = guard {
                 if let Err((i, s)) = g.check(self) {
-                    if self.scene.time.dt.fixed().is_none() {
-                        return Err(self.out_of_band(g, i, s, dt));
-                    }
-                    let st = &mut self.implicit_stats;
-                    st.stretch_kept += 1;
-                    st.max_stretch_kept = st.max_stretch_kept.max((s - 1.0).abs());
+                    return Err(self.out_of_band(g, i, s, dt));
                 }
             }
             return Ok(());
@@ -248,7 +245,9 @@ impl YarnSim {
             let keep = Checkpoint::of(self);
             let checked = self.energy_checked();
             let ledger = checked.then(|| Ledger::of(self));
-            let guard = checked.then(|| StretchGuard::of(self));
+            let guard = self
+                .stretch_checked(checked)
+                .then(|| StretchGuard::of(self));
             match self.substep_once(dt) {
                 Err(SimError::NonFinite { .. }) => {
                     keep.restore(self);
@@ -329,6 +328,13 @@ impl YarnSim {
         };
         self.failed = Some(e.clone());
         e
+    }
+
+    /// Whether this substep's stretch is checked ([`StretchGuard`]): where
+    /// its energy is (`energy_checked`), under `dt = "auto"` (a fixed `dt`
+    /// is the user's choice, run as it was).
+    fn stretch_checked(&self, energy_checked: bool) -> bool {
+        energy_checked && self.scene.time.dt.fixed().is_none()
     }
 
     /// The error of a substep that failed at the deepest cutback, saying so.

@@ -58,14 +58,8 @@ pub struct ImplicitStats {
     /// The largest energy rise so kept, J.
     pub max_energy_kept: f64,
     /// Of the undone ones, those refused for taking a segment's stretch
-    /// out of its band (`super::cutback::stretch_band`).
+    /// out of its band (`super::cutback::stretch_band`, `dt = "auto"`).
     pub stretch_cuts: u64,
-    /// Substeps of a fixed `dt` at the deepest cutback kept although a
-    /// segment's stretch left its band (under `dt = "auto"` they are
-    /// refused), and the largest such `|stretch - 1|`.
-    pub stretch_kept: u64,
-    /// The largest `|stretch - 1|` so kept.
-    pub max_stretch_kept: f64,
 }
 
 /// What [`implicit_grid`] writes.
