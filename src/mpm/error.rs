@@ -18,7 +18,7 @@ pub enum SimError {
     /// bound the scene's settings imply, at every step size it may try);
     /// the simulation refuses further steps until its state is restored.
     Refused {
-        /// The last substep taken.
+        /// The last substep taken (the state is the one after it).
         step: u64,
         /// Simulated time at its end, s.
         time: f64,

@@ -224,7 +224,15 @@ impl YarnSim {
             let guard = self
                 .stretch_checked(checked)
                 .then(|| StretchGuard::of(self));
+            let keep = guard.is_some().then(|| Checkpoint::of(self));
             self.substep_once(dt).map_err(|e| self.exhausted(e, dt))?;
+            if let (Some(g), Some(keep)) = (guard, keep) {
+                if let Err((i, s)) = g.check(self) {
+                    // refused: the state stays the one before it
+                    keep.restore(self);
+                    return Err(self.out_of_band(g, i, s, dt));
+                }
+            }
             if let Some(l) = ledger {
                 let (rise, tol) = l.rise(&Ledger::of(self));
                 if rise > tol {
@@ -232,11 +240,6 @@ impl YarnSim {
                     let st = &mut self.implicit_stats;
                     st.energy_kept += 1;
                     st.max_energy_kept = st.max_energy_kept.max(rise);
-                }
-            }
-            if let Some(g) = guard {
-                if let Err((i, s)) = g.check(self) {
-                    return Err(self.out_of_band(g, i, s, dt));
                 }
             }
             return Ok(());
@@ -308,7 +311,7 @@ impl YarnSim {
 
     /// The refusal of a substep that took segment `i`'s stretch to `s`,
     /// out of what `guard` allows, at the deepest cutback (`dt` long),
-    /// recorded in `failed`.
+    /// recorded in `failed`; the state is the one before it.
     fn out_of_band(&mut self, guard: StretchGuard, i: usize, s: f64, dt: f64) -> SimError {
         let m = &self.scene.material;
         let e = SimError::Refused {
