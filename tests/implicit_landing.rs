@@ -263,18 +263,20 @@ fn pile_keeps_its_band_or_refuses(k: f64, lo: f64, hi: f64, until: f64) -> Run {
     r
 }
 
-/// k 1e3: band [0.9, 1.1] (measured 2026-12-06: refused at t = 0.1269 s,
-/// 13 ms past the first contact, segment 28 at stretch 1.119 against the
-/// band [0.901, 1.099] of k 1e3 at dt / 32; until then at most -0.043 J
-/// against the start of 23.99 J, stretch 0.977-1.039).
+/// k 1e3: band [0.9, 1.1] (measured 2026-12-06: the substep ending
+/// t = 0.1269 s refused, 13 ms past the first contact, segment 28 at
+/// stretch 1.119 against the band [0.901, 1.099] of k 1e3 at dt / 32;
+/// until then at most -0.043 J against the start of 23.99 J, stretch
+/// 0.977-1.039).
 #[test]
 #[cfg_attr(debug_assertions, ignore = "release-mode test (cargo test --release)")]
 fn soft_pile_keeps_its_band_or_refuses() {
     pile_keeps_its_band_or_refuses(1e3, 0.9, 1.1, 0.16);
 }
 
-/// k 1e5: band [0.99, 1.01] (measured: refused at t = 0.1158 s, a segment
-/// at 1.038 at dt / 32; until then stretch 0.9933-1.0032).
+/// k 1e5: band [0.99, 1.01] (measured: the substep ending t = 0.1158 s
+/// refused, a segment at 1.038 at dt / 32; until then stretch
+/// 0.9933-1.0032).
 #[test]
 #[cfg_attr(debug_assertions, ignore = "release-mode test (cargo test --release)")]
 fn stiff_pile_keeps_its_band_or_refuses() {
