@@ -40,6 +40,7 @@ fn run_checked(sim: &mut YarnSim, steps: u64) -> Result<(), SimError> {
                     assert!(*step > start && *step <= start + steps, "{e}");
                     assert!(e.to_string().contains(&format!("step {step}")), "{e}");
                 }
+                SimError::Refused { what, .. } => panic!("unexpected refusal: {what}"),
                 SimError::BadInput(m) => panic!("unexpected bad input: {m}"),
             }
             assert_eq!(sim.failure(), Some(&e));

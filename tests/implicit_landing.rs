@@ -15,8 +15,15 @@
 //! the energy (friction acting after the solve) are cut back
 //! (`src/mpm/driver/cutback.rs`, `ENERGY_TOL`) or, where `dt / 32` does not
 //! suffice, kept and counted.
+//!
+//! The reference bundle's lowest four yarns (`implicit_pile_scene`) land
+//! on a circle and on one another: after every outer substep the energy
+//! and the stretch keep their bounds, and a substep that would leave the band of
+//! `material.k` at every cutback is refused with that reason
+//! (`cutback.rs`, stretch).
 
-use yarnsim::testing::implicit_landing_scene;
+use yarnsim::scene::YarnScene;
+use yarnsim::testing::{implicit_landing_scene, implicit_pile_scene};
 use yarnsim::{SimError, YarnSim};
 
 /// Simulated time of the runs, s: the landing at 0.111 s and 0.049 s of
@@ -45,7 +52,17 @@ fn total(sim: &YarnSim) -> f64 {
 }
 
 fn run(k: f64, mu: f64, until: f64) -> Run {
-    let mut sim = YarnSim::new(&implicit_landing_scene(k, mu)).unwrap();
+    run_scene(
+        &implicit_landing_scene(k, mu),
+        &format!("friction {mu}"),
+        until,
+    )
+}
+
+/// `scene` run outer substep by outer substep until `until` or an error.
+fn run_scene(scene: &YarnScene, what: &str, until: f64) -> Run {
+    let k = scene.material.k;
+    let mut sim = YarnSim::new(scene).unwrap();
     let e0 = total(&sim);
     let mut r = Run {
         e0,
@@ -75,7 +92,7 @@ fn run(k: f64, mu: f64, until: f64) -> Run {
     }
     let st = sim.implicit_stats();
     eprintln!(
-        "k {k:e}, friction {mu}: to t = {:.4} s, {} substeps, total energy {e0:.4} J at the \
+        "k {k:e}, {what}: to t = {:.4} s, {} substeps, total energy {e0:.4} J at the \
          start, at most {:+.3e} J above it; stretch {:.4}-{:.4}; kinetic energy {:.4} J at most, \
          {:.4} J at the end; {st:?}; {:?}",
         sim.time(),
@@ -196,4 +213,79 @@ fn very_stiff_yarns_with_friction_keep_and_count_what_the_cutbacks_do_not_remove
 #[cfg_attr(debug_assertions, ignore = "release-mode test (cargo test --release)")]
 fn very_stiff_yarns_land_without_friction_without_creating_energy() {
     very_stiff_on_circle(0.0);
+}
+
+/// Time of the first contact of [`implicit_pile_scene`]'s lowest yarn
+/// with the left circle, s: free fall `sqrt(2 h / g)` over its 0.07 m
+/// above the circle's top less the 1.5 cells (5.9 mm) its stencil reaches
+/// below it, h = 0.0641 m: 0.114 s.
+const PILE_CONTACT: f64 = 0.114;
+
+/// Four yarns of the reference bundle ([`implicit_pile_scene`]) at fibre
+/// stiffness `k` and `dt = "auto"`, to `until`: after every outer substep
+/// the total energy stays below its start plus [`ENERGY_BOUND`] of it and
+/// every stretch within `[lo, hi]` (the bands of the grid implicit
+/// integrator's requirement); the run gets past the first contact
+/// ([`PILE_CONTACT`]), and where it stops, the step control refused a
+/// substep, naming the settings and the reason, and refuses every later
+/// step.
+fn pile_keeps_its_band_or_refuses(k: f64, lo: f64, hi: f64, until: f64) -> Run {
+    let r = run_scene(
+        &implicit_pile_scene(k, 4),
+        "4 yarns of the reference",
+        until,
+    );
+    assert!(
+        r.max_rise <= ENERGY_BOUND * r.e0,
+        "energy rose {} over {}",
+        r.max_rise,
+        r.e0
+    );
+    assert!(r.lo >= lo && r.hi <= hi, "stretch {}-{}", r.lo, r.hi);
+    assert!(r.sim.time() > PILE_CONTACT, "stopped at {}", r.sim.time());
+    if let Some(e) = &r.error {
+        let SimError::Refused { what, .. } = e else {
+            panic!("{e}")
+        };
+        for part in [
+            "time.integrator",
+            "\"implicit\"",
+            "material.k",
+            "stretch",
+            "cutbacks",
+        ] {
+            assert!(what.contains(part), "no {part:?} in: {what}");
+        }
+        assert_eq!(r.sim.clone().step().unwrap_err(), *e);
+    } else {
+        assert!(r.sim.time() >= until - 1e-9, "{}", r.sim.time());
+    }
+    r
+}
+
+/// k 1e3: band [0.9, 1.1] (measured 2026-12-06: the substep ending
+/// t = 0.1269 s refused, 13 ms past the first contact, segment 28 at
+/// stretch 1.119 against the band [0.901, 1.099] of k 1e3 at dt / 32;
+/// until then at most -0.043 J against the start of 23.99 J, stretch
+/// 0.977-1.039).
+#[test]
+#[cfg_attr(debug_assertions, ignore = "release-mode test (cargo test --release)")]
+fn soft_pile_keeps_its_band_or_refuses() {
+    pile_keeps_its_band_or_refuses(1e3, 0.9, 1.1, 0.16);
+}
+
+/// k 1e5: band [0.99, 1.01] (measured: the substep ending t = 0.1158 s
+/// refused, a segment at 1.038 at dt / 32; until then stretch
+/// 0.9933-1.0032).
+#[test]
+#[cfg_attr(debug_assertions, ignore = "release-mode test (cargo test --release)")]
+fn stiff_pile_keeps_its_band_or_refuses() {
+    pile_keeps_its_band_or_refuses(1e5, 0.99, 1.01, 0.16);
+}
+
+/// k 1e7: band [0.99, 1.01], to 0.125 s, 12 ms past the first contact.
+#[test]
+#[cfg_attr(debug_assertions, ignore = "release-mode test (cargo test --release)")]
+fn very_stiff_pile_keeps_its_band_or_refuses() {
+    pile_keeps_its_band_or_refuses(1e7, 0.99, 1.01, 0.125);
 }

@@ -4,7 +4,8 @@
 //! fixed dt of 1e-3 (25x the explicit 4e-5) it drapes over the circles as
 //! the explicit step does, with no vertex inside a circle and no yarn-yarn
 //! segment crossing, and runs on past the moments where it used to stop;
-//! `dt = "auto"` under `dt_max = 1e-2` runs it too.
+//! `dt = "auto"` under `dt_max = 1e-2` runs it through the landing, where
+//! the stretch control may refuse it with its reason.
 //!
 //! The ends that whip down after the landing move faster than one cell
 //! per substep at dt 1e-3 (dx / dt = 3.906 m/s; the explicit run reaches
@@ -315,22 +316,44 @@ const AUTO_SAFETY: f64 = 0.5;
 /// 840 CG per substep, before the energy cutback, src/mpm/driver/cutback.rs;
 /// with it 3.93e-4 over 637 substeps, 6.70 Newton / 730 CG per substep:
 /// the landing's substeps that raise the total energy are halved).
+///
+/// Since the stretch control (src/mpm/driver/cutback.rs) a substep that
+/// takes a segment out of the band of `material.k` (0.901-1.099 at k 1e3)
+/// at every cutback is refused under `dt = "auto"`: the run may stop
+/// there, past the first contact (0.114 s), with that reason; up to it
+/// the same checks hold, without the drape's height.
 #[test]
 #[cfg_attr(debug_assertions, ignore = "release-mode test (cargo test --release)")]
 fn reference_bundle_runs_under_auto_dt_capped_at_1e_2() {
     let mut s = reference(Integrator::Implicit, 1e-2, true);
     s.time.safety = Some(AUTO_SAFETY);
-    let d = drape(&s, DRAPE_T);
+    let mut sim = YarnSim::new(&s).unwrap();
+    let t0 = Instant::now();
+    let end = sim.advance_to(DRAPE_T);
+    let d = measure(&sim, t0.elapsed().as_secs_f64());
     let dx = 1.0 / 256.0;
     print(
-        &format!("implicit auto, dt_max 1e-2, to {DRAPE_T} s"),
+        &format!(
+            "implicit auto, dt_max 1e-2, to {:.4} s ({end:?})",
+            sim.time()
+        ),
         &d,
         dx,
     );
     assert!(d.depth <= dx, "a vertex is {:.2} dx inside", d.depth / dx);
     assert_eq!(d.crossings, 0, "yarn-yarn segment crossings");
     assert!(d.mean_dt > 3e-4, "mean substep {:.3e}", d.mean_dt);
-    assert!(d.mean_y < 0.65 && d.touching >= 1, "{}", d.mean_y);
+    match end {
+        Ok(()) => assert!(d.mean_y < 0.65 && d.touching >= 1, "{}", d.mean_y),
+        Err(yarnsim::SimError::Refused { what, .. }) => {
+            assert!(sim.time() > 0.114, "refused at {}", sim.time());
+            assert!(
+                what.contains("material.k") && what.contains("time.integrator"),
+                "{what}"
+            );
+        }
+        Err(e) => panic!("{e}"),
+    }
 }
 
 /// The implicit reference scene after the landing has started (t = 0.13

@@ -33,6 +33,16 @@
 //! work (the attractor on, or a pin that moves), nor on the first substep
 //! of a new, loaded or edited state.
 //!
+//! **Stretch.** Under the same conditions and `dt = "auto"` a substep is
+//! also undone when it takes a segment's stretch `|x_r - x_l| / l0` out
+//! of the band `1 +- w` that the scene's fibre stiffness implies ([`stretch_band`]:
+//! the strain `v / c` of a yarn stopped from [`IMPACT_SPEED`], `c =
+//! sqrt(k / rho)` its fibre wave speed, at least [`STRETCH_FLOOR`]), or
+//! further out than the farthest segment at its start. At the deepest
+//! cutback such a substep is refused ([`SimError::Refused`], naming
+//! `time.integrator` and `material.k`). A fixed `dt` is not checked: its
+//! runs keep every bit.
+//!
 //! The explicit integrator has no cutback: there a failed substep is a
 //! diverging run, and the stable step is known before it.
 
@@ -49,6 +59,76 @@ pub const MAX_CUTBACKS: u32 = 5;
 /// of the kinetic and elastic energy at its start plus the work of gravity
 /// over it (see the module documentation).
 pub const ENERGY_TOL: f64 = 1e-2;
+
+/// Speed of the fall from which [`stretch_band`] takes its strain, m/s:
+/// `sqrt(2 g h)` for a drop of h = 0.5 m at g = 9.8 m/s^2 (half the
+/// built-in scenes' 1 m domain; the reference bundle lands at about
+/// 1.1 m/s).
+pub const IMPACT_SPEED: f64 = 3.13;
+
+/// The narrowest half-width of [`stretch_band`]: 1 % strain.
+pub const STRETCH_FLOOR: f64 = 1e-2;
+
+/// Half-width `w` of the band `[1 - w, 1 + w]` of segment stretch that a
+/// grid implicit substep must keep, for fibre stiffness `k` (N/m) and
+/// density `rho` (kg/m^2): the strain `v / c` of a bar stopped from speed
+/// `v` = [`IMPACT_SPEED`], `c = sqrt(k / rho)` its longitudinal wave speed
+/// (the elastic bar's impact, Timoshenko and Goodier, "Theory of
+/// Elasticity", 3rd ed. 1970, §154: the stress `rho c v` of the wave front),
+/// at least [`STRETCH_FLOOR`]. The reference material (rho 1): 0.099 at
+/// k 1e3, 0.0099 -> 0.01 at k 1e5 and above. Infinite at `k = 0`.
+pub fn stretch_band(k: f64, rho: f64) -> f64 {
+    if k > 0.0 {
+        (IMPACT_SPEED * (rho / k).sqrt()).max(STRETCH_FLOOR)
+    } else {
+        f64::INFINITY
+    }
+}
+
+/// The farthest any segment's stretch is from 1, and which segment.
+fn stretch_deviation(sim: &YarnSim) -> (f64, usize, f64) {
+    let mut out = (0.0, 0, 1.0);
+    for (i, s) in sim.stretches().into_iter().enumerate() {
+        if (s - 1.0).abs() > out.0 {
+            out = ((s - 1.0).abs(), i, s);
+        }
+    }
+    out
+}
+
+/// What a checked substep may do to the segments' stretch: leave it within
+/// the band `1 +- w` ([`stretch_band`]) or, where a segment started out of
+/// it, no farther out than the farthest did.
+#[derive(Clone, Copy, Debug)]
+struct StretchGuard {
+    w: f64,
+    allowed: f64,
+}
+
+impl StretchGuard {
+    fn of(sim: &YarnSim) -> Self {
+        let m = &sim.scene.material;
+        let w = stretch_band(m.k, m.density);
+        StretchGuard {
+            w,
+            allowed: w.max(stretch_deviation(sim).0),
+        }
+    }
+
+    /// `Err((segment, stretch))`: the segment farthest out of what the
+    /// guard allows after the substep.
+    fn check(&self, sim: &YarnSim) -> Result<(), (usize, f64)> {
+        if !self.allowed.is_finite() {
+            return Ok(());
+        }
+        let (d, i, s) = stretch_deviation(sim);
+        if d > self.allowed {
+            Err((i, s))
+        } else {
+            Ok(())
+        }
+    }
+}
 
 /// The energy ledger of a state: kinetic plus elastic, and gravitational
 /// potential, J.
@@ -139,8 +219,20 @@ impl YarnSim {
     /// and `depth < MAX_CUTBACKS`, as two halves.
     fn cut(&mut self, dt: f64, depth: u32) -> Result<(), SimError> {
         if depth == MAX_CUTBACKS {
-            let ledger = self.energy_checked().then(|| Ledger::of(self));
+            let checked = self.energy_checked();
+            let ledger = checked.then(|| Ledger::of(self));
+            let guard = self
+                .stretch_checked(checked)
+                .then(|| StretchGuard::of(self));
+            let keep = guard.is_some().then(|| Checkpoint::of(self));
             self.substep_once(dt).map_err(|e| self.exhausted(e, dt))?;
+            if let (Some(g), Some(keep)) = (guard, keep) {
+                if let Err((i, s)) = g.check(self) {
+                    // refused: the state stays the one before it
+                    keep.restore(self);
+                    return Err(self.out_of_band(g, i, s, dt));
+                }
+            }
             if let Some(l) = ledger {
                 let (rise, tol) = l.rise(&Ledger::of(self));
                 if rise > tol {
@@ -154,7 +246,11 @@ impl YarnSim {
         }
         if self.is_gridless() || dt <= self.advection_limit() {
             let keep = Checkpoint::of(self);
-            let ledger = self.energy_checked().then(|| Ledger::of(self));
+            let checked = self.energy_checked();
+            let ledger = checked.then(|| Ledger::of(self));
+            let guard = self
+                .stretch_checked(checked)
+                .then(|| StretchGuard::of(self));
             match self.substep_once(dt) {
                 Err(SimError::NonFinite { .. }) => {
                     keep.restore(self);
@@ -169,6 +265,11 @@ impl YarnSim {
                     keep.restore(self);
                     self.implicit_stats.undone += 1;
                     self.implicit_stats.energy_cuts += 1;
+                }
+                Ok(()) if guard.is_some_and(|g| g.check(self).is_err()) => {
+                    keep.restore(self);
+                    self.implicit_stats.undone += 1;
+                    self.implicit_stats.stretch_cuts += 1;
                 }
                 r => return r,
             }
@@ -208,6 +309,37 @@ impl YarnSim {
             && self.pins.iter().all(|p| still(&p.motion))
     }
 
+    /// The refusal of a substep that took segment `i`'s stretch to `s`,
+    /// out of what `guard` allows, at the deepest cutback (`dt` long),
+    /// recorded in `failed`; the state is the one before it.
+    fn out_of_band(&mut self, guard: StretchGuard, i: usize, s: f64, dt: f64) -> SimError {
+        let m = &self.scene.material;
+        let e = SimError::Refused {
+            step: self.steps,
+            time: self.time,
+            what: format!(
+                "under time.integrator = \"implicit\" with time.dt = \"auto\", segment {i}'s \
+                 stretch {s:.4} leaves the band [{:.4}, {:.4}] that material.k = {} (density {}) \
+                 allows (the strain of a yarn stopped from {IMPACT_SPEED} m/s, at least 1 %), even \
+                 after {MAX_CUTBACKS} cutbacks of the substep, to dt {dt:.3e} s; a softer \
+                 material.k, time.integrator = \"explicit\", or a fixed time.dt runs it",
+                1.0 - guard.w,
+                1.0 + guard.w,
+                m.k,
+                m.density,
+            ),
+        };
+        self.failed = Some(e.clone());
+        e
+    }
+
+    /// Whether this substep's stretch is checked ([`StretchGuard`]): where
+    /// its energy is (`energy_checked`), under `dt = "auto"` (a fixed `dt`
+    /// is the user's choice, run as it was).
+    fn stretch_checked(&self, energy_checked: bool) -> bool {
+        energy_checked && self.scene.time.dt.fixed().is_none()
+    }
+
     /// The error of a substep that failed at the deepest cutback, saying so.
     fn exhausted(&mut self, e: SimError, dt: f64) -> SimError {
         let e = match e {
@@ -222,5 +354,27 @@ impl YarnSim {
         };
         self.failed = Some(e.clone());
         e
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The band is the bar-impact strain `v / c`, `c = sqrt(k / rho)`:
+    /// for the reference material (rho 1 kg/m^2) at k 1e3, `c` = 31.62
+    /// m/s and `w` = 3.13 / 31.62 = 0.0990 (1e-12); at k 1e5 and 1e7 the
+    /// strain (0.0099, 0.00099) is below the 1 % floor; no band at k = 0;
+    /// a 4x denser yarn has half the wave speed and twice the strain.
+    #[test]
+    fn the_stretch_band_is_the_impact_strain_floored_at_one_percent() {
+        let c = (1e3f64 / 1.0).sqrt();
+        assert!((stretch_band(1e3, 1.0) - IMPACT_SPEED / c).abs() < 1e-12);
+        assert!((stretch_band(1e3, 1.0) - 0.0990).abs() < 1e-4);
+        assert_eq!(stretch_band(1e5, 1.0), STRETCH_FLOOR);
+        assert_eq!(stretch_band(1e7, 1.0), STRETCH_FLOOR);
+        assert!(stretch_band(0.0, 1.0).is_infinite());
+        let ratio = stretch_band(1e3, 4.0) / stretch_band(1e3, 1.0);
+        assert!((ratio - 2.0).abs() < 1e-12, "{ratio}");
     }
 }

@@ -57,6 +57,9 @@ pub struct ImplicitStats {
     pub energy_kept: u64,
     /// The largest energy rise so kept, J.
     pub max_energy_kept: f64,
+    /// Of the undone ones, those refused for taking a segment's stretch
+    /// out of its band (`super::cutback::stretch_band`, `dt = "auto"`).
+    pub stretch_cuts: u64,
 }
 
 /// What [`implicit_grid`] writes.

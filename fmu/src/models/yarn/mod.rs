@@ -181,7 +181,7 @@ impl YarnModel {
         weight: f64,
     ) -> Result<(), StepFailure> {
         step.map_err(|e| StepFailure {
-            terminal: matches!(e, SimError::NonFinite { .. }),
+            terminal: matches!(e, SimError::NonFinite { .. } | SimError::Refused { .. }),
             msg: e.to_string(),
         })?;
         // The yarn pulls on each pin with the opposite of the pin's force.
