@@ -29,47 +29,14 @@
 //! grid update: distance from the circle's surface (cells, negative
 //! inside), normal velocity and its change over that substep.
 
-use yarnsim::scene::builtin::yarn_reference;
-use yarnsim::scene::{StepSize, YarnScene, YarnSpec};
-use yarnsim::testing::Rng;
+use yarnsim::scene::{StepSize, YarnScene};
+use yarnsim::testing::{clear_of_circles, tilted_bundle, Rng};
 use yarnsim::YarnSim;
 
-const TOP: f64 = 1.0 - 3.0 / 256.0;
-
+/// The bundle of `tests/bundle_property.rs`: 12 yarns of 0.4 m, 100
+/// vertices.
 fn bundle(angle: f64, spacing: f64, lower: f64) -> YarnScene {
-    let (length, vertices) = (0.4, 100);
-    let mut s = yarn_reference();
-    let a = angle.to_radians();
-    let dir = [a.cos(), -a.sin()];
-    let normal = [a.sin(), a.cos()];
-    let width = 11.0 * spacing;
-    let half_y = 0.5 * (length * a.sin() + width * a.cos());
-    let (cx, cy) = (0.5, TOP - lower - half_y);
-    let start = [
-        cx - dir[0] * length / 2.0 - normal[0] * width / 2.0,
-        cy - dir[1] * length / 2.0 - normal[1] * width / 2.0,
-    ];
-    s.yarns = vec![YarnSpec {
-        start: Some(start),
-        direction: Some(dir),
-        length: Some(length),
-        vertices,
-        count: 12,
-        spacing: [normal[0] * spacing, normal[1] * spacing],
-        ..Default::default()
-    }];
-    s
-}
-
-fn clear_of_circles(s: &YarnScene) -> bool {
-    let sim = YarnSim::new(s).unwrap();
-    let dx = s.dx();
-    sim.particles().vert.x.iter().all(|x| {
-        s.obstacles.iter().all(|o| {
-            let d = ((x.x - o.center[0]).powi(2) + (x.y - o.center[1]).powi(2)).sqrt();
-            d > o.radius + dx
-        })
-    })
+    tilted_bundle(angle, spacing, lower, 0.4, 100)
 }
 
 /// The first `n` draws of seed 7 that start clear of the circles.
