@@ -10,7 +10,7 @@ mod common;
 
 use common::Rng;
 use yarnsim::scene::{StepSize, YarnScene};
-use yarnsim::testing::{clear_of_circles, tilted_bundle as bundle, BUNDLE_TOP as TOP};
+use yarnsim::testing::{clear_of_circles, tilted_bundle as bundle};
 use yarnsim::YarnSim;
 
 /// Runs `s` for 1 s; the error, if it diverged, or the stretch range
