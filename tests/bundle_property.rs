@@ -9,54 +9,9 @@
 mod common;
 
 use common::Rng;
-use yarnsim::scene::builtin::yarn_reference;
-use yarnsim::scene::{StepSize, YarnScene, YarnSpec};
+use yarnsim::scene::{StepSize, YarnScene};
+use yarnsim::testing::{clear_of_circles, tilted_bundle as bundle};
 use yarnsim::YarnSim;
-
-/// Highest point of a bundle at the start: 3 cells below the domain's top.
-const TOP: f64 = 1.0 - 3.0 / 256.0;
-
-/// The built-in scene with its 12 yarns `length` long (`vertices`
-/// vertices) tilted `angle` degrees down from +x, `spacing` m apart along
-/// their normal, centred in x, its highest point `lower` m below [`TOP`]
-/// (the drop height onto the circles follows: a bundle that starts within
-/// a cell of a circle is refused by [`clear_of_circles`]).
-fn bundle(angle: f64, spacing: f64, lower: f64, length: f64, vertices: u32) -> YarnScene {
-    let mut s = yarn_reference();
-    let a = angle.to_radians();
-    let dir = [a.cos(), -a.sin()];
-    let normal = [a.sin(), a.cos()];
-    let width = 11.0 * spacing;
-    // half extents of the bundle's bounding box in y
-    let half_y = 0.5 * (length * a.sin() + width * a.cos());
-    let (cx, cy) = (0.5, TOP - lower - half_y);
-    let start = [
-        cx - dir[0] * length / 2.0 - normal[0] * width / 2.0,
-        cy - dir[1] * length / 2.0 - normal[1] * width / 2.0,
-    ];
-    s.yarns = vec![YarnSpec {
-        start: Some(start),
-        direction: Some(dir),
-        length: Some(length),
-        vertices,
-        count: 12,
-        spacing: [normal[0] * spacing, normal[1] * spacing],
-        ..Default::default()
-    }];
-    s
-}
-
-/// Whether every vertex of `s` starts more than a cell away from every circle.
-fn clear_of_circles(s: &YarnScene) -> bool {
-    let sim = YarnSim::new(s).unwrap();
-    let dx = s.dx();
-    sim.particles().vert.x.iter().all(|x| {
-        s.obstacles.iter().all(|o| {
-            let d = ((x.x - o.center[0]).powi(2) + (x.y - o.center[1]).powi(2)).sqrt();
-            d > o.radius + dx
-        })
-    })
-}
 
 /// Runs `s` for 1 s; the error, if it diverged, or the stretch range
 /// sampled every 0.05 s.

@@ -35,6 +35,19 @@ pub struct Diagnostics {
 }
 
 impl YarnSim {
+    /// Grid node `(i, j)` after the last grid update, `[vx, vy, dvx, dvy]`
+    /// (its velocity and the velocity's change over the substep: forces,
+    /// gravity, contact), or `None` outside the stored window. For
+    /// measurement programs (`evidence/examples/crush_probe.rs`).
+    #[cfg(feature = "testing")]
+    pub fn grid_node(&self, i: usize, j: usize) -> Option<[f64; 4]> {
+        let g = &self.grid.geom;
+        if i < g.i0 || j < g.j0 || j - g.j0 >= g.stride {
+            return None;
+        }
+        self.grid.node.get(g.index(i, j)).copied()
+    }
+
     /// Left and right end of yarn `y`.
     pub fn yarn_endpoints(&self, y: usize) -> (Vec2, Vec2) {
         let r = &self.particles.yarn_vertices;

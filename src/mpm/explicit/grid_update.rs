@@ -249,7 +249,7 @@ fn obstacle_contacts(
 ) {
     for (oi, o) in ext.obstacles.iter().enumerate() {
         if let Some((normal, impulse)) =
-            obstacle_normal(o, xi, v, m, touching, wedges.reach, ext.yarn_radius)
+            obstacle_normal(o, xi, v, m, touching, wedges, ext.yarn_radius)
         {
             contacts.push(ContactNode {
                 index,

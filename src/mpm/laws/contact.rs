@@ -96,7 +96,8 @@ pub const FRICTION_ARC_CELLS: f64 = 2.0;
 /// law acts in full, without a yarn diameter: see [`normal_share`]). Removes the inward velocity of that share; returns
 /// the outward normal and the normal impulse delivered, or `None` when the
 /// node is not in contact: neither inside, nor carrying touching mass, nor
-/// within `pool_reach` (m) of the surface. A node in contact joins its
+/// within the pool's reach (`wedges.reach`, m) of the surface; the
+/// touching mass acts within `wedges.touch_reach` ([`normal_share`]). A node in contact joins its
 /// wedge's friction pool with its whole mass ([`ContactNode`]).
 #[inline]
 pub fn obstacle_normal(
@@ -105,11 +106,11 @@ pub fn obstacle_normal(
     v: &mut Vec2,
     m: f64,
     touching: f64,
-    pool_reach: f64,
+    wedges: &WedgeTable,
     yarn_radius: f64,
 ) -> Option<(Vec2, f64)> {
-    let (share, n, dist) = normal_share(o, xi, touching, yarn_radius);
-    if share <= 0.0 && dist >= o.radius + pool_reach {
+    let (share, n, dist) = normal_share(o, xi, touching, yarn_radius, wedges.touch_reach);
+    if share <= 0.0 && dist >= o.radius + wedges.reach {
         return None;
     }
     let vn = v.dot(&n);
@@ -137,16 +138,41 @@ pub fn obstacle_normal(
 /// circle do not stop it before its centre line reaches `d / 2` from the
 /// surface (in full inside the obstacle itself, they held it up to 0.15
 /// cells early at 256^2: `docs/obstacle-contact.md`, "Yarn diameter").
+///
+/// `touching` is one fraction for all obstacles (the scatter sums the
+/// mass of particles touching any of them), so a node farther than
+/// `touch_reach` (m, [`TOUCH_REACH_CELLS`] cells) from `o`'s surface,
+/// where no particle touching `o` reaches, has share 0 for `o`: without
+/// that bound a node carrying mass that touches one obstacle lost the
+/// velocity pointing at every other obstacle's centre (and joined their
+/// friction wedges), and the nodes inside a circle kept inward velocity
+/// (`docs/obstacle-contact.md`, "A cross-section crushed on a circle").
 #[inline]
-pub fn normal_share(o: &Obstacle, xi: Vec2, touching: f64, yarn_radius: f64) -> (f64, Vec2, f64) {
+pub fn normal_share(
+    o: &Obstacle,
+    xi: Vec2,
+    touching: f64,
+    yarn_radius: f64,
+    touch_reach: f64,
+) -> (f64, Vec2, f64) {
     let (n, dist) = outward(o, xi);
     let share = if yarn_radius == 0.0 && dist < o.radius {
         1.0
-    } else {
+    } else if dist < o.radius + touch_reach {
         touching.min(1.0)
+    } else {
+        0.0
     };
     (share, n, dist)
 }
+
+/// The farthest a grid node lies from an obstacle's surface, in cells,
+/// and still carries the mass of a particle touching it: the contact band
+/// ([`crate::mpm::explicit::particle_to_grid::CONTACT_CELLS`], 0.5 cells)
+/// plus the reach of a particle's quadratic B-spline stencil (1.5 cells
+/// per axis, `1.5 sqrt 2` along a diagonal).
+pub const TOUCH_REACH_CELLS: f64 =
+    crate::mpm::explicit::particle_to_grid::CONTACT_CELLS + 1.5 * std::f64::consts::SQRT_2;
 
 /// The outward unit normal of obstacle `o` at `x` and the distance of `x`
 /// from its centre (the normal is +y at the centre itself): the geometry
@@ -187,6 +213,8 @@ pub struct WedgeTable {
     pub start: Vec<usize>,
     /// [`POOL_CELLS`] in m.
     pub reach: f64,
+    /// [`TOUCH_REACH_CELLS`] in m.
+    pub touch_reach: f64,
 }
 
 impl WedgeTable {
@@ -201,6 +229,7 @@ impl WedgeTable {
         WedgeTable {
             start,
             reach: POOL_CELLS * dx,
+            touch_reach: TOUCH_REACH_CELLS * dx,
         }
     }
 
@@ -400,9 +429,15 @@ mod tests {
         assert_eq!(grown[0].radius, 0.1 + 0.002);
         assert_eq!(with_yarn_radius(std::slice::from_ref(&o), None)[0], o);
         let inside = Vec2::new(0.5, 0.55);
-        assert_eq!(normal_share(&o, inside, 0.0, 0.0).0, 1.0);
-        assert_eq!(normal_share(&grown[0], inside, 0.0, 0.002).0, 0.0);
-        assert_eq!(normal_share(&grown[0], inside, 0.25, 0.002).0, 0.25);
+        let reach = 0.01;
+        assert_eq!(normal_share(&o, inside, 0.0, 0.0, reach).0, 1.0);
+        assert_eq!(normal_share(&grown[0], inside, 0.0, 0.002, reach).0, 0.0);
+        assert_eq!(normal_share(&grown[0], inside, 0.25, 0.002, reach).0, 0.25);
+        // touching mass acts within the reach of o's surface, not beyond
+        let near = Vec2::new(0.5, 0.609);
+        let far = Vec2::new(0.5, 0.611);
+        assert_eq!(normal_share(&o, near, 0.25, 0.0, reach).0, 0.25);
+        assert_eq!(normal_share(&o, far, 0.25, 0.0, reach).0, 0.0);
     }
 
     #[test]
