@@ -10,6 +10,7 @@ use rayon::prelude::*;
 
 use crate::math::bspline::Stencil;
 use crate::math::{Mat2, Vec2};
+use crate::mpm::laws::contact::CONTACT_CELLS;
 use crate::mpm::laws::vertex_forces::vertex_forces;
 use crate::mpm::machinery::grid::{
     Grid, GridGeom, P2gNode, ScatterBuffer, StencilBounds, CHUNKS, FX, FY, M, MC, P2G_LANES, PX, PY,
@@ -17,14 +18,6 @@ use crate::mpm::machinery::grid::{
 use crate::mpm::machinery::particles::{Particles, Quads, Vertices};
 use crate::mpm::machinery::simd::{chunk_range, multiversion};
 use crate::scene::Obstacle;
-
-/// A particle closer than this many cells to an obstacle's surface (or
-/// inside it) counts as touching it: its grid weight gets Coulomb friction.
-/// With a yarn diameter the surface is the obstacle grown by half of it
-/// and a particle touches only on or inside it (margin 0), so the yarn's
-/// rest distance does not follow the cell (`docs/obstacle-contact.md`,
-/// "Yarn diameter").
-pub const CONTACT_CELLS: f64 = 0.5;
 
 /// What one particle adds to the grid, as an affine function of the node
 /// offset `o = (x_i - x_p) / dx`: node `i` of the stencil gets

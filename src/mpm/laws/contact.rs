@@ -3,7 +3,7 @@
 //! particles on the grid.
 //!
 //! Obstacle contact acts on every grid node that carries the weight of a
-//! particle touching the obstacle (within [`crate::mpm::explicit::particle_to_grid::CONTACT_CELLS`]
+//! particle touching the obstacle (within [`CONTACT_CELLS`]
 //! cells of its surface), not only on nodes inside the circle, so a yarn
 //! resting on an obstacle gets friction on all of its grid weight. It has
 //! two parts:
@@ -166,13 +166,20 @@ pub fn normal_share(
     (share, n, dist)
 }
 
+/// A particle closer than this many cells to an obstacle's surface (or
+/// inside it) counts as touching it: its grid weight gets Coulomb friction.
+/// With a yarn diameter the surface is the obstacle grown by half of it
+/// and a particle touches only on or inside it (margin 0), so the yarn's
+/// rest distance does not follow the cell (`docs/obstacle-contact.md`,
+/// "Yarn diameter").
+pub const CONTACT_CELLS: f64 = 0.5;
+
 /// The farthest a grid node lies from an obstacle's surface, in cells,
 /// and still carries the mass of a particle touching it: the contact band
-/// ([`crate::mpm::explicit::particle_to_grid::CONTACT_CELLS`], 0.5 cells)
+/// ([`CONTACT_CELLS`], 0.5 cells)
 /// plus the reach of a particle's quadratic B-spline stencil (1.5 cells
 /// per axis, `1.5 sqrt 2` along a diagonal).
-pub const TOUCH_REACH_CELLS: f64 =
-    crate::mpm::explicit::particle_to_grid::CONTACT_CELLS + 1.5 * std::f64::consts::SQRT_2;
+pub const TOUCH_REACH_CELLS: f64 = CONTACT_CELLS + 1.5 * std::f64::consts::SQRT_2;
 
 /// The outward unit normal of obstacle `o` at `x` and the distance of `x`
 /// from its centre (the normal is +y at the centre itself): the geometry
@@ -201,7 +208,7 @@ pub fn friction_wedges(o: &Obstacle, dx: f64) -> usize {
 /// Distance, in cells, from an obstacle's surface within which every grid
 /// node joins its wedge's friction pool with its whole mass, whatever
 /// particles it carries: the rows of the stencil of a yarn resting at the
-/// outer edge of the contact band ([`crate::mpm::explicit::particle_to_grid::CONTACT_CELLS`]),
+/// outer edge of the contact band ([`CONTACT_CELLS`]),
 /// whose particles sit partly inside the band and partly outside.
 pub const POOL_CELLS: f64 = 1.0;
 
