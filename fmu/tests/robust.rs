@@ -116,18 +116,9 @@ fn a_substep_beyond_the_stability_bound_gives_a_warning() {
     let f = Fmu::new(&scene);
     assert_eq!(f.set_real(&[VR_DT], &[2.0 * bound]), fmi2OK);
     assert_eq!(exit_init(&f), fmi2Warning);
-    let line = f
-        .lines()
-        .into_iter()
-        .find(|l| l.0 == fmi2Warning)
-        .expect("a warning line");
-    assert_eq!(line.1, "logStatusWarning");
-    assert!(line.2.contains("stability bound"), "{}", line.2);
-    assert!(
-        line.2.contains(&format!("{bound:.6e}")),
-        "{} {bound}",
-        line.2
-    );
+    let line = warning_line(&f);
+    assert!(line.contains("stability bound"), "{}", line);
+    assert!(line.contains(&format!("{bound:.6e}")), "{} {bound}", line);
     // A warning is not an error: the instance steps.
     assert_eq!(f.do_step(0.0, 4.0 * bound), fmi2OK);
 
@@ -249,6 +240,17 @@ fn scene_parameter_refuses_devices_directories_and_huge_files() {
     f.assert_error_contains("missing.toml");
 }
 
+/// The first warning `f` logged (category `logStatusWarning`).
+fn warning_line(f: &Fmu) -> String {
+    let line = f
+        .lines()
+        .into_iter()
+        .find(|l| l.0 == fmi2Warning)
+        .expect("a warning line");
+    assert_eq!(line.1, "logStatusWarning");
+    line.2
+}
+
 /// A yarn of the `nylon66-mono-0.30mm` preset (d 0.3 mm) laid on a circle
 /// of radius 0.1 m at `radius` from its center (a half circle of 41
 /// vertices), no bending, dt "auto".
@@ -280,12 +282,7 @@ fn a_yarn_laid_inside_its_diameter_warns_at_initialization() {
     let d = 0.3e-3;
     let f = Fmu::new(&laid_nylon(0.1));
     assert_eq!(f.init_warned(), fmi2Warning);
-    let line = f
-        .lines()
-        .into_iter()
-        .find(|l| l.0 == fmi2Warning)
-        .expect("a warning line");
-    assert_eq!(line.1, "logStatusWarning");
+    let line = warning_line(&f);
     for what in [
         "fmi2ExitInitializationMode",
         "obstacle 0",
@@ -293,7 +290,7 @@ fn a_yarn_laid_inside_its_diameter_warns_at_initialization() {
         "half of",
         "radius 0.10015 m",
     ] {
-        assert!(line.2.contains(what), "{what}: {}", line.2);
+        assert!(line.contains(what), "{what}: {}", line);
     }
     // a warning is not an error: the instance steps
     assert_eq!(f.do_step(0.0, 1e-3), fmi2OK);
