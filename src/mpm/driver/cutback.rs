@@ -219,11 +219,7 @@ impl YarnSim {
     /// and `depth < MAX_CUTBACKS`, as two halves.
     fn cut(&mut self, dt: f64, depth: u32) -> Result<(), SimError> {
         if depth == MAX_CUTBACKS {
-            let checked = self.energy_checked();
-            let ledger = checked.then(|| Ledger::of(self));
-            let guard = self
-                .stretch_checked(checked)
-                .then(|| StretchGuard::of(self));
+            let (ledger, guard) = self.checks();
             let keep = guard.is_some().then(|| Checkpoint::of(self));
             self.substep_once(dt).map_err(|e| self.exhausted(e, dt))?;
             if let (Some(g), Some(keep)) = (guard, keep) {
@@ -246,11 +242,7 @@ impl YarnSim {
         }
         if self.is_gridless() || dt <= self.advection_limit() {
             let keep = Checkpoint::of(self);
-            let checked = self.energy_checked();
-            let ledger = checked.then(|| Ledger::of(self));
-            let guard = self
-                .stretch_checked(checked)
-                .then(|| StretchGuard::of(self));
+            let (ledger, guard) = self.checks();
             match self.substep_once(dt) {
                 Err(SimError::NonFinite { .. }) => {
                     keep.restore(self);
@@ -333,11 +325,22 @@ impl YarnSim {
         e
     }
 
-    /// Whether this substep's stretch is checked ([`StretchGuard`]): where
-    /// its energy is (`energy_checked`), under `dt = "auto"` (a fixed `dt`
-    /// is the user's choice, run as it was).
-    fn stretch_checked(&self, energy_checked: bool) -> bool {
-        energy_checked && self.scene.time.dt.fixed().is_none()
+    /// What a substep from this state is checked against: the energy
+    /// ledger where its energy is checked (`energy_checked`), and the
+    /// stretch guard ([`StretchGuard`]) where, besides, `dt = "auto"` (a
+    /// fixed `dt` is the user's choice, run as it was).
+    fn checks(&self) -> (Option<Ledger>, Option<StretchGuard>) {
+        if !self.energy_checked() {
+            return (None, None);
+        }
+        let guard = self
+            .scene
+            .time
+            .dt
+            .fixed()
+            .is_none()
+            .then(|| StretchGuard::of(self));
+        (Some(Ledger::of(self)), guard)
     }
 
     /// The error of a substep that failed at the deepest cutback, saying so.
