@@ -40,6 +40,26 @@ fn nearest_on_curve(curve: &[Vec2], c: Vec2) -> Option<(Vec2, f64, usize)> {
     }
 }
 
+/// Every yarn of `scene` at the start, numbered as in the simulation, the
+/// CSV and the recording (copies of a `[[yarns]]` entry one after another):
+/// `(yarn, entry, copy, vertices)`. An entry whose geometry does not build
+/// gives none (the geometry checks report it).
+fn yarn_copies(scene: &YarnScene) -> impl Iterator<Item = (usize, usize, usize, Vec<Vec2>)> + '_ {
+    scene
+        .yarns
+        .iter()
+        .enumerate()
+        .flat_map(|(entry, spec)| {
+            let curves = spec.curves().unwrap_or_default();
+            curves
+                .into_iter()
+                .enumerate()
+                .map(move |(copy, curve)| (entry, copy, curve))
+        })
+        .enumerate()
+        .map(|(yarn, (entry, copy, curve))| (yarn, entry, copy, curve))
+}
+
 /// A coordinate in m for a message: 4 decimals without trailing zeros.
 fn short(x: f64) -> String {
     short_to(x, 4)
@@ -57,48 +77,42 @@ pub fn check_yarns_clear_of_obstacles(
     text: Option<&str>,
 ) -> Result<(), SceneError> {
     let tolerance = 0.5 * scene.dx();
-    let mut yarn = 0;
-    for (entry, spec) in scene.yarns.iter().enumerate() {
-        let Ok(curves) = spec.curves() else {
-            continue; // reported by the geometry checks
-        };
-        for (copy, curve) in curves.iter().enumerate() {
-            for (j, o) in scene.obstacles.iter().enumerate() {
-                let c = Vec2::from(o.center);
-                let Some((p, d, vertex)) = nearest_on_curve(curve, c) else {
-                    continue;
+    for (yarn, entry, copy, curve) in yarn_copies(scene) {
+        let count = scene.yarns[entry].count;
+        for (j, o) in scene.obstacles.iter().enumerate() {
+            let c = Vec2::from(o.center);
+            let Some((p, d, vertex)) = nearest_on_curve(&curve, c) else {
+                continue;
+            };
+            if d < o.radius - tolerance {
+                let line = match table_line(text, "[[yarns]]", entry) {
+                    Some(l) => format!(" at line {l}"),
+                    None => String::new(),
                 };
-                if d < o.radius - tolerance {
-                    let line = match table_line(text, "[[yarns]]", entry) {
-                        Some(l) => format!(" at line {l}"),
-                        None => String::new(),
-                    };
-                    let copy = if spec.count > 1 {
-                        format!(", copy {copy} of {}", spec.count)
-                    } else {
-                        String::new()
-                    };
-                    return Err(SceneError::Invalid {
-                        field: format!("obstacles[{j}]"),
-                        line: table_line(text, "[[obstacles]]", j),
-                        message: format!(
-                            "obstacle {j} (center [{}, {}], radius {}) overlaps yarn {yarn} \
+                let copy = if count > 1 {
+                    format!(", copy {copy} of {count}")
+                } else {
+                    String::new()
+                };
+                return Err(SceneError::Invalid {
+                    field: format!("obstacles[{j}]"),
+                    line: table_line(text, "[[obstacles]]", j),
+                    message: format!(
+                        "obstacle {j} (center [{}, {}], radius {}) overlaps yarn {yarn} \
                              (`yarns[{entry}]`{line}{copy}) at the start: its point [{}, {}] \
                              (near vertex {vertex}) lies {} m from the center, {} m inside the \
                              circle (more than half a grid cell); move the obstacle \
                              or the yarn apart",
-                            o.center[0],
-                            o.center[1],
-                            o.radius,
-                            short(p.x),
-                            short(p.y),
-                            short(d),
-                            short(o.radius - d)
-                        ),
-                    });
-                }
+                        o.center[0],
+                        o.center[1],
+                        o.radius,
+                        short(p.x),
+                        short(p.y),
+                        short(d),
+                        short(o.radius - d)
+                    ),
+                });
             }
-            yarn += 1;
         }
     }
     Ok(())
@@ -122,23 +136,16 @@ pub fn check_yarns_clear_of_obstacles(
 pub fn start_gap_warning(scene: &YarnScene, d: f64) -> Option<String> {
     // (depth inside the grown circle, yarn, entry, vertex, obstacle, gap)
     let mut deepest: Option<(f64, usize, usize, usize, usize, f64)> = None;
-    let mut yarn = 0;
-    for (entry, spec) in scene.yarns.iter().enumerate() {
-        let Ok(curves) = spec.curves() else {
-            continue;
-        };
-        for curve in &curves {
-            for (j, o) in scene.obstacles.iter().enumerate() {
-                let c = Vec2::from(o.center);
-                for (vertex, &x) in curve.iter().enumerate() {
-                    let gap = (x - c).norm() - o.radius;
-                    let depth = 0.5 * d - gap;
-                    if gap < 0.25 * d && deepest.is_none_or(|b| depth > b.0) {
-                        deepest = Some((depth, yarn, entry, vertex, j, gap));
-                    }
+    for (yarn, entry, _, curve) in yarn_copies(scene) {
+        for (j, o) in scene.obstacles.iter().enumerate() {
+            let c = Vec2::from(o.center);
+            for (vertex, &x) in curve.iter().enumerate() {
+                let gap = (x - c).norm() - o.radius;
+                let depth = 0.5 * d - gap;
+                if gap < 0.25 * d && deepest.is_none_or(|b| depth > b.0) {
+                    deepest = Some((depth, yarn, entry, vertex, j, gap));
                 }
             }
-            yarn += 1;
         }
     }
     let (_, yarn, entry, vertex, j, gap) = deepest?;
