@@ -318,6 +318,31 @@ fn errors_have_clear_messages_and_exit_codes() {
     );
 }
 
+/// `bench precision --implicit-duration` needs `--bundle` and a positive
+/// duration; each refusal names the flag (clap, exit code 2) before any
+/// run starts (and `--setting` matching no rung keeps a wrongly accepted
+/// command from running the ladder).
+#[test]
+fn implicit_duration_needs_bundle_and_a_positive_time() {
+    let base = [
+        "bench",
+        "precision",
+        "--out",
+        "/nonexistent-dir",
+        "--setting",
+        "no-such-rung",
+    ];
+    let with = |extra: &[&'static str]| [&base[..], extra].concat();
+    assert_fails(&with(&["--implicit-duration", "0.3"]), 2, "--bundle");
+    for d in ["0", "-1", "abc"] {
+        assert_fails(
+            &with(&["--bundle", "--implicit-duration", d]),
+            2,
+            "--implicit-duration",
+        );
+    }
+}
+
 #[test]
 fn overlapping_bodies_at_the_start_are_refused_naming_both() {
     // The small scene's obstacle moved onto its first yarn.
