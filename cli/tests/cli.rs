@@ -319,27 +319,23 @@ fn errors_have_clear_messages_and_exit_codes() {
 }
 
 /// `bench precision --implicit-duration` needs `--bundle` and a positive
-/// duration; each refusal names the flag (clap, exit code 2) before any
-/// run starts (and `--setting` matching no rung keeps a wrongly accepted
-/// command from running the ladder).
+/// time; clap refuses either naming the flag (exit code 2) before any run
+/// (`--setting` matching no rung: a wrongly accepted command runs nothing).
 #[test]
 fn implicit_duration_needs_bundle_and_a_positive_time() {
     let base = [
         "bench",
         "precision",
         "--out",
-        "/nonexistent-dir",
+        "/nonexistent",
         "--setting",
-        "no-such-rung",
+        "none",
     ];
     let with = |extra: &[&'static str]| [&base[..], extra].concat();
     assert_fails(&with(&["--implicit-duration", "0.3"]), 2, "--bundle");
     for d in ["0", "-1", "abc"] {
-        assert_fails(
-            &with(&["--bundle", "--implicit-duration", d]),
-            2,
-            "--implicit-duration",
-        );
+        let args = with(&["--bundle", "--implicit-duration", d]);
+        assert_fails(&args, 2, "--implicit-duration");
     }
 }
 
