@@ -45,7 +45,8 @@ pub enum BenchStudy {
         no_chain: bool,
         /// Instead: the reference bundle (yarn-reference) over a ladder of
         /// settings against a reference trajectory; writes
-        /// bundle_precision.csv, .svg, .txt (--quick: 0.1 s, coarse steps).
+        /// bundle_precision.csv, .svg, .txt (--quick: 0.1 s, coarse explicit
+        /// steps, no grid implicit rung).
         #[arg(long)]
         bundle: bool,
         /// With --bundle: the reference trajectory CSV (default: the shipped
@@ -55,6 +56,12 @@ pub enum BenchStudy {
         /// With --bundle: only the settings whose name contains this (repeatable).
         #[arg(long, value_name = "NAME", requires = "bundle")]
         setting: Vec<String>,
+        /// With --bundle: simulated time of the grid implicit integrator's
+        /// rungs (the slow ones, minutes per simulated second), at most the
+        /// ladder's 1 s; default: the whole 1 s.
+        #[arg(long, value_name = "SECONDS", requires = "bundle",
+              value_parser = crate::duration::parse_duration, allow_negative_numbers = true)]
+        implicit_duration: Option<f64>,
     },
     /// Skip what a scene doesn't need: optional passes on/off, 256^2 vs
     /// 1024^2 grid, per-pass breakdown of the reference scene.
@@ -176,6 +183,7 @@ pub fn execute(cmd: &EvidenceCommand) -> Result<(String, Vec<String>), CliError>
             bundle: true,
             reference,
             setting,
+            implicit_duration,
             ..
         }) => {
             let reference = match reference {
@@ -185,7 +193,8 @@ pub fn execute(cmd: &EvidenceCommand) -> Result<(String, Vec<String>), CliError>
             };
             let reference = Trajectory::from_csv(&reference)
                 .map_err(|e| CliError::Usage(format!("--reference: {e}")))?;
-            let (duration, implicit) = if *quick { (0.1, 0.1) } else { (1.0, 0.1) };
+            let duration = if *quick { 0.1 } else { 1.0 };
+            let implicit = implicit_duration.unwrap_or(duration);
             let ladder = bundle_precision::ladder(duration, implicit, *quick);
             let r =
                 bundle_precision::run(&ladder, &reference, setting).map_err(CliError::Failed)?;
@@ -302,6 +311,7 @@ mod tests {
             bundle: false,
             reference: None,
             setting: Vec::new(),
+            implicit_duration: None,
         }))
         .unwrap();
         assert!(text.contains("Fastest method per error level"));
@@ -338,6 +348,7 @@ mod tests {
             bundle: true,
             reference: Some(reference),
             setting: Vec::new(),
+            implicit_duration: None,
         }))
         .unwrap();
         assert!(text.contains("compared over 1.0000e-1 s only"), "{text}");

@@ -318,6 +318,27 @@ fn errors_have_clear_messages_and_exit_codes() {
     );
 }
 
+/// `bench precision --implicit-duration` needs `--bundle` and a positive
+/// time; clap refuses either naming the flag (exit code 2) before any run
+/// (`--setting` matching no rung: a wrongly accepted command runs nothing).
+#[test]
+fn implicit_duration_needs_bundle_and_a_positive_time() {
+    let base = [
+        "bench",
+        "precision",
+        "--out",
+        "/nonexistent",
+        "--setting",
+        "none",
+    ];
+    let with = |extra: &[&'static str]| [&base[..], extra].concat();
+    assert_fails(&with(&["--implicit-duration", "0.3"]), 2, "--bundle");
+    for d in ["0", "-1", "abc"] {
+        let args = with(&["--bundle", "--implicit-duration", d]);
+        assert_fails(&args, 2, "--implicit-duration");
+    }
+}
+
 #[test]
 fn overlapping_bodies_at_the_start_are_refused_naming_both() {
     // The small scene's obstacle moved onto its first yarn.

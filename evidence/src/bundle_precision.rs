@@ -8,10 +8,12 @@
 //! 1e-9 perturbation, `/docs/performance/bundle-convergence.md`), against
 //! the wall time per simulated second. Whole trajectories are compared
 //! (Hairer, Norsett, Wanner, "Solving Ordinary Differential Equations I",
-//! 2nd ed., Springer 1993, section II.4).
+//! 2nd ed., Springer 1993, section II.4). A run that the step control
+//! refuses part-way (the grid implicit integrator under `time.dt = "auto"`)
+//! is compared up to its refusal, and its row says where and why it stopped.
 
 use crate::plot::{LinePlot, Marker, Series};
-use crate::trajectory::{compare, record, Trajectory};
+use crate::trajectory::{compare, record, Stopped, Trajectory};
 use crate::{num, Table};
 
 /// The scene every setting runs.
@@ -30,7 +32,8 @@ pub struct Setting {
     pub overrides: Vec<String>,
     /// `time.dt` as written (`auto` or a number).
     pub dt: String,
-    /// Simulated time, s (shorter for the slow grid implicit integrator).
+    /// Simulated time asked for, s (the grid implicit integrator's rungs
+    /// may be given less: [`ladder`]'s `implicit_duration`).
     pub duration: f64,
 }
 
@@ -53,11 +56,17 @@ fn setting(scheme: &str, fields: &str, dt: &str, integrator: &str, duration: f64
     }
 }
 
-/// The ladder: explicit FLIP held-free and per-yarn at dt 4e-5, 2e-5, 1e-5
-/// and `auto`, APIC per-yarn at 4e-5 and 1e-5, and the grid implicit
-/// integrator at `auto` over `implicit_duration` s only (it is slow on this
-/// scene). `quick`: 0.1 s, and only the two coarse explicit steps and
-/// `auto` (a run of seconds, for tests).
+/// The ladder over `duration` s: explicit FLIP held-free and per-yarn at
+/// dt 4e-5, 2e-5, 1e-5 and `auto`, APIC per-yarn at 4e-5 and 1e-5, and the
+/// grid implicit integrator (FLIP, held-free) at `auto` and at a fixed
+/// 2e-4, both over `implicit_duration` s (at most `duration`; the CLI's
+/// `--implicit-duration`, by default the whole `duration`: the implicit
+/// rungs are the slow ones, minutes per simulated second on this scene).
+/// Under `auto` the step control may refuse a substep it cannot keep within
+/// the stretch band of `material.k`; that run then ends there
+/// ([`Trajectory::stopped`]) and is compared up to it. `quick`: only the
+/// two coarse explicit steps and `auto`, no implicit rung (with a short
+/// `duration`, a run of seconds, for tests).
 pub fn ladder(duration: f64, implicit_duration: f64, quick: bool) -> Vec<Setting> {
     let dts: &[&str] = if quick {
         &["4e-5", "auto"]
@@ -74,13 +83,15 @@ pub fn ladder(duration: f64, implicit_duration: f64, quick: bool) -> Vec<Setting
         for dt in ["4e-5", "1e-5"] {
             v.push(setting("apic", "per-yarn", dt, "explicit", duration));
         }
-        v.push(setting(
-            "flip",
-            "held-free",
-            "auto",
-            "implicit",
-            implicit_duration,
-        ));
+        for dt in ["auto", "2e-4"] {
+            v.push(setting(
+                "flip",
+                "held-free",
+                dt,
+                "implicit",
+                implicit_duration.min(duration),
+            ));
+        }
     }
     v
 }
@@ -97,6 +108,8 @@ pub struct BundleRun {
     pub ends_max: f64,
     /// Kinetic, elastic, potential, dissipated energy at the end, J per m.
     pub energy: [f64; 4],
+    /// Where and why the run ended before its duration, if it did.
+    pub stopped: Option<Stopped>,
 }
 
 /// The whole study.
@@ -126,6 +139,7 @@ pub fn measure(
         com_max: c.com_max,
         ends_max: c.ends_max,
         energy: last.energy,
+        stopped: run.stopped.clone(),
     })
 }
 
@@ -165,6 +179,7 @@ impl BundleReport {
             "elastic_J",
             "potential_J",
             "dissipated_J",
+            "stopped_at_s",
         ]);
         for r in &self.runs {
             let mut row = vec![
@@ -177,6 +192,7 @@ impl BundleReport {
                 num(r.ends_max),
             ];
             row.extend(r.energy.iter().map(|&e| num(e)));
+            row.push(r.stopped.as_ref().map_or(num(f64::NAN), |st| num(st.time)));
             t.push(row);
         }
         t
@@ -226,6 +242,16 @@ impl BundleReport {
                 num(r.setting.duration)
             );
         }
+        for r in &self.runs {
+            if let Some(st) = &r.stopped {
+                s += &format!(
+                    "{} stopped at t = {} s: {}\n",
+                    r.setting.name,
+                    num(st.time),
+                    st.reason
+                );
+            }
+        }
         s + &self.table().to_text()
     }
 
@@ -253,5 +279,75 @@ mod tests {
         let s = setting("flip", "per-yarn", "2.5e-6", "explicit", 1.0);
         let m = measure(&s, &r, &r).unwrap();
         assert_eq!((m.com_max, m.ends_max), (0.0, 0.0));
+        assert_eq!(m.stopped, None);
+    }
+
+    /// The full ladder has the two grid implicit rungs (`auto` and 2e-4)
+    /// over `implicit_duration`, at most `duration`; the quick one none.
+    #[test]
+    fn implicit_rungs_run_over_the_implicit_duration() {
+        let implicit = |l: Vec<Setting>| -> Vec<(String, f64)> {
+            l.into_iter()
+                .filter(|s| s.overrides.contains(&"time.integrator=implicit".into()))
+                .map(|s| (s.name, s.duration))
+                .collect()
+        };
+        let names = |d: f64| {
+            vec![
+                ("implicit flip held-free auto".to_string(), d),
+                ("implicit flip held-free 2e-4".to_string(), d),
+            ]
+        };
+        assert_eq!(implicit(ladder(1.0, 1.0, false)), names(1.0));
+        assert_eq!(implicit(ladder(1.0, 0.3, false)), names(0.3));
+        assert_eq!(implicit(ladder(0.5, 1.0, false)), names(0.5));
+        assert!(implicit(ladder(1.0, 1.0, true)).is_empty());
+        assert!(ladder(1.0, 1.0, false)
+            .iter()
+            .all(|s| s.overrides.contains(&format!("time.dt={}", s.dt))));
+    }
+
+    /// A run stopped at 0.12 s (the shipped reference cut after its frame
+    /// at 7/60 s): compared over its 8 frames (window 7/60 s, distance 0
+    /// against the reference itself), and the table's `stopped_at_s` and
+    /// the text's line name the stop; a run that was not stopped has `-`.
+    #[test]
+    fn a_stopped_run_is_compared_up_to_its_stop_and_reported() {
+        let r = Trajectory::from_csv(SHIPPED_REFERENCE).unwrap();
+        let mut cut = r.clone();
+        cut.frames.truncate(8);
+        cut.stopped = Some(Stopped {
+            time: 0.12,
+            reason: "substep refused after step 9 (t = 0.120000 s): why".into(),
+        });
+        let l = ladder(1.0, 1.0, false);
+        let report = BundleReport {
+            reference: r.label.clone(),
+            runs: vec![
+                measure(&l[0], &r, &r).unwrap(),
+                measure(l.last().unwrap(), &cut, &r).unwrap(),
+            ],
+        };
+        let stopped = &report.runs[1];
+        assert!(
+            (stopped.window - 7.0 / 60.0).abs() < 1e-3,
+            "{}",
+            stopped.window
+        );
+        assert_eq!((stopped.com_max, stopped.ends_max), (0.0, 0.0));
+        let csv = report.table().to_csv();
+        let mut lines = csv.lines();
+        assert!(lines.next().unwrap().ends_with(",stopped_at_s"));
+        assert!(lines.next().unwrap().ends_with(",-"));
+        assert!(lines.next().unwrap().ends_with(",1.2000e-1"));
+        let text = report.to_text();
+        assert!(
+            text.contains(&format!(
+                "{} stopped at t = 1.2000e-1 s: substep refused after step 9",
+                l.last().unwrap().name
+            )),
+            "{text}"
+        );
+        assert_eq!(text.matches("stopped at t =").count(), 1, "{text}");
     }
 }
