@@ -23,7 +23,7 @@ use super::{SimError, YarnSim};
 use crate::math::Vec2;
 use crate::mpm::explicit::grid_update::{self, GridForces};
 use crate::mpm::implicit_grid::{self, ContactTerm, Model, Problem};
-use crate::mpm::laws::contact::{normal_share, TOUCH_REACH_CELLS};
+use crate::mpm::laws::contact::{normal_share, touch_reach};
 use crate::mpm::laws::pins::PinEntry;
 use crate::mpm::machinery::grid::{Grid, BLOCK};
 
@@ -259,7 +259,7 @@ fn contact_terms(
         unknown[idx] = u as u32;
     }
     let mut out = Vec::new();
-    let touch_reach = TOUCH_REACH_CELLS * geom.dx;
+    let reach = touch_reach(geom.dx);
     for (k, &b) in grid.active.iter().enumerate() {
         let b = b as usize;
         if !grid_update::block_near(&geom, ext, b).0 {
@@ -275,8 +275,7 @@ fn contact_terms(
             let xi = Vec2::new((i0 + n / BLOCK) as f64, (j0 + n % BLOCK) as f64) * geom.dx;
             let touching = mc * (1.0 / m);
             for o in ext.obstacles {
-                let (share, normal, _) =
-                    normal_share(o, xi, touching, ext.yarn_radius, touch_reach);
+                let (share, normal, _) = normal_share(o, xi, touching, ext.yarn_radius, reach);
                 if share > 0.0 {
                     let c = if share < 1.0 {
                         (share / (1.0 - share)).min(CONTACT_MAX)

@@ -181,6 +181,14 @@ pub const CONTACT_CELLS: f64 = 0.5;
 /// per axis, `1.5 sqrt 2` along a diagonal).
 pub const TOUCH_REACH_CELLS: f64 = CONTACT_CELLS + 1.5 * std::f64::consts::SQRT_2;
 
+/// [`TOUCH_REACH_CELLS`] in m on a grid of spacing `dx`: the `touch_reach`
+/// of [`normal_share`], for the explicit ([`WedgeTable`]) and the implicit
+/// grid update alike.
+#[inline]
+pub fn touch_reach(dx: f64) -> f64 {
+    TOUCH_REACH_CELLS * dx
+}
+
 /// The outward unit normal of obstacle `o` at `x` and the distance of `x`
 /// from its centre (the normal is +y at the centre itself): the geometry
 /// of the obstacle law, shared by the grid integrators' node projection
@@ -236,7 +244,7 @@ impl WedgeTable {
         WedgeTable {
             start,
             reach: POOL_CELLS * dx,
-            touch_reach: TOUCH_REACH_CELLS * dx,
+            touch_reach: touch_reach(dx),
         }
     }
 
