@@ -59,7 +59,7 @@ pub enum BenchStudy {
         /// With --bundle: simulated time of the grid implicit integrator's
         /// rungs (the slow ones, minutes per simulated second), at most the
         /// ladder's 1 s; default: the whole 1 s.
-        #[arg(long, value_name = "SECONDS", requires = "bundle",
+        #[arg(long, value_name = "SECONDS", requires = "bundle", conflicts_with = "quick",
               value_parser = crate::duration::parse_duration, allow_negative_numbers = true)]
         implicit_duration: Option<f64>,
     },
@@ -195,6 +195,11 @@ pub fn execute(cmd: &EvidenceCommand) -> Result<(String, Vec<String>), CliError>
                 .map_err(|e| CliError::Usage(format!("--reference: {e}")))?;
             let duration = if *quick { 0.1 } else { 1.0 };
             let implicit = implicit_duration.unwrap_or(duration);
+            if implicit > duration {
+                return Err(CliError::Usage(format!(
+                    "--implicit-duration {implicit} s is longer than the ladder's {duration} s"
+                )));
+            }
             let ladder = bundle_precision::ladder(duration, implicit, *quick);
             let r =
                 bundle_precision::run(&ladder, &reference, setting).map_err(CliError::Failed)?;

@@ -318,25 +318,23 @@ fn errors_have_clear_messages_and_exit_codes() {
     );
 }
 
-/// `bench precision --implicit-duration` needs `--bundle` and a positive
-/// time; clap refuses either naming the flag (exit code 2) before any run
-/// (`--setting` matching no rung: a wrongly accepted command runs nothing).
+/// `bench precision --implicit-duration` needs `--bundle` (without it a
+/// wrongly accepted command would run the mass-spring study and fail at
+/// writing to `/nonexistent`, exit code 4), a positive time no longer than
+/// the ladder's 1 s, and no `--quick`; each refused naming the flag (exit
+/// code 2) before any run (`--setting` matching no rung: a wrongly accepted
+/// `--bundle` command runs nothing).
 #[test]
 fn implicit_duration_needs_bundle_and_a_positive_time() {
-    let base = [
-        "bench",
-        "precision",
-        "--out",
-        "/nonexistent",
-        "--setting",
-        "none",
-    ];
+    let base = ["bench", "precision", "--out", "/nonexistent"];
     let with = |extra: &[&'static str]| [&base[..], extra].concat();
     assert_fails(&with(&["--implicit-duration", "0.3"]), 2, "--bundle");
-    for d in ["0", "-1", "abc"] {
-        let args = with(&["--bundle", "--implicit-duration", d]);
+    for d in ["0", "-1", "abc", "1.5"] {
+        let args = with(&["--bundle", "--setting", "none", "--implicit-duration", d]);
         assert_fails(&args, 2, "--implicit-duration");
     }
+    let quick = with(&["--bundle", "--quick", "--implicit-duration", "0.05"]);
+    assert_fails(&quick, 2, "--implicit-duration");
 }
 
 #[test]
