@@ -43,12 +43,19 @@ fn main() {
                 e[2],
                 e[3]
             );
+            if let Some(st) = &t.stopped {
+                println!("stopped at t = {} s: {}", st.time, st.reason);
+            }
         }
         Some("compare") if args.len() >= 3 => {
             let c = compare(&read(&args[1]), &read(&args[2])).unwrap_or_else(|e| panic!("{e}"));
             println!(
-                "{} vs {}: com max {:.4} m, ends max {:.4} m",
-                args[1], args[2], c.com_max, c.ends_max
+                "{} vs {}: com max {:.4} m, ends max {:.4} m (over 0 to {:.4} s)",
+                args[1],
+                args[2],
+                c.com_max,
+                c.ends_max,
+                c.curve.last().map_or(0.0, |p| p.0)
             );
             if let Some(out) = args.get(3) {
                 let mut s = String::from("time,com,ends\n");
