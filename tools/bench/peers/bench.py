@@ -396,8 +396,9 @@ def bundle_preset(rows, duration, rounds, presets):
 def bundle_converged(rows, duration):
     """MuJoCo's bundle (planar armature set-up) at dt 1e-3 and 5e-4 and
     yarnsim's converged setting (per-yarn FLIP at dt 5e-6: the step within
-    1 cm of the shipped reference trajectory in the centre of mass over the
-    whole second, docs/performance/bundle-convergence.md), each run once
+    1 cm of the shipped reference trajectory, its dt/2, in the centre of
+    mass over the whole second, docs/performance/bundle-convergence.md),
+    each run once
     (MuJoCo, yarnsim, MuJoCo): MuJoCo's own convergence (the two steps'
     frames apart) and the tools' centres of mass apart."""
     mj1 = mujoco_rope.bundle(duration, dt=1e-3)
