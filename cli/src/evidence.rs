@@ -201,9 +201,18 @@ pub fn execute(cmd: &EvidenceCommand) -> Result<(String, Vec<String>), CliError>
                 )));
             }
             let ladder = bundle_precision::ladder(duration, implicit, *quick);
-            let r =
-                bundle_precision::run(&ladder, &reference, setting).map_err(CliError::Failed)?;
-            Ok((r.to_text(), write(out, &r.files())?))
+            let r = bundle_precision::run(&ladder, &reference, setting);
+            let written = write(out, &r.files())?;
+            if !r.failed.is_empty() {
+                let each: Vec<String> = r.failed.iter().map(|(n, e)| format!("{n}: {e}")).collect();
+                return Err(CliError::Failed(format!(
+                    "{} of the ladder's settings failed ({}); the others' results are written to {}",
+                    r.failed.len(),
+                    each.join("; "),
+                    out.display()
+                )));
+            }
+            Ok((r.to_text(), written))
         }
         EvidenceCommand::Bench(BenchStudy::Precision {
             out,

@@ -118,6 +118,10 @@ pub struct BundleReport {
     /// The reference's label (its first `#` line).
     pub reference: String,
     pub runs: Vec<BundleRun>,
+    /// The settings that could not be run or compared, with the error:
+    /// the others' results are kept (a ladder takes half an hour; one
+    /// failing rung must not lose them).
+    pub failed: Vec<(String, String)>,
 }
 
 /// Compares `run` (of `setting`) with `reference` over their common window.
@@ -144,25 +148,28 @@ pub fn measure(
 }
 
 /// Runs every setting (whose name contains one of `only`, if any is given)
-/// and compares it with `reference`.
-pub fn run(
-    settings: &[Setting],
-    reference: &Trajectory,
-    only: &[String],
-) -> Result<BundleReport, String> {
+/// and compares it with `reference`; a setting whose run or comparison
+/// fails goes to [`BundleReport::failed`] and the others go on.
+pub fn run(settings: &[Setting], reference: &Trajectory, only: &[String]) -> BundleReport {
     let mut runs = Vec::new();
+    let mut failed = Vec::new();
     for s in settings {
         if !only.is_empty() && !only.iter().any(|o| s.name.contains(o.as_str())) {
             continue;
         }
-        let t = record(SCENE, &s.overrides, s.duration, 1.0 / 60.0)
-            .map_err(|e| format!("{}: {e}", s.name))?;
-        runs.push(measure(s, &t, reference)?);
+        let measured = record(SCENE, &s.overrides, s.duration, 1.0 / 60.0)
+            .map_err(|e| format!("{}: {e}", s.name))
+            .and_then(|t| measure(s, &t, reference));
+        match measured {
+            Ok(r) => runs.push(r),
+            Err(e) => failed.push((s.name.clone(), e)),
+        }
     }
-    Ok(BundleReport {
+    BundleReport {
         reference: reference.label.clone(),
         runs,
-    })
+        failed,
+    }
 }
 
 impl BundleReport {
@@ -241,6 +248,9 @@ impl BundleReport {
                 r.setting.name,
                 num(r.setting.duration)
             );
+        }
+        for (name, e) in &self.failed {
+            s += &format!("{name} failed, not in the table: {e}\n");
         }
         for r in &self.runs {
             if let Some(st) = &r.stopped {
@@ -333,6 +343,7 @@ mod tests {
                 measure(&l[0], &r, &r).unwrap(),
                 measure(auto, &cut, &r).unwrap(),
             ],
+            failed: Vec::new(),
         };
         let stopped = &report.runs[1];
         assert!(
@@ -355,5 +366,30 @@ mod tests {
             "{text}"
         );
         assert_eq!(text.matches("stopped at t =").count(), 1, "{text}");
+    }
+
+    /// A rung that cannot run (here `time.dt = -1`, refused by the scene)
+    /// is reported with its error and the other rungs are kept: the quick
+    /// explicit rung at 4e-5 over 0.05 s is measured (release: 1,250
+    /// substeps).
+    #[test]
+    #[cfg_attr(debug_assertions, ignore = "runs the bundle; release only")]
+    fn a_failing_rung_is_reported_and_the_others_kept() {
+        let r = Trajectory::from_csv(SHIPPED_REFERENCE).unwrap();
+        let good = setting("flip", "held-free", "4e-5", "explicit", 0.05);
+        let bad = setting("flip", "held-free", "-1", "explicit", 0.05);
+        let report = run(&[good.clone(), bad.clone()], &r, &[]);
+        assert_eq!(report.runs.len(), 1);
+        assert_eq!(report.runs[0].setting, good);
+        assert_eq!(report.failed.len(), 1);
+        assert_eq!(report.failed[0].0, bad.name);
+        assert!(
+            report.failed[0].1.contains("time.dt"),
+            "{:?}",
+            report.failed
+        );
+        assert!(report
+            .to_text()
+            .contains(&format!("{} failed, not in the table:", bad.name)));
     }
 }
