@@ -124,17 +124,15 @@ pub struct BundleReport {
     pub failed: Vec<(String, String)>,
 }
 
-/// Compares `run` (of `setting`) with `reference` over their common window.
+/// Compares `run` (of `setting`) with `reference` over their common window
+/// (an error does not name the setting: [`run`] files it under its name).
 pub fn measure(
     setting: &Setting,
     run: &Trajectory,
     reference: &Trajectory,
 ) -> Result<BundleRun, String> {
-    let c = compare(run, reference).map_err(|e| format!("{}: {e}", setting.name))?;
-    let last = run
-        .frames
-        .last()
-        .ok_or_else(|| format!("{}: no frames", setting.name))?;
+    let c = compare(run, reference)?;
+    let last = run.frames.last().ok_or("no frames")?;
     Ok(BundleRun {
         setting: setting.clone(),
         steps: run.steps,
@@ -158,7 +156,7 @@ pub fn run(settings: &[Setting], reference: &Trajectory, only: &[String]) -> Bun
             continue;
         }
         let measured = record(SCENE, &s.overrides, s.duration, 1.0 / 60.0)
-            .map_err(|e| format!("{}: {e}", s.name))
+            .map_err(|e| e.to_string())
             .and_then(|t| measure(s, &t, reference));
         match measured {
             Ok(r) => runs.push(r),
@@ -388,8 +386,9 @@ mod tests {
             "{:?}",
             report.failed
         );
-        assert!(report
-            .to_text()
-            .contains(&format!("{} failed, not in the table:", bad.name)));
+        let text = report.to_text();
+        assert!(text.contains(&format!("{} failed, not in the table:", bad.name)));
+        // named once: the error itself does not repeat the setting
+        assert_eq!(text.matches(bad.name.as_str()).count(), 1, "{text}");
     }
 }
