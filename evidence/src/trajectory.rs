@@ -227,9 +227,14 @@ impl Trajectory {
         Ok(t)
     }
 
-    /// Wall time per simulated second.
+    /// Wall time per simulated second: over the time simulated, which for
+    /// a stopped run is its stop (the substeps after its last frame cost
+    /// wall time too).
     pub fn wall_per_second(&self) -> f64 {
-        let span = self.frames.last().map_or(0.0, |f| f.time);
+        let span = match &self.stopped {
+            Some(st) => st.time,
+            None => self.frames.last().map_or(0.0, |f| f.time),
+        };
         if span > 0.0 {
             self.wall_s / span
         } else {
@@ -376,6 +381,11 @@ mod tests {
             reason: "substep refused after step 7 (t = 0.127500 s): why".into(),
         });
         let csv = a.to_csv();
+        // the wall time is over the simulated time, to the stop
+        assert_eq!(
+            a.wall_per_second(),
+            a.wall_s / a.stopped.as_ref().unwrap().time
+        );
         assert_eq!(
             csv.lines().filter(|l| l.starts_with("# stopped")).count(),
             1
