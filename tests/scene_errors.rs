@@ -340,3 +340,32 @@ fn an_inline_list_entry_is_named_by_its_index() {
     assert!(err.contains("`obstacles[1].radius`"), "{err}");
     assert!(err.contains("a number"), "{err}");
 }
+
+/// `transfer.flip_time` (a relaxation time, s) is a positive number and
+/// takes the place of `transfer.flip_ratio`: the two together are refused
+/// at the line of `flip_time`, naming the ratio given.
+#[test]
+fn a_flip_time_is_positive_and_not_given_beside_a_ratio() {
+    let with = |table: &str| {
+        Scene::from_toml_str(&format!("{SCENE}\n[transfer]\n{table}"))
+            .map(|_| ())
+            .map_err(|e| e.to_string())
+    };
+    let first = SCENE.lines().count() + 3;
+    assert_eq!(with("flip_time = 0.004\n"), Ok(()));
+    assert_eq!(
+        with("flip_time = -0.004\n").unwrap_err(),
+        format!(
+            "scene error at line {first} in field `transfer.flip_time`: must be > 0, got -0.004"
+        )
+    );
+    assert_eq!(
+        with("flip_ratio = 0.9\nflip_time = 0.004\n").unwrap_err(),
+        format!(
+            "scene error at line {} in field `transfer.flip_time`: give transfer.flip_ratio \
+             (a blend per substep) or transfer.flip_time (a relaxation time), not both; \
+             flip_ratio is 0.9",
+            first + 1
+        )
+    );
+}

@@ -35,8 +35,9 @@ pub fn list_materials() -> String {
         out,
         "\ntex: g per km; mu: friction on yarn and on solids (obstacles); c = sqrt(EA / (tex 1e-6)):\n\
          the axial wave speed, which bounds the explicit substep (dt = \"auto\": about dx / c);\n\
-         [time] axial = \"implicit\" (with transfer.scheme = \"apic\") solves the fibre stretch by\n\
-         backward Euler and lifts that bound (then the cross-section and shear waves set dt).\n\
+         [time] axial = \"implicit\" (with transfer.scheme = \"apic\", or FLIP with a\n\
+         transfer.flip_time) solves the fibre stretch by backward Euler and lifts that bound\n\
+         (then the cross-section and shear waves set dt).\n\
          Use: [material] preset = \"NAME\"; any field overrides the preset's. Per metre of depth\n\
          at the sheet spacing s (default: the diameter): k = EA / s, density = tex 1e-6 / s,\n\
          bending = EI / s; a pin force per metre of depth times s is one yarn's. Sources, and\n\

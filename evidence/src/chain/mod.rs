@@ -97,6 +97,7 @@ pub fn schemes() -> Vec<Scheme> {
     let flip = |r: f64| TransferSpec {
         scheme: TransferScheme::Flip,
         flip_ratio: r,
+        flip_time: None,
     };
     vec![
         Scheme {
@@ -112,6 +113,7 @@ pub fn schemes() -> Vec<Scheme> {
             transfer: TransferSpec {
                 scheme: TransferScheme::Apic,
                 flip_ratio: 1.0,
+                flip_time: None,
             },
         },
     ]

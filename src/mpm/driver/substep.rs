@@ -146,7 +146,7 @@ impl YarnSim {
     ) -> Result<(), SimError> {
         let passes = self.passes();
         let bending = self.active_bending(passes);
-        let transfer = self.transfer;
+        let transfer = self.transfer.at_step(dt, self.scene.transfer.flip_time);
         let flip = transfer.needs_delta();
         let energy = self.grid_energy();
         let t0 = Instant::now();

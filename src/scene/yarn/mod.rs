@@ -77,6 +77,16 @@ pub struct TransferSpec {
     /// per-transfer dissipation); `r < 1` blends in APIC's damping.
     #[serde(default = "one", deserialize_with = "unit_interval_closed")]
     pub flip_ratio: f64,
+    /// Instead of `flip_ratio`: the time, s, over which a FLIP particle's
+    /// own velocity relaxes to the grid's; each substep's ratio is
+    /// `exp(-dt / flip_time)`, a damping per simulated second that does
+    /// not depend on the step.
+    #[serde(
+        default,
+        deserialize_with = "opt_positive",
+        skip_serializing_if = "Option::is_none"
+    )]
+    pub flip_time: Option<f64>,
 }
 
 impl Default for TransferSpec {
@@ -84,6 +94,7 @@ impl Default for TransferSpec {
         TransferSpec {
             scheme: TransferScheme::default(),
             flip_ratio: 1.0,
+            flip_time: None,
         }
     }
 }

@@ -225,12 +225,25 @@ impl YarnScene {
                 ),
             ));
         }
-        if t.axial.is_implicit() && self.transfer.scheme != TransferScheme::Apic {
+        let tr = &self.transfer;
+        if tr.flip_time.is_some() && tr.flip_ratio != 1.0 {
+            return Err(SceneError::Invalid {
+                field: "transfer.flip_time".into(),
+                line: text.and_then(|t| key_line(t, "[transfer]", "flip_time")),
+                message: format!(
+                    "give transfer.flip_ratio (a blend per substep) or transfer.flip_time (a \
+                     relaxation time), not both; flip_ratio is {}",
+                    tr.flip_ratio
+                ),
+            });
+        }
+        if t.axial.is_implicit() && tr.scheme == TransferScheme::Flip && tr.flip_time.is_none() {
             return Err(invalid(
                 "axial",
-                "axial = \"implicit\" needs [transfer] scheme = \"apic\": a FLIP particle keeps \
-                 the vertex-scale part of the axial solve's velocity change, which its position \
-                 never follows, and the run gains energy"
+                "axial = \"implicit\" under [transfer] scheme = \"flip\" needs \
+                 transfer.flip_time (for example 0.004 s), or scheme = \"apic\": a FLIP particle \
+                 keeps the vertex-scale part of the axial solve's velocity change, which its \
+                 position never follows, and without a relaxation time the run gains energy"
                     .into(),
             ));
         }
