@@ -156,13 +156,14 @@ fn unit_table_covers_every_field_once() {
          EI = 1e-9\nfriction_solid = 0.2\nspacing = 3e-4\ntransverse_modulus = 4e6\n\
          shear_modulus = 1e6\n",
     );
-    // `time.axial` by the rich yarn scene under the explicit integrator
-    // with APIC (the scope of `axial = "implicit"`)
+    // `time.axial` and `transfer.flip_time` by the rich yarn scene under
+    // the explicit integrator with FLIP and a relaxation time (the scope
+    // of `axial = "implicit"` under FLIP)
     let axial = RICH_YARN
         .replace("integrator = \"implicit\"\n", "axial = \"implicit\"\n")
         .replace(
             "scheme = \"flip\"\nflip_ratio = 0.95\n",
-            "scheme = \"apic\"\n",
+            "scheme = \"flip\"\nflip_time = 0.004\n",
         );
     for (scenes, fields) in [
         (

@@ -334,7 +334,9 @@ impl YarnSim {
     pub fn num_yarns(&self) -> usize {
         self.particles.num_yarns()
     }
-    /// The transfer scheme.
+    /// The transfer scheme; under `transfer.flip_time` its FLIP ratio is 1
+    /// here and each substep of `dt` takes `exp(-dt / flip_time)`
+    /// ([`Transfer::at_step`]).
     pub fn transfer(&self) -> Transfer {
         self.transfer
     }

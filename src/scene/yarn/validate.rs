@@ -226,10 +226,21 @@ impl YarnScene {
             ));
         }
         let tr = &self.transfer;
+        let flip_time_line = || text.and_then(|t| key_line(t, "[transfer]", "flip_time"));
+        if let Some(tau) = tr.flip_time {
+            // the reader checks it in a file; a scene built in code too
+            if !(tau.is_finite() && tau > 0.0) {
+                return Err(SceneError::Invalid {
+                    field: "transfer.flip_time".into(),
+                    line: flip_time_line(),
+                    message: format!("must be > 0, got {tau}"),
+                });
+            }
+        }
         if tr.flip_time.is_some() && tr.flip_ratio != 1.0 {
             return Err(SceneError::Invalid {
                 field: "transfer.flip_time".into(),
-                line: text.and_then(|t| key_line(t, "[transfer]", "flip_time")),
+                line: flip_time_line(),
                 message: format!(
                     "give transfer.flip_ratio (a blend per substep) or transfer.flip_time (a \
                      relaxation time), not both; flip_ratio is {}",
@@ -243,7 +254,8 @@ impl YarnScene {
                 "axial = \"implicit\" under [transfer] scheme = \"flip\" needs \
                  transfer.flip_time (for example 0.004 s), or scheme = \"apic\": a FLIP particle \
                  keeps the vertex-scale part of the axial solve's velocity change, which its \
-                 position never follows, and without a relaxation time the run gains energy"
+                 position never follows; pure FLIP gains energy from it, and a fixed flip_ratio \
+                 damps it per substep, so by an amount that changes with dt"
                     .into(),
             ));
         }
