@@ -256,30 +256,40 @@ fn flip_reference(k: f64, axial: Axial) -> YarnScene {
 }
 
 /// `transfer.flip_time` of the FLIP checks, s: the particles' own velocity
-/// relaxes to the grid's over 4 ms (100 substeps of the built-in 4e-5 s).
-/// Measured on this bundle at k = 1e7 over its whole second at dt 4e-5:
-/// 2 and 4 ms never gain energy from one frame (1/60 s) to the next; 8 ms
-/// gains up to 1.0 J in a frame after the landing, 20 ms 2.3 J, and 100
-/// ms diverges at 0.72 s.
-const FLIP_TIME: f64 = 0.004;
+/// relaxes to the grid's over 2 ms (50 substeps of the built-in 4e-5 s),
+/// the setting at which the seed material's bundle converges in the step
+/// (`docs/performance/bundle-convergence.md`). Measured on this bundle at
+/// k = 1e7 over its whole second at dt 4e-5: 2 and 4 ms never gain energy
+/// from one frame (1/60 s) to the next; 8 ms gains up to 1.0 J in a frame
+/// after the landing, 20 ms 2.3 J, and 100 ms diverges at 0.72 s.
+const FLIP_TIME: f64 = 0.002;
 
-/// Under FLIP with a relaxation time the stiff bundle (k = 1e7, `dt =
-/// "auto"`) keeps every stretch within [0.999, 1.001] through the fall,
-/// the landing and the slide between the circles to 0.6 s (checked every
-/// 5 ms), and its total energy never rises from one check to the next by
-/// more than 1e-4 of its start. Pure FLIP (no relaxation time, refused at
-/// load) rose by up to 3.9 J between two frames (1/60 s) after the
-/// landing (with `FLIP_TIME` = 1e9 s this test fails: 19.6 J), and the
-/// bundle's kinetic energy at 0.5 s was 26.5 J against 14.5 J of the
-/// explicit run at k = 1e7 at its stable step.
+/// Under FLIP with a relaxation time of 2 ms, at the built-in dt 4e-5 (the
+/// setting at which the seed material's bundle converges in the step), the
+/// stiff bundle (k = 1e7) keeps every stretch within [0.999, 1.001]
+/// through the fall, the landing and the slide between the circles over
+/// its whole second (checked every 5 ms; measured [0.9994741,
+/// 1.0000115]), and its total energy never rises from one check to the
+/// next by more than 1e-4 of its start (measured: it falls at every
+/// check). Under `dt = "auto"` the same holds to 0.6 s, but later the
+/// end-of-step obstacle placement compresses a segment for a moment (to
+/// 0.9961 at 0.85 s) and the energy rises once by 0.08 J within 5 ms;
+/// with 4 ms at dt 4e-5, to 0.9984 and once by 0.17 J (see
+/// `docs/yarn-integrators.md`, "Why a relaxation time under FLIP"). Pure
+/// FLIP (no relaxation time, refused at load) rose by up to 3.9 J between
+/// two frames (1/60 s) after the landing (with `FLIP_TIME` = 1e9 s this
+/// test fails), and the bundle's kinetic energy at 0.5 s was 26.5 J
+/// against 14.5 J of the explicit run at k = 1e7 at its stable step.
 #[test]
 #[cfg_attr(debug_assertions, ignore = "release-mode test (cargo test --release)")]
 fn stiff_bundle_under_flip_keeps_its_length_and_never_gains_energy() {
-    let mut sim = YarnSim::new(&flip_reference(1e7, Axial::Implicit)).unwrap();
+    let mut s = flip_reference(1e7, Axial::Implicit);
+    s.time.dt = StepSize::Fixed(4e-5);
+    let mut sim = YarnSim::new(&s).unwrap();
     let e0 = total_energy(&sim);
     let (mut lo, mut hi, mut rise) = (1.0f64, 1.0f64, f64::NEG_INFINITY);
     let mut last = e0;
-    for i in 1..=120 {
+    for i in 1..=200 {
         sim.advance_to(0.005 * i as f64).unwrap();
         let d = sim.diagnostics();
         lo = lo.min(d.min_stretch);
@@ -290,15 +300,15 @@ fn stiff_bundle_under_flip_keeps_its_length_and_never_gains_energy() {
     }
     eprintln!(
         "stretch [{lo:.7}, {hi:.7}], largest rise between checks {rise:.3e} J of {e0:.3} J, \
-         {last:.2} J at 0.6 s, {} substeps",
+         {last:.2} J at 1 s, {} substeps",
         sim.dt_stats().substeps
     );
     assert!(lo >= 0.999 && hi <= 1.001, "[{lo}, {hi}]");
     assert!(rise <= 1e-4 * e0, "{rise} of {e0}");
-    // the checks span the landing and the slide, not a free fall that
-    // keeps its energy: by 0.6 s the bundle has lost over 40 % of it
-    // (measured 44.3 J left of 75.7 J)
-    assert!(last < 0.6 * e0, "{last}");
+    // the checks span the landing, the slide and the pile, not a free
+    // fall that keeps its energy: by 1 s the bundle has lost over 70 % of
+    // it (measured 15.6 J left of 75.7 J)
+    assert!(last < 0.3 * e0, "{last}");
 }
 
 /// At a fixed step `transfer.flip_time = tau` is the blend `flip_ratio =

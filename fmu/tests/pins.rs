@@ -507,3 +507,34 @@ fn a_preset_yarns_pin_force_times_the_spacing_is_one_yarns_weight() {
     // oscillation
     assert!(err.abs() < 0.02, "{err}");
 }
+
+/// A scene file with `transfer.flip_time` (a relaxation time, not an FMU
+/// variable) runs with the library's bits, and `transfer.flip_ratio`
+/// reads 1; another ratio beside it is refused, naming
+/// `transfer.flip_time`, and the FMU reports the error.
+#[test]
+fn a_scene_with_a_flip_time_runs_and_refuses_another_ratio() {
+    let mut scene = small_scene();
+    scene.transfer.flip_time = Some(0.004);
+    let f = Fmu::initialized(&scene);
+    assert_eq!(f.get_real(&[VR_FLIP_RATIO]), Ok(vec![1.0]));
+    let out = fmu_run(&f);
+    assert_eq!(bits(&out), bits(&library_run(&scene)));
+    assert_ne!(bits(&out), bits(&library_run(&small_scene())));
+    let g = Fmu::new(&scene);
+    // a fixed parameter: set before initialization, checked with the scene
+    // at its end
+    assert_eq!(g.set_real(&[VR_FLIP_RATIO], &[0.9]), fmi2OK);
+    assert_eq!(g.setup(0.0, None), fmi2OK);
+    // SAFETY: `g.c` came from `fmi2Instantiate` and lives until its `Fmu` drops.
+    let status = unsafe {
+        assert_eq!(fmi2EnterInitializationMode(g.c), fmi2OK);
+        fmi2ExitInitializationMode(g.c)
+    };
+    assert_eq!(status, fmi2Error);
+    let e = g.last_error();
+    assert!(
+        e.contains("transfer.flip_time") && e.contains("flip_ratio is 0.9"),
+        "{e}"
+    );
+}

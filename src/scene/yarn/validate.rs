@@ -252,7 +252,7 @@ impl YarnScene {
             return Err(invalid(
                 "axial",
                 "axial = \"implicit\" under [transfer] scheme = \"flip\" needs \
-                 transfer.flip_time (for example 0.004 s), or scheme = \"apic\": a FLIP particle \
+                 transfer.flip_time (for example 0.002 s), or scheme = \"apic\": a FLIP particle \
                  keeps the vertex-scale part of the axial solve's velocity change, which its \
                  position never follows; pure FLIP gains energy from it, and a fixed flip_ratio \
                  damps it per substep, so by an amount that changes with dt"
