@@ -13,10 +13,12 @@ mod material;
 pub mod material_units;
 mod overlap;
 pub mod presets;
+mod transfer;
 mod validate;
 
 pub use axial::Axial;
 pub use material::{Material, YarnMaterial};
+pub use transfer::{TransferScheme, TransferSpec};
 pub use validate::MAX_DIAMETER_CELLS;
 
 /// A complete yarn-bundle scene. See the README section "Scene files" for
@@ -65,40 +67,6 @@ pub struct YarnScene {
     pub pins: Vec<PinSpec>,
 }
 
-/// The grid-to-particle velocity update (`[transfer]`); see
-/// `crate::mpm::machinery::transfer`.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct TransferSpec {
-    /// `"flip"` (default) or `"apic"`.
-    #[serde(default)]
-    pub scheme: TransferScheme,
-    /// FLIP ratio in `[0, 1]` for `"flip"` (default 1: pure FLIP, no
-    /// per-transfer dissipation); `r < 1` blends in APIC's damping.
-    #[serde(default = "one", deserialize_with = "unit_interval_closed")]
-    pub flip_ratio: f64,
-    /// Instead of `flip_ratio`: the time, s, over which a FLIP particle's
-    /// own velocity relaxes to the grid's; each substep's ratio is
-    /// `exp(-dt / flip_time)`, a damping per simulated second that does
-    /// not depend on the step.
-    #[serde(
-        default,
-        deserialize_with = "opt_positive",
-        skip_serializing_if = "Option::is_none"
-    )]
-    pub flip_time: Option<f64>,
-}
-
-impl Default for TransferSpec {
-    fn default() -> Self {
-        TransferSpec {
-            scheme: TransferScheme::default(),
-            flip_ratio: 1.0,
-            flip_time: None,
-        }
-    }
-}
-
 /// Yarn-on-yarn contact (`[contact]`); see `crate::mpm::laws::fields`.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -127,31 +95,6 @@ pub enum FieldPartition {
     /// friction with `material.friction` between any two yarns (its cost:
     /// `docs/performance/contact.md`).
     PerYarn,
-}
-
-/// Name of a transfer scheme.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, Default)]
-#[serde(rename_all = "lowercase")]
-pub enum TransferScheme {
-    /// The particle keeps its velocity and adds the grid's change (blended
-    /// with APIC by `flip_ratio`).
-    #[default]
-    Flip,
-    /// APIC (the reference Taichi implementation's): velocity and affine matrix replaced by the grid's.
-    Apic,
-}
-
-impl TransferScheme {
-    /// Every value of `[transfer] scheme`, as a scene file writes it.
-    pub const NAMES: [&'static str; 2] = ["flip", "apic"];
-
-    /// The value as a scene file writes it (one of [`TransferScheme::NAMES`]).
-    pub fn name(&self) -> &'static str {
-        match self {
-            TransferScheme::Flip => Self::NAMES[0],
-            TransferScheme::Apic => Self::NAMES[1],
-        }
-    }
 }
 
 /// Which end of a yarn a pin starts from.
@@ -597,10 +540,7 @@ fn default_obstacle_friction() -> f64 {
 
 // ---- validating field readers (the error carries the value's span) --------
 
-use super::readers::{
-    bounded_u32, finite2, nonnegative, one, opt_finite, opt_positive, positive,
-    unit_interval_closed,
-};
+use super::readers::{bounded_u32, finite2, nonnegative, one, opt_finite, opt_positive, positive};
 use serde::de::Error as _;
 
 fn kind_is_yarn<'de, D: Deserializer<'de>>(d: D) -> Result<String, D::Error> {
