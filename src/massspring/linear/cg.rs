@@ -197,6 +197,11 @@ fn dot(a: &[f64], b: &[f64]) -> f64 {
     a.iter().zip(b).map(|(x, y)| x * y).sum()
 }
 
+/// Below this largest entry of the right-hand side [`pcg`] solves the
+/// system scaled by its inverse: the squares in its dot products would
+/// underflow.
+const TINY_RHS: f64 = 1e-100;
+
 /// Solves `A x = b` by preconditioned CG from the initial guess in `x`,
 /// until `|r| <= tol |b|` or `max_iter` iterations.
 pub fn pcg(
@@ -208,6 +213,25 @@ pub fn pcg(
     max_iter: usize,
 ) -> CgResult {
     let n = a.n;
+    let bmax = b.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    if bmax > 0.0 && bmax < TINY_RHS {
+        // Squares of so small a residual underflow (a chain at rest to
+        // round-off after a long damped run: |b| ~ 1e-162), which would
+        // stop CG at its first step with zero curvature: solve for `x /
+        // max |b_i|` with that scaled right-hand side, then scale back.
+        // Above this size nothing changes (same bits).
+        let s = 1.0 / bmax;
+        let scaled: Vec<f64> = b.iter().map(|v| v * s).collect();
+        for v in x.iter_mut() {
+            *v *= s;
+            if !v.is_finite() {
+                *v = 0.0;
+            }
+        }
+        let r = pcg(a, &scaled, x, pre, tol, max_iter);
+        x.iter_mut().for_each(|v| *v *= bmax);
+        return r;
+    }
     let bnorm = dot(b, b).sqrt();
     if bnorm == 0.0 {
         x.iter_mut().for_each(|v| *v = 0.0);
@@ -328,6 +352,27 @@ mod tests {
         .unwrap();
         for i in 0..8 {
             assert!((x[i] - d[i]).abs() < 1e-12);
+        }
+    }
+
+    /// A right-hand side whose squares underflow (|b| ~ 1e-162, a chain at
+    /// rest to round-off) is solved as well as a unit one, to the same
+    /// relative residual, where plain CG stopped at its first step with zero
+    /// curvature (relative residual 1).
+    #[test]
+    fn pcg_solves_a_right_hand_side_whose_squares_underflow() {
+        let a = tridiag(8);
+        let pre = Preconditioner::new(PreconditionerKind::Jacobi, &a);
+        let unit: Vec<f64> = (0..8).map(|i| (i as f64 * 0.37).sin() + 0.5).collect();
+        let mut xu = vec![0.0; 8];
+        let ru = pcg(&a, &unit, &mut xu, &pre, 1e-12, 100);
+        let tiny: Vec<f64> = unit.iter().map(|v| v * 1e-162).collect();
+        let mut xt = vec![0.0; 8];
+        let rt = pcg(&a, &tiny, &mut xt, &pre, 1e-12, 100);
+        assert!(rt.converged && rt.relative_residual <= 1e-12, "{rt:?}");
+        assert_eq!(rt.iterations, ru.iterations);
+        for (t, u) in xt.iter().zip(&xu) {
+            assert!((t / 1e-162 - u).abs() <= 1e-9 * u.abs().max(1.0), "{t} {u}");
         }
     }
 }
