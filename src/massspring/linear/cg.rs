@@ -216,7 +216,7 @@ pub fn pcg(
     let bmax = b.iter().fold(0.0f64, |m, v| m.max(v.abs()));
     if bmax > 0.0 && bmax < TINY_RHS {
         // Squares of so small a residual underflow (a chain at rest to
-        // round-off after a long damped run: |b| ~ 1e-162), which would
+        // round-off after a long backward Euler run: |b| ~ 1e-162), which would
         // stop CG at its first step with zero curvature: solve for `x /
         // max |b_i|` with that scaled right-hand side, then scale back.
         // Above this size nothing changes (same bits).

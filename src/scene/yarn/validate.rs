@@ -209,6 +209,32 @@ impl YarnScene {
         }
     }
 
+    /// `[transfer]`: a `flip_time` is positive (the reader checks it in a
+    /// file; a scene built in code too) and not given beside a
+    /// `flip_ratio` other than 1.
+    fn validate_transfer(&self, text: Option<&str>) -> Result<(), SceneError> {
+        let tr = &self.transfer;
+        let Some(tau) = tr.flip_time else {
+            return Ok(());
+        };
+        let invalid = |message: String| SceneError::Invalid {
+            field: "transfer.flip_time".into(),
+            line: text.and_then(|t| key_line(t, "[transfer]", "flip_time")),
+            message,
+        };
+        if !(tau.is_finite() && tau > 0.0) {
+            return Err(invalid(format!("must be > 0, got {tau}")));
+        }
+        if tr.flip_ratio != 1.0 {
+            return Err(invalid(format!(
+                "give transfer.flip_ratio (a blend per substep) or transfer.flip_time (a \
+                 relaxation time), not both; flip_ratio is {}",
+                tr.flip_ratio
+            )));
+        }
+        Ok(())
+    }
+
     fn validate_time(&self, text: Option<&str>) -> Result<(), SceneError> {
         let t = &self.time;
         let invalid = |field: &str, message: String| SceneError::Invalid {
@@ -225,29 +251,9 @@ impl YarnScene {
                 ),
             ));
         }
+        // before the axial check below, which reads `flip_time`
+        self.validate_transfer(text)?;
         let tr = &self.transfer;
-        let flip_time_line = || text.and_then(|t| key_line(t, "[transfer]", "flip_time"));
-        if let Some(tau) = tr.flip_time {
-            // the reader checks it in a file; a scene built in code too
-            if !(tau.is_finite() && tau > 0.0) {
-                return Err(SceneError::Invalid {
-                    field: "transfer.flip_time".into(),
-                    line: flip_time_line(),
-                    message: format!("must be > 0, got {tau}"),
-                });
-            }
-        }
-        if tr.flip_time.is_some() && tr.flip_ratio != 1.0 {
-            return Err(SceneError::Invalid {
-                field: "transfer.flip_time".into(),
-                line: flip_time_line(),
-                message: format!(
-                    "give transfer.flip_ratio (a blend per substep) or transfer.flip_time (a \
-                     relaxation time), not both; flip_ratio is {}",
-                    tr.flip_ratio
-                ),
-            });
-        }
         if t.axial.is_implicit() && tr.scheme == TransferScheme::Flip && tr.flip_time.is_none() {
             return Err(invalid(
                 "axial",
