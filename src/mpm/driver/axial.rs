@@ -19,8 +19,22 @@
 //! optimization form of backward Euler, Gast, Schroeder, Stomakhin, Jiang,
 //! Teran 2015), found by the projected Newton of the grid-free integrator
 //! ([`crate::mpm::implicit_vertex::newton`], a banded Cholesky solve per
-//! iteration, block tridiagonal here) with no bending, attractor or contact
-//! term and the pinned vertices held (`dv = 0`). `M` lumps a vertex and
+//! iteration, block tridiagonal here) with no bending, attractor or
+//! friction term and the pinned vertices held (`dv = 0`). The solve knows
+//! the two boundaries the grid step enforces and it would otherwise undo:
+//! a vertex the springs would carry past the grid's bounds (where the
+//! gather clamps it, [`crate::mpm::laws::contact::grid_bounds`]) ends on
+//! them, held by a normal-velocity constraint
+//! ([`crate::mpm::implicit_vertex::contacts`]; a clamp after the solve
+//! compressed the segment instead); and a sticky wall, which takes the
+//! share `h` of the force on a vertex whose stencil reaches its nodes
+//! ([`crate::mpm::laws::contact::sticky_share`]), lets the springs move
+//! that vertex as if it weighed `m / (1 - h)` (held where `h = 1`;
+//! without it the springs pulled a yarn's end out of the wall, its FLIP
+//! velocity growing while the wall held its position). The obstacles are
+//! not in the solve: the gather leaves the vertices outside them, and a
+//! vertex the solve leaves inside one is pushed back with the circle's
+//! Coulomb law on its inward velocity, as the gather does. `M` lumps a vertex and
 //! half of each adjacent segment's quadrature particle, and each
 //! quadrature particle takes the mean `dv` of its two vertices after its
 //! gather, so the step keeps the momentum (the spring forces cancel in
@@ -47,10 +61,19 @@ use rayon::prelude::*;
 use super::{SimError, YarnSim};
 use crate::math::Vec2;
 use crate::mpm::implicit_vertex::newton::{self, Constraint};
-use crate::mpm::implicit_vertex::{Rod, Settings};
+use crate::mpm::implicit_vertex::{contacts, Rod, Settings};
 use crate::mpm::laws::constitutive::YarnEnergy;
-use crate::mpm::laws::contact::{grid_bounds, keep_in_domain};
+use crate::mpm::laws::contact::{grid_bounds, keep_in_domain, sticky_share};
 use crate::mpm::machinery::particles::Particles;
+use crate::scene::WallMode;
+
+/// The relative round-off of the step's energy at the strains of a stiff
+/// fibre (see [`round_off`]): a predicted decrease below this fraction of
+/// the energy is not there to find (1e-13 in the grid-free integrator; a
+/// yarn thrown into a corner at k = 1e7 stopped its line search with the
+/// predicted decrease at 1.2e-13 of the energy and the gradient at half
+/// its first value, measured).
+const DECREASE_TOL: f64 = 1e-8;
 
 /// 100 times the round-off of the step's gradient `|g|_{M^-1}` (the
 /// Newton solve's absolute tolerance, beside a relative one of 1e-4 of the
@@ -67,7 +90,9 @@ use crate::mpm::machinery::particles::Particles;
 /// the gradient has fallen by 1e-3 (`floor_tol`, 1e-6 in the grid-free
 /// integrator): the spring energy `a / 2 (|e| / l0 - 1)^2` is computed to
 /// a relative precision of about `eps |x| / |e| / (|e| / l0 - 1)`, 1e-8 at
-/// the strains of a stiff fibre (1e-6 at k = 1e7 on the reference bundle).
+/// the strains of a stiff fibre (1e-6 at k = 1e7 on the reference bundle),
+/// and for the same reason Newton stops where its step would lower the
+/// energy by less than 1e-8 of it ([`DECREASE_TOL`]).
 fn round_off(rod: &Rod) -> f64 {
     let stiff = rod
         .segments
@@ -85,10 +110,14 @@ fn round_off(rod: &Rod) -> f64 {
 type YarnStep = Result<(Vec<Vec2>, Vec<Vec2>, usize), String>;
 
 /// The backward Euler step of the axial springs of the yarn with vertices
-/// `range` (see the module docs) from the positions `x*` the vertices have.
+/// `range` (see the module docs) from the positions `x*` the vertices
+/// have, inside `bounds` ([`grid_bounds`]) on both axes, with each
+/// vertex's `wall_share` ([`sticky_share`]; empty: none).
 fn yarn_step(
     p: &Particles,
     pinned: &[bool],
+    bounds: (f64, f64),
+    wall_share: &[f64],
     k: f64,
     dt: f64,
     range: std::ops::Range<usize>,
@@ -102,6 +131,23 @@ fn yarn_step(
         m[i + 1 - range.start] += 0.5 * q.m[s];
         segments.push((q.vol[s] * k, q.l0[s]));
     }
+    // a sticky wall absorbs the share `h` of a force on a vertex in its
+    // reach: the vertex answers the springs as `m / (1 - h)` would, and
+    // not at all where the wall holds its whole stencil
+    let mut fixed: Vec<Option<Vec2>> = pinned[range.clone()]
+        .iter()
+        .map(|&p| p.then(Vec2::zeros))
+        .collect();
+    if !wall_share.is_empty() {
+        for (i, (m, f)) in m.iter_mut().zip(fixed.iter_mut()).enumerate() {
+            let h = wall_share[range.start + i];
+            if h >= 1.0 {
+                *f = Some(Vec2::zeros());
+            } else if h > 0.0 {
+                *m /= 1.0 - h;
+            }
+        }
+    }
     let n = range.len();
     let rod = Rod {
         x: v.x[range.clone()].to_vec(),
@@ -113,22 +159,18 @@ fn yarn_step(
         bend: Vec::new(),
         attractor: None,
     };
-    let cons: Vec<Constraint> = pinned[range]
-        .iter()
-        .map(|&p| {
-            if p {
-                Constraint::Fixed(Vec2::zeros())
-            } else {
-                Constraint::Free
-            }
-        })
-        .collect();
     let settings = Settings {
         rel_tol: 1e-4,
         abs_tol: round_off(&rod),
         floor_tol: 1e-3,
+        decrease_tol: DECREASE_TOL,
         ..Settings::default()
     };
+    // the springs alone, and where that leaves a vertex beyond the grid's
+    // bounds, the solve that holds it on them (the same first solve)
+    let cons: Vec<Constraint> = (fixed.iter())
+        .map(|f| f.map_or(Constraint::Free, Constraint::Fixed))
+        .collect();
     let out = newton::solve(
         &rod,
         &cons,
@@ -136,6 +178,14 @@ fn yarn_step(
         vec![Vec2::zeros(); n],
         &settings,
     )?;
+    let beyond = |(x, v): (&Vec2, &Vec2)| {
+        let y = x + v * dt;
+        y.x < bounds.0 || y.y < bounds.0 || y.x > bounds.1 || y.y > bounds.1
+    };
+    if !rod.x.iter().zip(&out.v).any(beyond) {
+        return Ok((out.v, out.gradient, out.newton));
+    }
+    let out = contacts::step(&rod, &fixed, &[], Some(bounds), dt, &settings)?;
     Ok((out.v, out.gradient, out.newton))
 }
 
@@ -162,9 +212,24 @@ impl YarnSim {
     pub(super) fn axial_step(&mut self, dt: f64) -> Result<Vec<Vec2>, SimError> {
         let k = self.energy.k;
         let yv = &self.particles.yarn_vertices;
+        let geom = self.grid.geom;
+        let bounds = grid_bounds(geom.dx, geom.n);
+        let sticky = self.passes().walls && self.scene.walls.mode == WallMode::Sticky;
+        let wall_share: Vec<f64> = if sticky {
+            let cells = self.scene.walls.cells as usize;
+            (self.particles.vert.x.iter())
+                .map(|&x| sticky_share(cells, geom.n, geom.inv_dx, x))
+                .collect()
+        } else {
+            Vec::new()
+        };
         let steps: Vec<YarnStep> = (0..yv.len() - 1)
             .into_par_iter()
-            .map(|y| yarn_step(&self.particles, &self.pinned, k, dt, yv[y]..yv[y + 1]))
+            .map(|y| {
+                let range = yv[y]..yv[y + 1];
+                let p = &self.particles;
+                yarn_step(p, &self.pinned, bounds, &wall_share, k, dt, range)
+            })
             .collect();
         let mut dv = Vec::with_capacity(self.particles.vert.x.len());
         let mut impulse = Vec::with_capacity(self.particles.vert.x.len());
@@ -196,8 +261,6 @@ impl YarnSim {
                 .iter()
                 .fold(Vec2::zeros(), |a, &i| a + impulse[i] / dt);
         }
-        let geom = self.grid.geom;
-        let bounds = grid_bounds(geom.dx, geom.n);
         let obstacles = super::substep::active_obstacles(&self.obstacles, self.passes());
         let vert = &mut self.particles.vert;
         for ((x, v), d) in vert.x.iter_mut().zip(vert.v.iter_mut()).zip(&dv) {

@@ -73,7 +73,7 @@ impl YarnSim {
         }
         let obstacles = active_obstacles(&self.obstacles, self.passes());
         let settings = Settings::default();
-        let out = match implicit_vertex::step(&rod, &fixed, obstacles, dt, &settings) {
+        let out = match implicit_vertex::step(&rod, &fixed, obstacles, None, dt, &settings) {
             Ok(out) => out,
             Err(what) => {
                 let e = SimError::NonFinite {

@@ -45,6 +45,7 @@
 //! touching mass only, inside too ([`normal_share`]): a yarn's centre line
 //! rests `d / 2` from the surface whatever the cell.
 
+use crate::math::bspline::Stencil;
 use crate::math::Vec2;
 pub use crate::mpm::machinery::grid::ContactNode;
 use crate::scene::{Obstacle, WallMode};
@@ -375,6 +376,27 @@ pub fn wall_velocity(
     }
 }
 
+/// The share of the stencil weight of a particle at `x` (quadratic
+/// B-spline, [`Stencil`]) on the nodes a sticky wall `cells` thick holds
+/// on an `n`-node grid of spacing `1 / inv_dx` ([`wall_velocity`]): the
+/// fraction of a force on the particle that the wall absorbs, 0 away
+/// from the walls and 1 deep inside them.
+#[inline]
+pub fn sticky_share(cells: usize, n: usize, inv_dx: f64, x: Vec2) -> f64 {
+    let s = Stencil::new(x, inv_dx);
+    let mut held = 0.0;
+    for i in 0..3 {
+        for j in 0..3 {
+            let (ni, nj) = (s.base[0] + i as i32, s.base[1] + j as i32);
+            let inside = |k: i32| k >= cells as i32 && (k as i64) + (cells as i64) < n as i64;
+            if !(inside(ni) && inside(nj)) {
+                held += s.weight(i, j);
+            }
+        }
+    }
+    held
+}
+
 /// Where a particle ends its move of a substep: outside every obstacle of
 /// `obstacles` ([`project_out`]), then where its stencil stays on the grid
 /// ([`clamp_to_grid`] within [`grid_bounds`]).
@@ -453,6 +475,50 @@ mod tests {
         let far = Vec2::new(0.5, 0.611);
         assert_eq!(normal_share(&o, near, 0.25, 0.0, reach).0, 0.25);
         assert_eq!(normal_share(&o, far, 0.25, 0.0, reach).0, 0.0);
+    }
+
+    /// The sticky share is the stencil weight on the nodes
+    /// [`wall_velocity`] holds: 0 where no held node is in reach, 1 where
+    /// all are, between at the edge of the wall; the same at each wall.
+    #[test]
+    fn sticky_share_is_the_weight_on_the_held_nodes() {
+        let (cells, n) = (3, 64);
+        let inv_dx = 64.0;
+        let held = |i: i32, j: i32| {
+            let v = wall_velocity(
+                WallMode::Sticky,
+                cells,
+                n,
+                i as usize,
+                j as usize,
+                Vec2::new(1.0, 1.0),
+            );
+            v == Vec2::zeros()
+        };
+        for x in [
+            Vec2::new(0.5, 0.5),
+            Vec2::new(0.03, 0.5),
+            Vec2::new(0.07, 0.5),
+            Vec2::new(0.5, 0.97),
+            Vec2::new(0.02, 0.02),
+        ] {
+            let s = Stencil::new(x, inv_dx);
+            let mut want = 0.0;
+            for i in 0..3 {
+                for j in 0..3 {
+                    if held(s.base[0] + i as i32, s.base[1] + j as i32) {
+                        want += s.weight(i, j);
+                    }
+                }
+            }
+            assert_eq!(sticky_share(cells, n, inv_dx, x), want, "at {x:?}");
+        }
+        assert_eq!(sticky_share(cells, n, inv_dx, Vec2::new(0.5, 0.5)), 0.0);
+        assert!((sticky_share(cells, n, inv_dx, Vec2::new(0.02, 0.5)) - 1.0).abs() < 1e-12);
+        let edge = sticky_share(cells, n, inv_dx, Vec2::new(0.03, 0.5));
+        assert!(edge > 0.5 && edge < 1.0, "{edge}");
+        let mirrored = sticky_share(cells, n, inv_dx, Vec2::new(1.0 - 0.03 - 1.0 / 64.0, 0.5));
+        assert!((mirrored - edge).abs() < 1e-12, "{mirrored} {edge}");
     }
 
     #[test]
