@@ -217,7 +217,7 @@ impl YarnSim {
         let sticky = self.passes().walls && self.scene.walls.mode == WallMode::Sticky;
         // the step's buffers live from one substep to the next (allocated
         // and freed each substep, they cost the allocator's trimming and
-        // page faults: 3 to 6 % of the stiff bundle's run, measured)
+        // page faults: about 2 % of the stiff bundle's wall time, measured)
         let mut scratch = std::mem::take(&mut self.axial_scratch);
         scratch.wall_share.clear();
         if sticky {
