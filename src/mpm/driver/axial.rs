@@ -206,33 +206,39 @@ impl YarnSim {
 
     /// The axial springs' backward Euler step over `dt` of every yarn,
     /// after the vertex gather and the pins (see the module docs): moves
-    /// the vertices and returns each vertex's velocity change for
+    /// the vertices and keeps each vertex's velocity change for
     /// [`YarnSim::axial_quads`]. On a failed solve the error is recorded
     /// in `failed`.
-    pub(super) fn axial_step(&mut self, dt: f64) -> Result<Vec<Vec2>, SimError> {
+    pub(super) fn axial_step(&mut self, dt: f64) -> Result<(), SimError> {
         let k = self.energy.k;
         let yv = &self.particles.yarn_vertices;
         let geom = self.grid.geom;
         let bounds = grid_bounds(geom.dx, geom.n);
         let sticky = self.passes().walls && self.scene.walls.mode == WallMode::Sticky;
-        let wall_share: Vec<f64> = if sticky {
+        // the step's buffers live from one substep to the next (allocated
+        // and freed each substep, they cost the allocator's trimming and
+        // page faults: about 2 % of the stiff bundle's wall time, measured)
+        let mut scratch = std::mem::take(&mut self.axial_scratch);
+        scratch.wall_share.clear();
+        if sticky {
             let cells = self.scene.walls.cells as usize;
-            (self.particles.vert.x.iter())
-                .map(|&x| sticky_share(cells, geom.n, geom.inv_dx, x))
-                .collect()
-        } else {
-            Vec::new()
-        };
+            let share = |&x| sticky_share(cells, geom.n, geom.inv_dx, x);
+            scratch
+                .wall_share
+                .extend(self.particles.vert.x.iter().map(share));
+        }
+        let wall_share = &scratch.wall_share;
         let steps: Vec<YarnStep> = (0..yv.len() - 1)
             .into_par_iter()
             .map(|y| {
                 let range = yv[y]..yv[y + 1];
                 let p = &self.particles;
-                yarn_step(p, &self.pinned, bounds, &wall_share, k, dt, range)
+                yarn_step(p, &self.pinned, bounds, wall_share, k, dt, range)
             })
             .collect();
-        let mut dv = Vec::with_capacity(self.particles.vert.x.len());
-        let mut impulse = Vec::with_capacity(self.particles.vert.x.len());
+        let (dv, impulse) = (&mut scratch.dv, &mut scratch.impulse);
+        dv.clear();
+        impulse.clear();
         let (mut newton, mut max_newton) = (0, 0);
         for (y, s) in steps.into_iter().enumerate() {
             match s {
@@ -249,6 +255,7 @@ impl YarnSim {
                         what: format!("the axial solve of yarn {y} failed: {what}"),
                     };
                     self.failed = Some(e.clone());
+                    self.axial_scratch = scratch;
                     return Err(e);
                 }
             }
@@ -263,7 +270,7 @@ impl YarnSim {
         }
         let obstacles = super::substep::active_obstacles(&self.obstacles, self.passes());
         let vert = &mut self.particles.vert;
-        for ((x, v), d) in vert.x.iter_mut().zip(vert.v.iter_mut()).zip(&dv) {
+        for ((x, v), d) in vert.x.iter_mut().zip(vert.v.iter_mut()).zip(dv.iter()) {
             *x += d * dt;
             *v += d;
             // as the gather leaves a vertex: outside the obstacles, inside
@@ -274,16 +281,30 @@ impl YarnSim {
         st.substeps += 1;
         st.newton += newton;
         st.max_newton = st.max_newton.max(max_newton);
-        Ok(dv)
+        self.axial_scratch = scratch;
+        Ok(())
     }
 
     /// Each quadrature particle's share of the axial step: the mean
     /// velocity change `dv` of its two vertices, after its gather.
-    pub(super) fn axial_quads(&mut self, dv: &[Vec2]) {
+    pub(super) fn axial_quads(&mut self) {
+        let dv = &self.axial_scratch.dv;
         let q = &mut self.particles.quad;
         for (v, &l) in q.v.iter_mut().zip(&q.left) {
             let l = l as usize;
             *v += (dv[l] + dv[l + 1]) * 0.5;
         }
     }
+}
+
+/// The buffers of [`YarnSim::axial_step`], kept from one substep to the
+/// next (not part of the state: each substep overwrites them).
+#[derive(Clone, Debug, Default)]
+pub struct AxialScratch {
+    /// Each vertex's velocity change, for [`YarnSim::axial_quads`].
+    dv: Vec<Vec2>,
+    /// Each vertex's constraint impulse (`dE/dv`).
+    impulse: Vec<Vec2>,
+    /// Each vertex's [`sticky_share`] (empty without sticky walls).
+    wall_share: Vec<f64>,
 }

@@ -91,6 +91,8 @@ pub struct YarnSim {
     obstacles: Vec<Obstacle>,
     /// Newton and CG iterations of the implicit substeps.
     implicit_stats: ImplicitStats,
+    /// The axial solve's buffers (`[time] axial = "implicit"`).
+    axial_scratch: axial::AxialScratch,
 }
 
 /// The transfer scheme a scene asks for.
@@ -178,6 +180,7 @@ impl YarnSim {
             timings: PassTimes::default(),
             scene: scene.clone(),
             implicit_stats: ImplicitStats::default(),
+            axial_scratch: Default::default(),
         };
         if sim.is_auto() {
             // Not used under "auto"; kept positive for the saved state.

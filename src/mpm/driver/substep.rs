@@ -217,11 +217,10 @@ impl YarnSim {
         }
         // `axial = "implicit"`: the fibre springs' step on the vertices
         // (`axial.rs`), before the quadrature particles read their edges
-        let axial_dv = if self.scene.time.axial.is_implicit() && bad_v.is_none() {
-            Some(self.axial_step(dt)?)
-        } else {
-            None
-        };
+        let axial = self.scene.time.axial.is_implicit() && bad_v.is_none();
+        if axial {
+            self.axial_step(dt)?;
+        }
         let t4 = Instant::now();
         let bad_q = grid_to_particle::gather_quads(
             &mut self.particles.quad,
@@ -235,8 +234,8 @@ impl YarnSim {
             passes.plasticity,
             transfer,
         );
-        if let Some(dv) = &axial_dv {
-            self.axial_quads(dv);
+        if axial {
+            self.axial_quads();
         }
         if flip {
             spin::balance(&mut self.particles, &self.pinned);
