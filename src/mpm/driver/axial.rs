@@ -34,11 +34,13 @@
 //! velocity growing while the wall held its position). The obstacles are
 //! not in the solve: the gather leaves the vertices outside them, and a
 //! vertex the solve leaves inside one is pushed back with the circle's
-//! Coulomb law on its inward velocity, as the gather does. `M` lumps a vertex and
-//! half of each adjacent segment's quadrature particle, and each
-//! quadrature particle takes the mean `dv` of its two vertices after its
-//! gather, so the step keeps the momentum (the spring forces cancel in
-//! pairs). Under APIC every particle takes the grid's velocity at each
+//! Coulomb law on its inward velocity, as the gather does. A slip wall
+//! gets no such share: the grid removes only the outward velocity at its
+//! nodes, and the bounds hold the vertex. `M` lumps a vertex and half of
+//! each adjacent segment's quadrature particle, and each quadrature
+//! particle takes the mean `dv` of its two vertices after its gather, so
+//! away from the walls the step keeps the momentum (the spring forces
+//! cancel in pairs; a wall takes what it holds). Under APIC every particle takes the grid's velocity at each
 //! transfer, so what the grid cannot hold of `dv` is dropped at the next
 //! one. Under FLIP a particle keeps its own velocity but moves with the
 //! grid's: the vertex-scale part of `dv` would stay in the particles'
@@ -51,8 +53,8 @@
 //! ([`crate::mpm::machinery::transfer::Transfer::at_step`]); at 2 and 4
 //! ms the bundle never gains energy from one frame to the next over its
 //! second, at 8 ms it gains 1.0 J in a frame, at 20 ms 2.3 J, and at
-//! 100 ms it diverges (measured at dt 4e-5). Shear, the cross-section, bending, gravity and contact stay
-//! explicit on the grid; the yarns' solves are independent and run in
+//! 100 ms it diverges (measured at dt 4e-5). Shear, the cross-section,
+//! bending, gravity and contact stay explicit on the grid; the yarns' solves are independent and run in
 //! parallel, each sequentially, so the result has the same bits for any
 //! thread count.
 
@@ -72,7 +74,10 @@ use crate::scene::WallMode;
 /// the energy is not there to find (1e-13 in the grid-free integrator; a
 /// yarn thrown into a corner at k = 1e7 stopped its line search with the
 /// predicted decrease at 1.2e-13 of the energy and the gradient at half
-/// its first value, measured).
+/// its first value, measured). The energy holds the tension a yarn
+/// carries, so this stops Newton at an unbalanced impulse of about 1e-4
+/// of that tension's (its strain's error 1e-4 of the strain), where the
+/// relative tolerance asks 1e-4 of the step's first gradient.
 const DECREASE_TOL: f64 = 1e-8;
 
 /// 100 times the round-off of the step's gradient `|g|_{M^-1}` (the
@@ -141,7 +146,8 @@ fn yarn_step(
     if !wall_share.is_empty() {
         for (i, (m, f)) in m.iter_mut().zip(fixed.iter_mut()).enumerate() {
             let h = wall_share[range.start + i];
-            if h >= 1.0 {
+            // a stencil held whole sums its nine weights to 1 less round-off
+            if h >= 1.0 - 1e-12 {
                 *f = Some(Vec2::zeros());
             } else if h > 0.0 {
                 *m /= 1.0 - h;
@@ -185,8 +191,10 @@ fn yarn_step(
     if !rod.x.iter().zip(&out.v).any(beyond) {
         return Ok((out.v, out.gradient, out.newton));
     }
+    // (contacts::step repeats that first solve: only near the bounds)
+    let first = out.newton;
     let out = contacts::step(&rod, &fixed, &[], Some(bounds), dt, &settings)?;
-    Ok((out.v, out.gradient, out.newton))
+    Ok((out.v, out.gradient, first + out.newton))
 }
 
 impl YarnSim {
@@ -300,7 +308,7 @@ impl YarnSim {
 /// The buffers of [`YarnSim::axial_step`], kept from one substep to the
 /// next (not part of the state: each substep overwrites them).
 #[derive(Clone, Debug, Default)]
-pub struct AxialScratch {
+pub(super) struct AxialScratch {
     /// Each vertex's velocity change, for [`YarnSim::axial_quads`].
     dv: Vec<Vec2>,
     /// Each vertex's constraint impulse (`dE/dv`).

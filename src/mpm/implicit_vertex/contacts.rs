@@ -14,8 +14,8 @@
 //! explicit substep) is held the same way, without friction: a vertex that
 //! would end beyond a wall takes `n . v_i = (wall - x_i) / dt` along the
 //! wall's inward normal, and one that would end beyond two (or that one
-//! wall's constraint leaves beyond the other) ends in their corner for
-//! the step. Friction bounds the tangential impulse by `mu lambda_i`
+//! wall's constraint leaves beyond the other) ends in their corner, which
+//! lets go of a wall whose impulse pulls. Friction bounds the tangential impulse by `mu lambda_i`
 //! (smoothed below `eps_v`, [`super::newton::Settings`]), with `lambda`
 //! from the previous round of the same step (round 0 frictionless): the
 //! rounds stop when the set is unchanged and no `lambda` moved by more than
@@ -239,6 +239,29 @@ pub fn step(
                         }
                     }
                 }
+                (Some(Touch::Corner(upper)), _) => {
+                    // the corner's impulse along each wall's inward
+                    // normal: a wall that pulls lets go, and the vertex
+                    // keeps the other if that one pushes
+                    let g = sol.gradient[i];
+                    let pushes = |a: usize| if upper[a] { -g[a] } else { g[a] } >= 0.0;
+                    let keep = match (pushes(0), pushes(1)) {
+                        (true, true) => touch[i],
+                        (true, false) => Some(Touch::Wall {
+                            axis: 0,
+                            upper: upper[0],
+                        }),
+                        (false, true) => Some(Touch::Wall {
+                            axis: 1,
+                            upper: upper[1],
+                        }),
+                        (false, false) => None,
+                    };
+                    if keep != touch[i] {
+                        touch[i] = keep;
+                        changed = true;
+                    }
+                }
                 _ if base[i] == Constraint::Free => {
                     if let Some(k) = inside(obstacles, walls, y[i]) {
                         touch[i] = Some(k);
@@ -335,8 +358,8 @@ mod tests {
         assert_eq!(out.v[0], Vec2::new(-1.0, 0.0));
     }
 
-    /// A vertex driven beyond two walls ends in their corner, whichever
-    /// it would cross first.
+    /// A vertex driven beyond two walls ends in their corner, whether it
+    /// moves more along one axis or the other.
     #[test]
     fn a_vertex_driven_into_a_corner_ends_in_it() {
         let walls = Some((0.0, 1.0));
@@ -349,6 +372,30 @@ mod tests {
                 "ends at {end:?}"
             );
         }
+    }
+
+    /// A corner lets go of a wall that pulls: a vertex driven into the
+    /// corner (0, 1) on a stiff spring to a held vertex 0.09 below it ends
+    /// on the wall x = 0 the spring presses it against, below y = 1, which
+    /// it would only reach with the upper wall pulling it up.
+    #[test]
+    fn a_corner_lets_go_of_a_wall_that_pulls() {
+        let walls = Some((0.0, 1.0));
+        let rod = Rod {
+            x: vec![Vec2::new(0.02, 0.99), Vec2::new(0.02, 0.9)],
+            m: vec![1.0, 1.0],
+            vstar: vec![Vec2::new(-1.0, 0.5), Vec2::zeros()],
+            dt: 0.1,
+            segments: vec![(1e4, 0.09)],
+            bending: 0.0,
+            bend: Vec::new(),
+            attractor: None,
+        };
+        let fixed = [None, Some(Vec2::zeros())];
+        let out = step(&rod, &fixed, &[], walls, 0.1, &settings()).unwrap();
+        let end = rod.x[0] + out.v[0] * 0.1;
+        assert!(end.x.abs() < 1e-12, "ends at {end:?}");
+        assert!(end.y < 1.0, "ends at {end:?}");
     }
 
     /// A wall and then the other axis's wall make a corner; the same wall,
