@@ -337,6 +337,14 @@ pub fn obstacle_friction(
     }
 }
 
+/// Whether node `k` of an `n`-node axis lies in the lower and in the upper
+/// wall, `cells` thick: the nodes [`wall_velocity`] holds and
+/// [`sticky_share`] weighs.
+#[inline(always)]
+fn in_walls(cells: usize, n: usize, k: usize) -> (bool, bool) {
+    (k < cells, k + cells >= n)
+}
+
 /// Velocity of grid node `(i, j)` after the walls (`cells` thick) of an `n`-node grid.
 #[inline(always)]
 pub fn wall_velocity(
@@ -347,8 +355,8 @@ pub fn wall_velocity(
     j: usize,
     mut v: Vec2,
 ) -> Vec2 {
-    let (lo_x, hi_x) = (i < cells, i + cells >= n);
-    let (lo_y, hi_y) = (j < cells, j + cells >= n);
+    let (lo_x, hi_x) = in_walls(cells, n, i);
+    let (lo_y, hi_y) = in_walls(cells, n, j);
     match mode {
         WallMode::None => v,
         WallMode::Sticky => {
@@ -384,12 +392,16 @@ pub fn wall_velocity(
 #[inline]
 pub fn sticky_share(cells: usize, n: usize, inv_dx: f64, x: Vec2) -> f64 {
     let s = Stencil::new(x, inv_dx);
+    // a particle keeps `x >= dx` (`clamp_to_grid`): its stencil's nodes
+    // are not negative
+    let walled = |axis: usize, k: usize| {
+        let (lo, hi) = in_walls(cells, n, s.base[axis] as usize + k);
+        lo || hi
+    };
     let mut held = 0.0;
     for i in 0..3 {
         for j in 0..3 {
-            let (ni, nj) = (s.base[0] + i as i32, s.base[1] + j as i32);
-            let inside = |k: i32| k >= cells as i32 && (k as i64) + (cells as i64) < n as i64;
-            if !(inside(ni) && inside(nj)) {
+            if walled(0, i) || walled(1, j) {
                 held += s.weight(i, j);
             }
         }
