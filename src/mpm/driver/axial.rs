@@ -62,7 +62,7 @@ use rayon::prelude::*;
 
 use super::{SimError, YarnSim};
 use crate::math::Vec2;
-use crate::mpm::implicit_vertex::newton::{self, Constraint};
+use crate::mpm::implicit_vertex::newton;
 use crate::mpm::implicit_vertex::{contacts, Rod, Settings};
 use crate::mpm::laws::constitutive::YarnEnergy;
 use crate::mpm::laws::contact::{grid_bounds, keep_in_domain, sticky_share};
@@ -174,20 +174,14 @@ fn yarn_step(
     };
     // the springs alone, and where that leaves a vertex beyond the grid's
     // bounds, the solve that holds it on them (the same first solve)
-    let cons: Vec<Constraint> = (fixed.iter())
-        .map(|f| f.map_or(Constraint::Free, Constraint::Fixed))
-        .collect();
     let out = newton::solve(
         &rod,
-        &cons,
+        &contacts::held(&fixed),
         &vec![None; n],
         vec![Vec2::zeros(); n],
         &settings,
     )?;
-    let beyond = |(x, v): (&Vec2, &Vec2)| {
-        let y = x + v * dt;
-        y.x < bounds.0 || y.y < bounds.0 || y.x > bounds.1 || y.y > bounds.1
-    };
+    let beyond = |(x, v): (&Vec2, &Vec2)| contacts::inside(&[], Some(bounds), x + v * dt).is_some();
     if !rod.x.iter().zip(&out.v).any(beyond) {
         return Ok((out.v, out.gradient, out.newton));
     }

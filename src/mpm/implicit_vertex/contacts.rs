@@ -38,7 +38,7 @@ pub const LAMBDA_RTOL: f64 = 1e-4;
 /// What a vertex touches: an obstacle (by index) or a wall of the box,
 /// along `axis` (0: x, 1: y), the lower or the upper one.
 #[derive(Clone, Copy, Debug, PartialEq)]
-enum Touch {
+pub(crate) enum Touch {
     Circle(usize),
     Wall {
         axis: usize,
@@ -91,9 +91,16 @@ fn ahead(rod: &Rod, v: &[Vec2], reach: f64) -> Vec<Vec2> {
     rod.x.iter().zip(v).map(|(x, v)| x + v * reach).collect()
 }
 
+/// The constraints of vertices held at `fixed` velocities (`None`: free).
+pub(crate) fn held(fixed: &[Option<Vec2>]) -> Vec<Constraint> {
+    (fixed.iter())
+        .map(|f| f.map_or(Constraint::Free, Constraint::Fixed))
+        .collect()
+}
+
 /// What a position `y` is inside: the deepest obstacle, else the wall of
 /// `walls` (`[lo, hi]` on both axes) it is beyond, or the corner.
-fn inside(obstacles: &[Obstacle], walls: Option<(f64, f64)>, y: Vec2) -> Option<Touch> {
+pub(crate) fn inside(obstacles: &[Obstacle], walls: Option<(f64, f64)>, y: Vec2) -> Option<Touch> {
     let mut best: Option<(usize, f64)> = None;
     for (k, o) in obstacles.iter().enumerate() {
         let depth = o.radius - outward(o, y).1;
@@ -182,10 +189,7 @@ pub fn step(
     s: &Settings,
 ) -> Result<Stepped, String> {
     let n = rod.len();
-    let base: Vec<Constraint> = fixed
-        .iter()
-        .map(|f| f.map_or(Constraint::Free, Constraint::Fixed))
-        .collect();
+    let base = held(fixed);
     // what each vertex touches
     let mut touch: Vec<Option<Touch>> = vec![None; n];
     let start = rod.vstar.clone();
