@@ -40,9 +40,9 @@
 //! each adjacent segment's quadrature particle, and each quadrature
 //! particle takes the mean `dv` of its two vertices after its gather, so
 //! away from the walls the step keeps the momentum (the spring forces
-//! cancel in pairs; a wall takes what it holds). Under APIC every particle takes the grid's velocity at each
-//! transfer, so what the grid cannot hold of `dv` is dropped at the next
-//! one. Under FLIP a particle keeps its own velocity but moves with the
+//! cancel in pairs; a wall takes what it holds). Under APIC every
+//! particle takes the grid's velocity at each transfer, so what the grid
+//! cannot hold of `dv` is dropped at the next one. Under FLIP a particle keeps its own velocity but moves with the
 //! grid's: the vertex-scale part of `dv` would stay in the particles'
 //! velocities while their positions never follow it, and with pure FLIP
 //! the run gains energy (the reference bundle at k = 1e7: up to 3.9 J from
@@ -54,9 +54,9 @@
 //! ms the bundle never gains energy from one frame to the next over its
 //! second, at 8 ms it gains 1.0 J in a frame, at 20 ms 2.3 J, and at
 //! 100 ms it diverges (measured at dt 4e-5). Shear, the cross-section,
-//! bending, gravity and contact stay explicit on the grid; the yarns' solves are independent and run in
-//! parallel, each sequentially, so the result has the same bits for any
-//! thread count.
+//! bending, gravity and contact stay explicit on the grid; the yarns'
+//! solves are independent and run in parallel, each sequentially, so the
+//! result has the same bits for any thread count.
 
 use rayon::prelude::*;
 

@@ -15,9 +15,10 @@
 //! would end beyond a wall takes `n . v_i = (wall - x_i) / dt` along the
 //! wall's inward normal, and one that would end beyond two (or that one
 //! wall's constraint leaves beyond the other) ends in their corner, which
-//! lets go of a wall whose impulse pulls. Friction bounds the tangential impulse by `mu lambda_i`
-//! (smoothed below `eps_v`, [`super::newton::Settings`]), with `lambda`
-//! from the previous round of the same step (round 0 frictionless): the
+//! lets go of a wall whose impulse pulls. Friction bounds the tangential
+//! impulse by `mu lambda_i` (smoothed below `eps_v`,
+//! [`super::newton::Settings`]), with `lambda` from the previous round of
+//! the same step (round 0 frictionless): the
 //! rounds stop when the set is unchanged and no `lambda` moved by more than
 //! [`LAMBDA_RTOL`] of the largest, at most [`MAX_ROUNDS`] (else an error,
 //! which the cutback answers by halving the substep). Nothing carries
