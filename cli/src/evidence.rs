@@ -31,6 +31,8 @@ pub enum BenchStudy {
     Precision {
         /// Output directory for precision*.csv, precision_<scene>.svg,
         /// precision_chain.svg, precision.txt.
+        // (clap prints this text as written: no Markdown)
+        #[allow(rustdoc::invalid_html_tags)]
         #[arg(long, value_name = "DIR", default_value = "evidence")]
         out: PathBuf,
         /// Fewer step sizes and shorter runs (seconds instead of a minute or two).

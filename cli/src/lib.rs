@@ -6,7 +6,7 @@
 //! * [`materials`]: `yarnsim materials`, the yarn presets.
 //! * [`run`]: `yarnsim run` (+ [`table`] for its summary).
 //! * [`record`]: `yarnsim record`, the only module that talks to Rerun.
-//! * [`bench`]: `yarnsim bench`.
+//! * [`bench`](mod@bench): `yarnsim bench`.
 //! * [`driver`], [`schedule`]: the frame loop, progress bar and Ctrl-C.
 //! * [`estimate`]: memory and recording-size estimates of large scenes.
 //! * [`yarn`]: how the commands start a yarn scene (the stable-step check)

@@ -1,8 +1,8 @@
 //! Work-precision of the reference bundle (`yarn-reference`: 12 yarns
 //! falling onto three circles, 256^2): each setting of a ladder (transfer
 //! scheme, contact fields, step size, integrator) is recorded with
-//! [`trajectory::record`] and compared with a reference trajectory with
-//! [`trajectory::compare`] over the common time window: the largest
+//! [`crate::trajectory::record`] and compared with a reference trajectory with
+//! [`crate::trajectory::compare`] over the common time window: the largest
 //! distance over the frames of the centre of mass (the converging
 //! observable) and of the 24 yarn ends (measured; they are sensitive to a
 //! 1e-9 perturbation, `/docs/performance/bundle-convergence.md`), against

@@ -231,7 +231,7 @@ pub fn yarn_stable(scene: &YarnScene, dt: f64) -> bool {
 
 /// The yarn's theoretical step bound (Courant number 1), see the module docs.
 /// The wave speed and the formula are the solver's
-/// ([`crate::mpm::driver::timestep::stable_dt`]); the speed is the one gravity and
+/// ([`yarnsim::mpm::driver::timestep::stable_dt`]); the speed is the one gravity and
 /// attractor can give over the probe time.
 pub fn yarn_bound(scene: &YarnScene) -> f64 {
     let g = Vec2::from(scene.gravity).norm();

@@ -5,12 +5,12 @@
 //!
 //! * [`scenes`]: the built-in `wire`, `three-particle` and `cloth`, each
 //!   parsed from its file under `scenes/massspring/` by
-//!   [`crate::scene::builtin`].
-//! * [`forces`]: spring, damping and gravity forces, energies, Hessian blocks.
-//! * [`linear`]: sparse matrix, PCG with Jacobi / IC(0), dense direct solve.
+//!   [`crate::scene::builtin`](mod@crate::scene::builtin).
+//! * `forces`: spring, damping and gravity forces, energies, Hessian blocks.
+//! * `linear`: sparse matrix, PCG with Jacobi / IC(0), dense direct solve.
 //! * [`integrators`]: forward / symplectic Euler, trapezoidal, backward Euler,
 //!   Chebyshev-accelerated Jacobi, PBD strain limiting, sphere collision.
-//! * [`driver`]: [`Simulation`], the frame loop and the choice of step size.
+//! * `driver`: [`Simulation`], the frame loop and the choice of step size.
 //!
 //! ```
 //! use yarnsim::massspring::{scenes, Integrator, IntegratorOptions, Simulation};
@@ -39,7 +39,7 @@ use crate::scene::SceneError;
 
 /// The built-in mass-spring scenes, each parsed from its file under
 /// `scenes/massspring/` (the one list of built-ins is
-/// [`crate::scene::builtin`]).
+/// [`crate::scene::builtin`](mod@crate::scene::builtin)).
 pub mod scenes {
     use crate::scene::{builtin, builtin_names, Scene};
 

@@ -1,5 +1,5 @@
 //! The unit and the accepted range of every scene-file field, in one place:
-//! the commented scene files of [`super::commented`] (`yarnsim scene show`)
+//! the commented scene files of `super::commented` (`yarnsim scene show`)
 //! write them, and a test compares them with the reference tables of
 //! `docs/scene-files.md`.
 //!

@@ -15,7 +15,7 @@
 //!   traffic: the working set of the reference scene (about 2 MB of
 //!   particles, 5 MB of grid window) stays in the caches.
 //! * The roofline: per pass, the measured time per substep of the
-//!   `yarn-reference` scene on 1 thread ([`YarnSim::timings`]) against
+//!   `yarn-reference` scene on 1 thread ([`yarnsim::YarnSim::timings`]) against
 //!   `min(peak flop/s, flop/byte x bandwidth)`, for the DRAM, L3 and L2
 //!   bandwidth; and the 20x-Taichi goal against the same bound.
 //!

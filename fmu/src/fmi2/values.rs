@@ -1,6 +1,6 @@
 //! The FMI 2.0 getters and setters: Real, Integer, Boolean (a C `int`) and
 //! String, as many values as value references; the table is the one the
-//! FMI 3.0 getters and setters share ([`crate::shell::value_exports`]).
+//! FMI 3.0 getters and setters share (`crate::shell::value_exports`).
 
 use super::*;
 use crate::shell::{get_strings, ok, set_strings, value_exports};

@@ -2,7 +2,7 @@
 //! (scalars and the array outputs, `nValues` checked against the sum of the
 //! array sizes), Int32 (the substep count and the execution parameters),
 //! Boolean (a C `bool`) and String. The table is that of the FMI 2.0 ones
-//! ([`crate::shell::value_exports`]), with `nValues`.
+//! (`crate::shell::value_exports`), with `nValues`.
 
 use std::ffi::c_int;
 

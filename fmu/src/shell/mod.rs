@@ -1,9 +1,9 @@
 //! The shell around every export of either FMI version, model- and
-//! version-neutral: [`call`] (the instance check, the logged failures, the
+//! version-neutral: `call` (the instance check, the logged failures, the
 //! caught panics), the helpers that turn C pointers into Rust values, the
 //! export macros both front ends ([`crate::fmi2`], [`crate::fmi3`]) build
 //! their tables with, and the bodies of the FMU-state functions
-//! ([`fmu_state`]). The C types it takes are those the two versions share:
+//! (`fmu_state`). The C types it takes are those the two versions share:
 //! an instance is a `void*`, a status a C `int` of the same values, a
 //! string a `const char*`.
 

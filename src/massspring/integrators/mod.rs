@@ -1,11 +1,11 @@
 //! Scene-independent time integrators (the course notes' "driver" side). Each one
 //! advances a [`State`] of a [`System`] by one step `h`; the frame loop and
-//! the choice of `h` live in [`crate::massspring::driver`].
+//! the choice of `h` live in `crate::massspring::driver`.
 //!
 //! * [`Integrator::ForwardEuler`], [`Integrator::SymplecticEuler`]: explicit,
 //!   step bounded by [`stability::StabilityInfo`].
 //! * [`Integrator::BackwardEuler`], [`Integrator::Trapezoidal`]: the velocity
-//!   system solved by PCG (Jacobi or IC(0)), see [`implicit`].
+//!   system solved by PCG (Jacobi or IC(0)), see `implicit`.
 //! * [`Integrator::ChebyshevJacobi`]: Wang 2015's optimisation form of
 //!   backward Euler, Jacobi iterations with Chebyshev acceleration.
 //! * [`Integrator::Pbd`]: Müller et al. 2007's position-based model (inertia, gravity

@@ -17,7 +17,7 @@ pub const SELF_WEIGHT: f64 = 0.2;
 pub enum StrainSolver {
     /// The Unity cloth scripts: every spring proposes positions for its two ends, each free
     /// vertex moves to the average of its proposals and itself (weight
-    /// [`SELF_WEIGHT`]). Order-independent, but it only approaches the limit
+    /// `SELF_WEIGHT`). Order-independent, but it only approaches the limit
     /// asymptotically (slowly on large sheets).
     #[default]
     Jacobi,

@@ -356,7 +356,7 @@ impl YarnSim {
     /// The normal impulse (N s per m of depth) the obstacles' contact law
     /// of the grid update delivered over the last substep, summed over the
     /// contact nodes of the grid (the impulse that bounds the obstacle
-    /// friction, [`crate::mpm::laws::contact`]); divided by the substep,
+    /// friction, `crate::mpm::laws::contact`); divided by the substep,
     /// the total normal force on the obstacles.
     pub fn obstacle_normal_impulse(&self) -> f64 {
         self.grid.contacts.iter().flatten().map(|c| c.impulse).sum()

@@ -30,7 +30,7 @@ pub const CHUNKS: usize = 4;
 /// by the bytes they stream, and six lanes ran 1.2x faster in the scatter
 /// than eight padded to a 64-byte line (same bits).
 pub type P2gNode = [f64; P2G_LANES];
-/// Lanes of a [`P2gNode`].
+/// Lanes of a `P2gNode`.
 pub const P2G_LANES: usize = 6;
 /// Lane of the x momentum in a [`P2gNode`].
 pub const PX: usize = 0;

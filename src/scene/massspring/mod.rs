@@ -8,7 +8,7 @@
 //! file form. See the README, "Mass-spring scene files", for every field with
 //! its unit and default.
 //!
-//! * [`system`]: the expanded scene, flat arrays.
+//! * `system`: the expanded scene, flat arrays.
 //! * `build`: the expansion, one function per scene element.
 
 mod build;

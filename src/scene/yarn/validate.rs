@@ -130,7 +130,7 @@ impl YarnScene {
     }
 
     /// A yarn that starts within `material.diameter / 2` of an obstacle's
-    /// surface ([`overlap::start_gap_warning`]); `None` without a diameter.
+    /// surface (`overlap::start_gap_warning`); `None` without a diameter.
     pub fn start_gap_warning(&self) -> Option<String> {
         overlap::start_gap_warning(self, self.material.diameter()?)
     }

@@ -1,6 +1,6 @@
 //! The yarn-bundle physics behind the `YarnBundle` FMU: inputs, parameter
 //! overrides, the [`YarnSim`] they build, the values of its variables
-//! ([`variables`](mod@variables) lists them; [`inputs`] holds the inputs) and its part of
+//! ([`variables`](mod@variables) lists them; `inputs` holds the inputs) and its part of
 //! a serialized FMU state.
 
 use std::path::Path;
