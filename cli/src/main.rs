@@ -150,8 +150,6 @@ struct SceneArgs {
     /// Override a scene field, KEY=VALUE with VALUE in TOML (repeatable):
     /// --set material.friction=0.1 --set gravity=[0,-3] --set yarns[0].count=4
     /// (an entry of a list as in error messages, `[0]`, or as `.0`).
-    // (clap prints this text as written: no Markdown)
-    #[allow(rustdoc::broken_intra_doc_links)]
     #[arg(long = "set", value_name = "KEY=VALUE")]
     set: Vec<String>,
 }
