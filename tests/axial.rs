@@ -314,9 +314,9 @@ const FLIP_TIME: f64 = 0.002;
 /// the bounds' clamp described below, 0.99947, passed) through the fall,
 /// the landing, the slide between the circles and the pile against the
 /// walls over its whole second (checked every 5 ms; measured [0.999981,
-/// 1.000011] at 4e-5 and [0.999818, 1.000007] at 2e-5), and its total energy never rises from
-/// one check to the next by more than 1e-4 of its start (measured: it
-/// falls at every check at 4e-5; at 2e-5 it rises once, by 2.4e-3 J, 3e-5
+/// 1.000011] at 4e-5 and [0.999818, 1.000007] at 2e-5), and its total
+/// energy never rises from one check to the next by more than 1e-4 of
+/// its start (measured: it falls at every check at 4e-5; at 2e-5 it rises once, by 2.4e-3 J, 3e-5
 /// of its start). At dt 1e-5 (not run here: 80 s) it keeps [0.999993,
 /// 1.000011] and falls at every check; under `dt = "auto"` it keeps
 /// [0.999994, 1.000017] but rises once by 0.14 J, at 0.905 s, where a

@@ -42,8 +42,9 @@
 //! away from the walls the step keeps the momentum (the spring forces
 //! cancel in pairs; a wall takes what it holds). Under APIC every
 //! particle takes the grid's velocity at each transfer, so what the grid
-//! cannot hold of `dv` is dropped at the next one. Under FLIP a particle keeps its own velocity but moves with the
-//! grid's: the vertex-scale part of `dv` would stay in the particles'
+//! cannot hold of `dv` is dropped at the next one. Under FLIP a particle
+//! keeps its own velocity but moves with the grid's: the vertex-scale
+//! part of `dv` would stay in the particles'
 //! velocities while their positions never follow it, and with pure FLIP
 //! the run gains energy (the reference bundle at k = 1e7: up to 3.9 J from
 //! one frame to the next after the landing, 26.5 J of kinetic energy at
