@@ -31,21 +31,28 @@
 //! ([`crate::mpm::laws::contact::sticky_share`]), lets the springs move
 //! that vertex as if it weighed `m / (1 - h)` (held where `h = 1`;
 //! without it the springs pulled a yarn's end out of the wall, its FLIP
-//! velocity growing while the wall held its position). The obstacles are
-//! not in the solve: the gather leaves the vertices outside them, and a
-//! vertex the solve leaves inside one is pushed back with the circle's
-//! Coulomb law on its inward velocity, as the gather does; where that
-//! placement would strain a segment by more than [`PLACED_STRAIN`], the
-//! vertex is held at the placed position and velocity and the yarn's
-//! springs are solved again around it (without it the placement crushed a
-//! stiff yarn's end segment, to 0.60 of its length for a yarn thrown end
-//! first at a circle at 3 m/s). A slip wall
-//! gets no such share: the grid removes only the outward velocity at its
-//! nodes, and the bounds hold the vertex. `M` lumps a vertex and half of
+//! velocity growing while the wall held its position). A slip wall gets
+//! no such share: the grid removes only the outward velocity at its
+//! nodes, and the bounds hold the vertex.
+//!
+//! The obstacles are not in the solve: the gather leaves the vertices
+//! outside them, and a vertex the solve leaves inside one is pushed back
+//! with the circle's Coulomb law on its inward velocity, as the gather
+//! does. Where that placement would strain one of the vertex's segments
+//! by more than [`PLACED_STRAIN`], the vertex is held at the placed
+//! position and velocity and the yarn's springs are solved again around
+//! it (without it the placement crushed a stiff yarn's end segment, to
+//! 0.60 of its length for a yarn thrown end first at a circle at 3 m/s;
+//! two neighbours held in one round keep the chord the placement gives
+//! their segment).
+//!
+//! `M` lumps a vertex and half of
 //! each adjacent segment's quadrature particle, and each quadrature
 //! particle takes the mean `dv` of its two vertices after its gather, so
-//! away from the walls the step keeps the momentum (the spring forces
-//! cancel in pairs; a wall takes what it holds). Under APIC every
+//! away from the walls and the obstacles the step keeps the momentum (the
+//! spring forces cancel in pairs; a wall or a circle takes what it holds,
+//! and the quadrature particles beside a vertex held on a circle take
+//! their share of the Coulomb law's change of its velocity). Under APIC every
 //! particle takes the grid's velocity at each transfer, so what the grid
 //! cannot hold of `dv` is dropped at the next one. Under FLIP a particle
 //! keeps its own velocity but moves with the grid's: the vertex-scale
@@ -117,13 +124,16 @@ fn round_off(rod: &Rod) -> f64 {
 }
 
 /// One yarn's axial step: the velocity change of each of its vertices,
-/// the impulse each constraint delivered (`dE/dv`, zero but at the pinned
-/// vertices), the Newton iterations it took, and the vertices it placed on
+/// the impulse each constraint delivered (`dE/dv`: zero to the solve's
+/// tolerance but at the held vertices, the pins, the grid's bounds, a
+/// sticky wall's whole share and the vertices held on a circle; the
+/// caller reads the pins'),
+/// the Newton iterations it took, and the vertices it placed on
 /// an obstacle (index in the yarn, position), see [`PLACED_STRAIN`].
 type YarnStep = Result<(Vec<Vec2>, Vec<Vec2>, usize, Vec<(usize, Vec2)>), String>;
 
-/// The strain, 1e-4 (a tenth of the `[0.999, 1.001]` band the stiff
-/// bundle is held to), that placing a vertex back on an obstacle's surface
+/// The strain, 1e-4 (a tenth of the goal's `[0.999, 1.001]` band for a
+/// stiff yarn's stretch), that placing a vertex back on an obstacle's surface
 /// may give one of its segments before the springs answer it in the same
 /// step. The solve leaves the obstacles to the end-of-step placement
 /// ([`keep_in_domain`]: the vertex back on the surface, the circle's
@@ -149,7 +159,8 @@ struct Bounds<'a> {
 
 /// The backward Euler step of the axial springs of the yarn with vertices
 /// `range` (see the module docs) from the positions `x*` the vertices
-/// have, within `within`.
+/// have, held by `within` (the grid's bounds, the sticky walls) and
+/// placed out of its obstacles.
 fn yarn_step(
     p: &Particles,
     pinned: &[bool],
@@ -232,7 +243,10 @@ fn yarn_step(
         (dv, gradient, newton) = (d, g, newton + it);
     }
     // a vertex whose placement on an obstacle would strain a segment past
-    // PLACED_STRAIN: held there, the springs solved again (a few rounds)
+    // PLACED_STRAIN: held there, the springs solved again (a few rounds;
+    // the bounds are held in them where the first solve needed it, and a
+    // vertex a later round alone carries past them gets the clamp after
+    // the step)
     let mut placed = Vec::new();
     let mut rod = rod;
     for _ in 0..PLACE_ROUNDS {
@@ -399,7 +413,7 @@ impl YarnSim {
             *x += d * dt;
             *v += d;
         }
-        // the vertices the solve held on an obstacle's surface (its dv is
+        // the vertices the solve held on an obstacle's surface (their dv is
         // the velocity change the circle's Coulomb law gave them)
         for &(i, x) in &placed {
             vert.x[i] = x;
