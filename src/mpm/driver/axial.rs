@@ -78,7 +78,7 @@ use crate::math::Vec2;
 use crate::mpm::implicit_vertex::newton;
 use crate::mpm::implicit_vertex::{contacts, Rod, Settings};
 use crate::mpm::laws::constitutive::YarnEnergy;
-use crate::mpm::laws::contact::{grid_bounds, keep_in_domain, project_out, sticky_share};
+use crate::mpm::laws::contact::{grid_bounds, keep_in_domain, project_out_of, sticky_share};
 use crate::mpm::machinery::particles::{Particles, Vertices};
 use crate::scene::Obstacle;
 use crate::scene::WallMode;
@@ -217,25 +217,16 @@ fn yarn_step(
     };
     // the springs alone, and where that leaves a vertex beyond the grid's
     // bounds, the solve that holds it on them (the same first solve)
-    let out = newton::solve(
-        &rod,
-        &contacts::held(&fixed),
-        &vec![None; n],
-        vec![Vec2::zeros(); n],
-        &settings,
-    )?;
+    let (mut dv, mut gradient, mut newton) = springs_alone(&rod, &fixed, &settings)?;
     let beyond = |(x, v): (&Vec2, &Vec2)| contacts::inside(&[], Some(bounds), x + v * dt).is_some();
-    let near_bounds = rod.x.iter().zip(&out.v).any(beyond);
-    let (mut dv, mut gradient, mut newton) = (out.v, out.gradient, out.newton);
+    let near_bounds = rod.x.iter().zip(&dv).any(beyond);
     let solve = |rod: &Rod, fixed: &[Option<Vec2>], settings: &Settings| {
         if near_bounds {
             // (contacts::step repeats the first solve: only near the bounds)
             let o = contacts::step(rod, fixed, &[], Some(bounds), dt, settings)?;
-            Ok::<_, String>((o.v, o.gradient, o.newton))
-        } else {
-            let (cons, fric) = (contacts::held(fixed), vec![None; rod.len()]);
-            let o = newton::solve(rod, &cons, &fric, vec![Vec2::zeros(); rod.len()], settings)?;
             Ok((o.v, o.gradient, o.newton))
+        } else {
+            springs_alone(rod, fixed, settings)
         }
     };
     if near_bounds {
@@ -281,12 +272,26 @@ fn yarn_step(
     Ok((dv, gradient, newton, placed))
 }
 
+/// The backward Euler step of `rod`'s springs alone, the vertices of
+/// `fixed` held: the velocity changes, the impulses (`dE/dv`) and the
+/// Newton iterations.
+fn springs_alone(
+    rod: &Rod,
+    fixed: &[Option<Vec2>],
+    settings: &Settings,
+) -> Result<(Vec<Vec2>, Vec<Vec2>, usize), String> {
+    let n = rod.len();
+    let (cons, fric) = (contacts::held(fixed), vec![None; n]);
+    let o = newton::solve(rod, &cons, &fric, vec![Vec2::zeros(); n], settings)?;
+    Ok((o.v, o.gradient, o.newton))
+}
+
 /// Rounds of [`place`] and a new solve in one axial step (at most; a
 /// vertex left inside after them gets the end-of-step placement alone).
 const PLACE_ROUNDS: usize = 3;
 
 /// The free vertices of `rod` whose end-of-step placement on `obstacles`
-/// ([`project_out`]) would change one of their segments' strain by more
+/// ([`project_out_of`]) would change one of their segments' strain by more
 /// than [`PLACED_STRAIN`]: each with the position the placement gives it
 /// and its velocity change `d` (the Coulomb law's velocity less the
 /// gathered one, `v` from the yarn's first vertex `start` on).
@@ -306,9 +311,7 @@ fn place(
             continue;
         }
         let (mut x, mut w) = (y(i), v.v[start + i] + dv[i]);
-        for o in obstacles {
-            project_out(o, &mut x, &mut w);
-        }
+        project_out_of(obstacles, &mut x, &mut w);
         if x == y(i) {
             continue;
         }

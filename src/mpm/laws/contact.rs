@@ -410,14 +410,20 @@ pub fn sticky_share(cells: usize, n: usize, inv_dx: f64, x: Vec2) -> f64 {
 }
 
 /// Where a particle ends its move of a substep: outside every obstacle of
-/// `obstacles` ([`project_out`]), then where its stencil stays on the grid
-/// ([`clamp_to_grid`] within [`grid_bounds`]).
+/// `obstacles` ([`project_out_of`]), then where its stencil stays on the
+/// grid ([`clamp_to_grid`] within [`grid_bounds`]).
 #[inline(always)]
 pub fn keep_in_domain(obstacles: &[Obstacle], bounds: (f64, f64), x: &mut Vec2, v: &mut Vec2) {
+    project_out_of(obstacles, x, v);
+    clamp_to_grid(x, v, bounds.0, bounds.1);
+}
+
+/// [`project_out`] of every obstacle of `obstacles`, in their order.
+#[inline(always)]
+pub fn project_out_of(obstacles: &[Obstacle], x: &mut Vec2, v: &mut Vec2) {
     for o in obstacles {
         project_out(o, x, v);
     }
-    clamp_to_grid(x, v, bounds.0, bounds.1);
 }
 
 /// The coordinates, m, a particle of the grid `n` cells of `dx` a side may
