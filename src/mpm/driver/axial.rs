@@ -48,25 +48,29 @@
 //!
 //! `M` lumps a vertex and half of
 //! each adjacent segment's quadrature particle, and each quadrature
-//! particle takes the mean `dv` of its two vertices after its gather, so
+//! particle takes the mean `dv` of its two vertices, so
 //! away from the walls and the obstacles the step keeps the momentum (the
 //! spring forces cancel in pairs; a wall or a circle takes what it holds,
 //! and the quadrature particles beside a vertex held on a circle take
 //! their share of the Coulomb law's change of its velocity). Under APIC every
 //! particle takes the grid's velocity at each transfer, so what the grid
 //! cannot hold of `dv` is dropped at the next one. Under FLIP a particle
-//! keeps its own velocity but moves with the grid's: the vertex-scale
-//! part of `dv` would stay in the particles'
-//! velocities while their positions never follow it, and with pure FLIP
-//! the run gains energy (the reference bundle at k = 1e7: up to 3.9 J from
-//! one frame to the next after the landing, 26.5 J of kinetic energy at
-//! 0.5 s against 14.5 J of the explicit run). So FLIP needs
-//! `transfer.flip_time` (checked at load): the particles' own velocity
-//! relaxes to the grid's over that time whatever the step
-//! ([`crate::mpm::machinery::transfer::Transfer::at_step`]); at 2 and 4
-//! ms the bundle never gains energy from one frame to the next over its
-//! second, at 8 ms it gains 1.0 J in a frame, at 20 ms 2.3 J, and at
-//! 100 ms it diverges (measured at dt 4e-5). Shear, the cross-section,
+//! keeps its own velocity but moves with the grid's, so the positions take
+//! `dv` and the velocities only what the grid holds of it
+//! ([`crate::mpm::machinery::share`]: `m dv` on the nodes, divided by all
+//! the mass there, gathered back by every particle, other yarns' too; a
+//! sticky wall's nodes keep theirs). Given `dv` itself, a vertex kept the
+//! part of it that the grid gives other yarns' mass on its nodes and the
+//! vertex-scale part: a yarn's end held by other yarns reached FLIP
+//! velocities of 13 to 22 m/s while it moved at about 1 m/s, and the
+//! stiff bundle's energy rose (0.46 J within 5 ms at `time.safety =
+//! 0.15`). FLIP still needs `transfer.flip_time` (checked at load): the
+//! particles' own velocity relaxes to the grid's over that time whatever
+//! the step ([`crate::mpm::machinery::transfer::Transfer::at_step`]); with
+//! `dv` itself, at 2 and 4
+//! ms the bundle never gained energy from one frame to the next over its
+//! second, at 8 ms it gained 1.0 J in a frame, at 20 ms 2.3 J, and at
+//! 100 ms it diverged (measured at dt 4e-5). Shear, the cross-section,
 //! bending, gravity and contact stay explicit on the grid; the yarns'
 //! solves are independent and run in parallel, each sequentially, so the
 //! result has the same bits for any thread count.
@@ -78,8 +82,11 @@ use crate::math::Vec2;
 use crate::mpm::implicit_vertex::newton;
 use crate::mpm::implicit_vertex::{contacts, Rod, Settings};
 use crate::mpm::laws::constitutive::YarnEnergy;
-use crate::mpm::laws::contact::{grid_bounds, keep_in_domain, project_out_of, sticky_share};
+use crate::mpm::laws::contact::{
+    grid_bounds, keep_in_domain, project_out_of, sticky_holds, sticky_share,
+};
 use crate::mpm::machinery::particles::{Particles, Vertices};
+use crate::mpm::machinery::share::{FieldGrids, Share};
 use crate::scene::Obstacle;
 use crate::scene::WallMode;
 
@@ -343,9 +350,10 @@ impl YarnSim {
     /// The axial springs' backward Euler step over `dt` of every yarn,
     /// after the vertex gather and the pins (see the module docs): moves
     /// the vertices and keeps each vertex's velocity change for
-    /// [`YarnSim::axial_quads`]. On a failed solve the error is recorded
-    /// in `failed`.
-    pub(super) fn axial_step(&mut self, dt: f64) -> Result<(), SimError> {
+    /// [`YarnSim::axial_quads`] (`flip`: the substep's transfer is FLIP,
+    /// and the particles' velocities take [`Share`] of it). On a failed
+    /// solve the error is recorded in `failed`.
+    pub(super) fn axial_step(&mut self, dt: f64, flip: bool) -> Result<(), SimError> {
         let k = self.energy.k;
         let yv = &self.particles.yarn_vertices;
         let geom = self.grid.geom;
@@ -411,10 +419,36 @@ impl YarnSim {
                 .iter()
                 .fold(Vec2::zeros(), |a, &i| a + impulse[i] / dt);
         }
+        // under FLIP the particles keep what the grid holds of dv (see
+        // the module docs); the positions take dv itself
+        if flip {
+            let mut free: Vec<bool> = self.pinned.iter().map(|&p| !p).collect();
+            for &(i, _) in &placed {
+                free[i] = false;
+            }
+            let mut grids = vec![&self.grid];
+            let (mut vert_field, mut quad_field) = (None, None);
+            if let Some(f) = &self.fields {
+                grids.extend(&f.grids);
+                (vert_field, quad_field) = (Some(&f.vert_field[..]), Some(&f.quad_field[..]));
+            }
+            let fields = FieldGrids {
+                grids,
+                vert_field,
+                quad_field,
+            };
+            let (cells, n) = (self.scene.walls.cells as usize, geom.n);
+            let held = |i, j| sticky && sticky_holds(cells, n, i, j);
+            let s = &mut scratch;
+            s.share.of(&self.particles, &fields, &s.dv, &free, held);
+        } else {
+            scratch.share.clear();
+        }
+        let (dv, vert_u) = (&scratch.dv, &scratch.share.vert);
         let vert = &mut self.particles.vert;
-        for ((x, v), d) in vert.x.iter_mut().zip(vert.v.iter_mut()).zip(dv.iter()) {
+        for (i, ((x, v), d)) in vert.x.iter_mut().zip(&mut vert.v).zip(dv).enumerate() {
             *x += d * dt;
-            *v += d;
+            *v += if flip { vert_u[i] } else { *d };
         }
         // the vertices the solve held on an obstacle's surface (their dv is
         // the velocity change the circle's Coulomb law gave them)
@@ -434,11 +468,18 @@ impl YarnSim {
         Ok(())
     }
 
-    /// Each quadrature particle's share of the axial step: the mean
-    /// velocity change `dv` of its two vertices, after its gather.
+    /// Each quadrature particle's share of the axial step, after its
+    /// gather: the mean velocity change `dv` of its two vertices, or under
+    /// FLIP what the grid holds of the step ([`Share`]).
     pub(super) fn axial_quads(&mut self) {
-        let dv = &self.axial_scratch.dv;
+        let (dv, qu) = (&self.axial_scratch.dv, &self.axial_scratch.share.quad);
         let q = &mut self.particles.quad;
+        if !qu.is_empty() {
+            for (v, u) in q.v.iter_mut().zip(qu) {
+                *v += u;
+            }
+            return;
+        }
         for (v, &l) in q.v.iter_mut().zip(&q.left) {
             let l = l as usize;
             *v += (dv[l] + dv[l + 1]) * 0.5;
@@ -456,4 +497,6 @@ pub(super) struct AxialScratch {
     impulse: Vec<Vec2>,
     /// Each vertex's [`sticky_share`] (empty without sticky walls).
     wall_share: Vec<f64>,
+    /// Under FLIP, what the grid holds of `dv` (empty otherwise).
+    share: Share,
 }

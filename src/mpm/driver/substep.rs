@@ -219,7 +219,7 @@ impl YarnSim {
         // (`axial.rs`), before the quadrature particles read their edges
         let axial = self.scene.time.axial.is_implicit() && bad_v.is_none();
         if axial {
-            self.axial_step(dt)?;
+            self.axial_step(dt, flip)?;
         }
         let t4 = Instant::now();
         let bad_q = grid_to_particle::gather_quads(

@@ -345,6 +345,14 @@ fn in_walls(cells: usize, n: usize, k: usize) -> (bool, bool) {
     (k < cells, k + cells >= n)
 }
 
+/// Whether a sticky wall `cells` thick holds node `(i, j)` of an `n x n`
+/// grid (sets its velocity to zero, [`wall_velocity`]).
+#[inline(always)]
+pub fn sticky_holds(cells: usize, n: usize, i: usize, j: usize) -> bool {
+    let ((lo_x, hi_x), (lo_y, hi_y)) = (in_walls(cells, n, i), in_walls(cells, n, j));
+    lo_x || hi_x || lo_y || hi_y
+}
+
 /// Velocity of grid node `(i, j)` after the walls (`cells` thick) of an `n`-node grid.
 #[inline(always)]
 pub fn wall_velocity(
@@ -537,6 +545,13 @@ mod tests {
         assert!(edge > 0.5 && edge < 1.0, "{edge}");
         let mirrored = sticky_share(cells, n, inv_dx, Vec2::new(1.0 - 0.03 - 1.0 / 64.0, 0.5));
         assert!((mirrored - edge).abs() < 1e-12, "{mirrored} {edge}");
+        // sticky_holds names the same nodes, on every node of the grid
+        for i in 0..n as i32 {
+            for j in 0..n as i32 {
+                let h = sticky_holds(cells, n, i as usize, j as usize);
+                assert_eq!(h, held(i, j), "node ({i}, {j})");
+            }
+        }
     }
 
     #[test]

@@ -1,0 +1,291 @@
+//! What the grid holds of a velocity change given to the particles
+//! after the gather: the change's momentum `m dv` scattered with the
+//! substep's stencils onto the nodes of each particle's field, divided by
+//! the mass that every particle of the field puts on those nodes, and
+//! gathered back by every particle. This is the PIC transfer of the
+//! change alone, `u_p = sum_n w_pn (sum_q w_qn m_q dv_q) / (sum_q w_qn
+//! m_q)`: it keeps the momentum exactly (`sum_p m_p u_p = sum_p m_p
+//! dv_p`), spreads it over every particle that shares the nodes (the
+//! other yarns' too), and drops the part the grid cannot represent (the
+//! change from one vertex to the next). The axial step of `axial =
+//! "implicit"` gives its velocity change through it under FLIP, where a
+//! particle keeps its own velocity from one substep to the next
+//! (`crate::mpm::driver`'s `axial.rs`).
+
+use crate::math::bspline::Stencil;
+use crate::math::Vec2;
+use crate::mpm::machinery::grid::{Grid, GridGeom};
+use crate::mpm::machinery::particles::Particles;
+
+/// Momentum `[x, y]` and mass per node of a field's window.
+type Nodes = Vec<[f64; 3]>;
+
+/// What the grid holds of a velocity change ([`Share::of`]): each
+/// vertex's and each quadrature particle's share, and the node buffers,
+/// kept between substeps (all zero between calls).
+#[derive(Clone, Debug, Default)]
+pub struct Share {
+    nodes: Vec<Nodes>,
+    /// Each vertex's share of the change.
+    pub vert: Vec<Vec2>,
+    /// Each quadrature particle's share of the change.
+    pub quad: Vec<Vec2>,
+}
+
+/// The particles' fields: the grid of each field (field 0 the
+/// simulation's own grid; its window and the blocks its scatter touched,
+/// which hold every node of the substep's stencils) and, with more than
+/// one, each vertex's and each quadrature particle's field.
+pub struct FieldGrids<'a> {
+    pub grids: Vec<&'a Grid>,
+    pub vert_field: Option<&'a [u16]>,
+    pub quad_field: Option<&'a [u16]>,
+}
+
+impl Share {
+    /// The grid's share of the velocity change `dv` of the vertices whose
+    /// `free` is set and of the quadrature particles between two of them
+    /// (the mean of their two), into [`Share::vert`] and [`Share::quad`];
+    /// the others keep their own change (`dv`, or the mean of the
+    /// quadrature particle's two) and still lend their mass to the nodes.
+    /// One sequential pass in particle order, so the bits do not depend on
+    /// the thread count. A node where `held(i, j)` (a sticky wall's) gives
+    /// its particles nothing: what reached it is the wall's, as the grid
+    /// update holds that node.
+    pub fn of(
+        &mut self,
+        p: &Particles,
+        fields: &FieldGrids,
+        dv: &[Vec2],
+        free: &[bool],
+        held: impl Fn(usize, usize) -> bool,
+    ) {
+        of(p, fields, dv, free, held, self);
+    }
+
+    /// Forgets the last shares (a substep without one).
+    pub fn clear(&mut self) {
+        self.vert.clear();
+        self.quad.clear();
+    }
+}
+
+/// [`Share::of`] (a free function: the node buffers and the outputs are
+/// borrowed apart).
+fn of(
+    p: &Particles,
+    fields: &FieldGrids,
+    dv: &[Vec2],
+    free: &[bool],
+    held: impl Fn(usize, usize) -> bool,
+    out: &mut Share,
+) {
+    let (v, q) = (&p.vert, &p.quad);
+    let (nodes, vert_u, quad_u) = (&mut out.nodes, &mut out.vert, &mut out.quad);
+    nodes.resize(fields.grids.len(), Nodes::new());
+    for (buf, g) in nodes.iter_mut().zip(&fields.grids) {
+        if buf.len() != g.geom.storage() {
+            // every node is zero between calls: only the size changes
+            buf.clear();
+            buf.resize(g.geom.storage(), [0.0; 3]);
+        }
+    }
+    let field = |f: Option<&[u16]>, i: usize| f.map_or(0, |f| f[i] as usize);
+    let quad_free = |k: usize| {
+        let l = q.left[k] as usize;
+        free[l] && free[l + 1]
+    };
+    let quad_dv = |k: usize| {
+        let l = q.left[k] as usize;
+        (dv[l] + dv[l + 1]) * 0.5
+    };
+    for i in 0..v.x.len() {
+        let f = field(fields.vert_field, i);
+        let d = if free[i] { dv[i] } else { Vec2::zeros() };
+        splat(
+            &mut nodes[f],
+            &fields.grids[f].geom,
+            &v.stencil[i],
+            v.m[i],
+            d,
+        );
+    }
+    for k in 0..q.x.len() {
+        let f = field(fields.quad_field, k);
+        let d = if quad_free(k) {
+            quad_dv(k)
+        } else {
+            Vec2::zeros()
+        };
+        splat(
+            &mut nodes[f],
+            &fields.grids[f].geom,
+            &q.stencil[k],
+            q.m[k],
+            d,
+        );
+    }
+    vert_u.clear();
+    vert_u.extend((0..v.x.len()).map(|i| {
+        let f = field(fields.vert_field, i);
+        if free[i] {
+            gather(&nodes[f], &fields.grids[f].geom, &v.stencil[i], &held)
+        } else {
+            dv[i]
+        }
+    }));
+    quad_u.clear();
+    quad_u.extend((0..q.x.len()).map(|k| {
+        let f = field(fields.quad_field, k);
+        if quad_free(k) {
+            gather(&nodes[f], &fields.grids[f].geom, &q.stencil[k], &held)
+        } else {
+            quad_dv(k)
+        }
+    }));
+    // zero what the splats wrote, for the next call: the blocks the
+    // substep's scatter touched with the same stencils
+    for (buf, g) in nodes.iter_mut().zip(&fields.grids) {
+        for &b in &g.active {
+            for k in g.geom.block_nodes(b as usize) {
+                buf[k] = [0.0; 3];
+            }
+        }
+    }
+}
+
+/// Adds a particle of mass `m` and velocity change `d` to the nodes.
+#[inline(always)]
+fn splat(nodes: &mut [[f64; 3]], g: &GridGeom, st: &Stencil, m: f64, d: Vec2) {
+    // a particle's stencil lies inside the window its scatter fitted, at
+    // nodes >= 0
+    let (bi, bj) = (st.base[0] as usize, st.base[1] as usize);
+    for (a, row) in g.stencil_rows_mut(nodes, bi, bj).into_iter().enumerate() {
+        for (b, n) in row.iter_mut().enumerate() {
+            let w = st.weight(a, b) * m;
+            n[0] += w * d.x;
+            n[1] += w * d.y;
+            n[2] += w;
+        }
+    }
+}
+
+/// The velocity change the nodes hold, interpolated at the particle
+/// (none from a node `held`).
+#[inline(always)]
+fn gather(
+    nodes: &[[f64; 3]],
+    g: &GridGeom,
+    st: &Stencil,
+    held: &impl Fn(usize, usize) -> bool,
+) -> Vec2 {
+    let (bi, bj) = (st.base[0] as usize, st.base[1] as usize);
+    let mut u = Vec2::zeros();
+    for (a, row) in g.stencil_rows(nodes, bi, bj).into_iter().enumerate() {
+        for (b, n) in row.iter().enumerate() {
+            let w = st.weight(a, b);
+            if w > 0.0 && !held(bi + a, bj + b) {
+                // the particle's own mass is on the node: n[2] > 0
+                u += Vec2::new(n[0], n[1]) * (w / n[2]);
+            }
+        }
+    }
+    u
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mpm::laws::bending::rest_of_curve;
+    use crate::scene::builtin::yarn_reference;
+
+    /// The reference bundle's particles (12 yarns side by side, sharing
+    /// nodes), their stencils set, on its 256^2 grid.
+    fn bundle() -> (Particles, GridGeom) {
+        let scene = yarn_reference();
+        let mut p = Particles::from_scene(&scene, rest_of_curve);
+        let g = GridGeom::new(scene.grid.resolution as usize, scene.grid.size);
+        for (s, x) in p.vert.stencil.iter_mut().zip(&p.vert.x) {
+            *s = Stencil::new(*x, g.inv_dx);
+        }
+        for (s, x) in p.quad.stencil.iter_mut().zip(&p.quad.x) {
+            *s = Stencil::new(*x, g.inv_dx);
+        }
+        (p, g)
+    }
+
+    fn run(p: &Particles, g: GridGeom, dv: &[Vec2], free: &[bool]) -> (Vec<Vec2>, Vec<Vec2>) {
+        // a grid over the whole domain, every block marked as touched
+        let mut grid = Grid::new(g);
+        grid.geom = g;
+        grid.active = (0..g.blocks() as u32).collect();
+        let fields = FieldGrids {
+            grids: vec![&grid],
+            vert_field: None,
+            quad_field: None,
+        };
+        let mut s = Share::default();
+        s.of(p, &fields, dv, free, |_, _| false);
+        // the buffers are left zero for the next call
+        assert!(s.nodes[0].iter().all(|n| *n == [0.0; 3]));
+        (s.vert, s.quad)
+    }
+
+    /// Momentum kept (to round-off, 1e-12 of `sum m |dv|`) for a change
+    /// that varies from vertex to vertex; the vertex-scale part is what
+    /// the grid drops, so the shared change is smoother than `dv`.
+    #[test]
+    fn keeps_the_momentum_and_drops_the_vertex_scale() {
+        let (p, g) = bundle();
+        let n = p.vert.x.len();
+        let dv: Vec<Vec2> = (0..n)
+            .map(|i| Vec2::new(if i % 2 == 0 { 1.0 } else { -0.5 }, 0.3 * (i as f64).sin()))
+            .collect();
+        let (vu, qu) = run(&p, g, &dv, &vec![true; n]);
+        let mean = |i: usize| (dv[i] + dv[i + 1]) * 0.5;
+        let (mut given, mut kept, mut scale) = (Vec2::zeros(), Vec2::zeros(), 0.0);
+        for i in 0..n {
+            given += dv[i] * p.vert.m[i];
+            kept += vu[i] * p.vert.m[i];
+            scale += dv[i].norm() * p.vert.m[i];
+        }
+        for ((&l, &m), u) in p.quad.left.iter().zip(&p.quad.m).zip(&qu) {
+            given += mean(l as usize) * m;
+            kept += u * m;
+        }
+        assert!((given - kept).norm() <= 1e-12 * scale, "{given:?} {kept:?}");
+        // the alternating x component is mostly vertex-scale: the grid
+        // holds its mean, 0.25, and little of the +-0.75 about it
+        let spread = vu.iter().map(|u| (u.x - 0.25).abs()).fold(0.0, f64::max);
+        assert!(spread < 0.2, "{spread}");
+    }
+
+    /// A change the same for every particle is held whole (the weights
+    /// sum to one), and a vertex that is not free keeps its own.
+    #[test]
+    fn a_uniform_change_is_held_whole() {
+        let (p, g) = bundle();
+        let n = p.vert.x.len();
+        let d = Vec2::new(0.7, -1.3);
+        let mut free = vec![true; n];
+        free[5] = false;
+        let mut dv = vec![d; n];
+        dv[5] = Vec2::new(9.0, 9.0);
+        let (vu, qu) = run(&p, g, &dv, &free);
+        assert_eq!(vu[5], dv[5]);
+        // the particles whose stencils share nodes with those of vertex 5
+        // and of its two quadrature particles (4 and 5, which give no
+        // change either), within three cells of one of them, on its yarn
+        // or the next, get less of `d`, never more; every other one gets `d`
+        let zero = [p.vert.x[5], p.quad.x[4], p.quad.x[5]];
+        let far = |x: &Vec2| zero.iter().all(|z| (x - z).amax() >= 3.0 * g.dx);
+        for (i, u) in vu.iter().enumerate().filter(|&(i, _)| i != 5) {
+            assert!(!far(&p.vert.x[i]) || (u - d).norm() < 1e-12, "{i}: {u:?}");
+            assert!(u.norm() <= d.norm() * (1.0 + 1e-12), "{i}: {u:?}");
+        }
+        for (k, u) in qu.iter().enumerate() {
+            let far_q = far(&p.quad.x[k]) && !matches!(p.quad.left[k], 4 | 5);
+            assert!(!far_q || (u - d).norm() < 1e-12, "quad {k}: {u:?}");
+        }
+    }
+}
