@@ -204,12 +204,14 @@ fn hanging_yarn_carries_its_weight_below() {
 /// fourth, at k = 1e7, every particle thrown at a random velocity (up to
 /// 0.5 m/s a component, so the stiff springs work in every substep), without
 /// gravity, walls or obstacles: every substep changes the particles' total
-/// momentum by round-off only (1e-12 of `sum m |v|`; measured 1.0e-15 and
+/// momentum by round-off only (1e-12 of `sum m |v|`; measured 1.6e-15 and
 /// 5.8e-15), under FLIP and APIC, though the yarns share grid nodes: each
 /// yarn's springs cancel in pairs on its lumped vertices, and each
 /// quadrature particle takes the mean change of its two vertices, its mass
 /// counted half in each (lumped 0.3 and 0.7 instead, the balance is off by
-/// 1.3e-4: this test fails).
+/// 1.3e-4: this test fails); under FLIP the particles then keep the grid's
+/// share of those changes (`src/mpm/machinery/share.rs`), which moves
+/// momentum between the yarns and keeps its sum.
 #[test]
 fn the_axial_step_keeps_momentum_where_yarns_share_nodes() {
     for scheme in [TransferScheme::Flip, TransferScheme::Apic] {
