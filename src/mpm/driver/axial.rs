@@ -442,13 +442,13 @@ impl YarnSim {
             let s = &mut scratch;
             s.share.of(&self.particles, &fields, &s.dv, &free, held);
         } else {
-            scratch.share.clear();
+            scratch.share.own(&self.particles, &scratch.dv);
         }
-        let (dv, vert_u) = (&scratch.dv, &scratch.share.vert);
         let vert = &mut self.particles.vert;
-        for (i, ((x, v), d)) in vert.x.iter_mut().zip(&mut vert.v).zip(dv).enumerate() {
+        let steps = vert.x.iter_mut().zip(&mut vert.v);
+        for ((x, v), (d, u)) in steps.zip(scratch.dv.iter().zip(&scratch.share.vert)) {
             *x += d * dt;
-            *v += if flip { vert_u[i] } else { *d };
+            *v += u;
         }
         // the vertices the solve held on an obstacle's surface (their dv is
         // the velocity change the circle's Coulomb law gave them)
@@ -472,17 +472,9 @@ impl YarnSim {
     /// gather: the mean velocity change `dv` of its two vertices, or under
     /// FLIP what the grid holds of the step ([`Share`]).
     pub(super) fn axial_quads(&mut self) {
-        let (dv, qu) = (&self.axial_scratch.dv, &self.axial_scratch.share.quad);
         let q = &mut self.particles.quad;
-        if !qu.is_empty() {
-            for (v, u) in q.v.iter_mut().zip(qu) {
-                *v += u;
-            }
-            return;
-        }
-        for (v, &l) in q.v.iter_mut().zip(&q.left) {
-            let l = l as usize;
-            *v += (dv[l] + dv[l + 1]) * 0.5;
+        for (v, u) in q.v.iter_mut().zip(&self.axial_scratch.share.quad) {
+            *v += u;
         }
     }
 }
@@ -497,6 +489,7 @@ pub(super) struct AxialScratch {
     impulse: Vec<Vec2>,
     /// Each vertex's [`sticky_share`] (empty without sticky walls).
     wall_share: Vec<f64>,
-    /// Under FLIP, what the grid holds of `dv` (empty otherwise).
+    /// Each particle's share of `dv` (under FLIP what the grid holds of
+    /// it, otherwise its own).
     share: Share,
 }

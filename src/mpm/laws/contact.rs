@@ -402,14 +402,11 @@ pub fn sticky_share(cells: usize, n: usize, inv_dx: f64, x: Vec2) -> f64 {
     let s = Stencil::new(x, inv_dx);
     // a particle keeps `x >= dx` (`clamp_to_grid`): its stencil's nodes
     // are not negative
-    let walled = |axis: usize, k: usize| {
-        let (lo, hi) = in_walls(cells, n, s.base[axis] as usize + k);
-        lo || hi
-    };
+    let (bi, bj) = (s.base[0] as usize, s.base[1] as usize);
     let mut held = 0.0;
     for i in 0..3 {
         for j in 0..3 {
-            if walled(0, i) || walled(1, j) {
+            if sticky_holds(cells, n, bi + i, bj + j) {
                 held += s.weight(i, j);
             }
         }

@@ -69,11 +69,23 @@ impl Share {
         of(p, fields, dv, free, held, self);
     }
 
-    /// Forgets the last shares (a substep without one).
-    pub fn clear(&mut self) {
+    /// Each particle keeps its own change: a vertex its `dv`, a
+    /// quadrature particle the mean of its two vertices' (a substep whose
+    /// transfer drops what the grid cannot hold at the next one, APIC).
+    pub fn own(&mut self, p: &Particles, dv: &[Vec2]) {
         self.vert.clear();
+        self.vert.extend_from_slice(dv);
         self.quad.clear();
+        self.quad.extend(p.quad.left.iter().map(|&l| mean(dv, l)));
     }
+}
+
+/// The mean change of the two vertices of the quadrature particle whose
+/// left vertex is `l`.
+#[inline(always)]
+fn mean(dv: &[Vec2], l: u32) -> Vec2 {
+    let l = l as usize;
+    (dv[l] + dv[l + 1]) * 0.5
 }
 
 /// [`Share::of`] (a free function: the node buffers and the outputs are
@@ -97,61 +109,36 @@ fn of(
         }
     }
     let field = |f: Option<&[u16]>, i: usize| f.map_or(0, |f| f[i] as usize);
-    let quad_free = |k: usize| {
-        let l = q.left[k] as usize;
-        free[l] && free[l + 1]
-    };
-    let quad_dv = |k: usize| {
-        let l = q.left[k] as usize;
-        (dv[l] + dv[l + 1]) * 0.5
-    };
-    for i in 0..v.x.len() {
+    // every particle, vertices first: its field, stencil and mass, whether
+    // it takes a share, and its own change
+    let verts = (0..v.x.len()).map(|i| {
         let f = field(fields.vert_field, i);
-        let d = if free[i] { dv[i] } else { Vec2::zeros() };
-        splat(
-            &mut nodes[f],
-            &fields.grids[f].geom,
-            &v.stencil[i],
-            v.m[i],
-            d,
-        );
+        (f, &v.stencil[i], v.m[i], free[i], dv[i])
+    });
+    let quads = (0..q.x.len()).map(|k| {
+        let (f, l) = (field(fields.quad_field, k), q.left[k] as usize);
+        let shared = free[l] && free[l + 1];
+        (f, &q.stencil[k], q.m[k], shared, mean(dv, q.left[k]))
+    });
+    for (f, st, m, shared, d) in verts.clone().chain(quads.clone()) {
+        let d = if shared { d } else { Vec2::zeros() };
+        splat(&mut nodes[f], &fields.grids[f].geom, st, m, d);
     }
-    for k in 0..q.x.len() {
-        let f = field(fields.quad_field, k);
-        let d = if quad_free(k) {
-            quad_dv(k)
+    let nodes = &*nodes;
+    let share_of = |(f, st, _, shared, d): (usize, &Stencil, f64, bool, Vec2)| {
+        if shared {
+            gather(&nodes[f], &fields.grids[f].geom, st, &held)
         } else {
-            Vec2::zeros()
-        };
-        splat(
-            &mut nodes[f],
-            &fields.grids[f].geom,
-            &q.stencil[k],
-            q.m[k],
-            d,
-        );
-    }
+            d
+        }
+    };
     vert_u.clear();
-    vert_u.extend((0..v.x.len()).map(|i| {
-        let f = field(fields.vert_field, i);
-        if free[i] {
-            gather(&nodes[f], &fields.grids[f].geom, &v.stencil[i], &held)
-        } else {
-            dv[i]
-        }
-    }));
+    vert_u.extend(verts.map(share_of));
     quad_u.clear();
-    quad_u.extend((0..q.x.len()).map(|k| {
-        let f = field(fields.quad_field, k);
-        if quad_free(k) {
-            gather(&nodes[f], &fields.grids[f].geom, &q.stencil[k], &held)
-        } else {
-            quad_dv(k)
-        }
-    }));
+    quad_u.extend(quads.map(share_of));
     // zero what the splats wrote, for the next call: the blocks the
     // substep's scatter touched with the same stencils
-    for (buf, g) in nodes.iter_mut().zip(&fields.grids) {
+    for (buf, g) in out.nodes.iter_mut().zip(&fields.grids) {
         for &b in &g.active {
             for k in g.geom.block_nodes(b as usize) {
                 buf[k] = [0.0; 3];
