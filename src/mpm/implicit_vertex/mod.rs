@@ -22,7 +22,8 @@
 //! (Gast, Schroeder, Stomakhin, Jiang, Teran 2015, the optimization form of
 //! backward Euler; Baraff and Witkin 1998 for a mass-spring yarn) by
 //! projected Newton with a banded Cholesky solve per iteration
-//! ([`newton`], [`banded`]): the Hessian of a yarn is block pentadiagonal,
+//! ([`newton`], [`banded`]; block tridiagonal without bending,
+//! [`block_tridiagonal`]): the Hessian of a yarn is block pentadiagonal,
 //! so an iteration costs `O(n)` and the solve is exact. Pins prescribe their
 //! vertices' velocities; obstacles are normal-velocity constraints with
 //! Coulomb friction in the minimisation ([`contacts`]). Masses are lumped:
@@ -32,6 +33,7 @@
 //! with it) for the outputs.
 
 pub mod banded;
+pub mod block_tridiagonal;
 pub mod contacts;
 pub mod energy;
 pub mod newton;

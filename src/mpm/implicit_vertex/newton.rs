@@ -9,9 +9,12 @@
 //! system stays symmetric positive definite and is solved exactly by a
 //! banded Cholesky factorisation ([`super::banded`]): the Hessian of a
 //! yarn couples each vertex to its two neighbours on either side
-//! (bending), half-bandwidth 5 in the 2n unknowns.
+//! (bending), half-bandwidth 5 in the 2n unknowns; without bending, to its
+//! neighbours only, by a block tridiagonal `LDL^T`
+//! ([`super::block_tridiagonal`]).
 
 use super::banded::Banded;
+use super::block_tridiagonal::BlockTridiagonal;
 use super::energy::{Block, Rod};
 use crate::math::Vec2;
 
@@ -90,6 +93,71 @@ fn f0(u: f64, eps: f64) -> (f64, f64, f64) {
             2.0 * u / eps - u * u / (eps * eps),
             2.0 / eps - 2.0 * u / (eps * eps),
         )
+    }
+}
+
+/// The Newton system of a yarn: the band of half-bandwidth 5 in the `2n`
+/// unknowns with bending (a vertex coupled to the second one on), the
+/// 2x2 blocks of a block tridiagonal matrix without it (the stretch
+/// springs couple neighbours only; its factorisation chains one division
+/// per vertex where the band's chains two rows' square roots and
+/// divisions).
+enum System {
+    Band(Banded),
+    Blocks(BlockTridiagonal),
+}
+
+impl System {
+    fn new(n: usize, bends: bool) -> Self {
+        if bends {
+            System::Band(Banded::zeros(2 * n, 5))
+        } else {
+            System::Blocks(BlockTridiagonal::zeros(n))
+        }
+    }
+
+    fn clear(&mut self) {
+        match self {
+            System::Band(a) => a.clear(),
+            System::Blocks(t) => t.clear(),
+        }
+    }
+
+    /// Adds the block `b` to `A(i, i + off)`, `off` 0 (the lower triangle
+    /// of a diagonal block is read), 1 or 2 (with bending only).
+    // the 2x2 blocks' entries read best as index loops
+    #[allow(clippy::needless_range_loop)]
+    fn add(&mut self, i: usize, off: usize, b: &Block) {
+        match self {
+            System::Band(a) => {
+                for r in 0..2 {
+                    let cols = if off == 0 { r + 1 } else { 2 };
+                    for c in 0..cols {
+                        a.add(2 * i + r, 2 * (i + off) + c, b[r][c]);
+                    }
+                }
+            }
+            System::Blocks(t) if off == 0 => t.add_diag(i, b),
+            System::Blocks(t) => {
+                debug_assert_eq!(off, 1, "no block beyond the next without bending");
+                t.add_off(i, b);
+            }
+        }
+    }
+
+    /// Factors the system; `Err(vertex)` where it is not positive definite.
+    fn factor(&mut self) -> Result<(), usize> {
+        match self {
+            System::Band(a) => a.factor().map_err(|row| row / 2),
+            System::Blocks(t) => t.factor(),
+        }
+    }
+
+    fn solve(&self, b: &mut [f64]) {
+        match self {
+            System::Band(a) => a.solve(b),
+            System::Blocks(t) => t.solve(b),
+        }
     }
 }
 
@@ -205,20 +273,24 @@ pub fn solve(
     let mut g = total_gradient(rod, fric, eps, &v);
     let pg =
         |g: &[Vec2]| -> Vec<Vec2> { cons.iter().zip(g).map(|(c, g)| project(c, *g)).collect() };
-    let g0 = m_norm(rod, &pg(&g));
+    let mut pgv = pg(&g);
+    let g0 = m_norm(rod, &pgv);
+    let converged = |gn: f64| gn <= s.rel_tol * g0 || gn <= s.abs_tol || gn == 0.0;
     // half-bandwidth: bending couples a vertex to the second one on, stretch
     // to the next only
     let bends = rod.bending > 0.0;
-    let mut a = Banded::zeros(2 * n, if bends { 5 } else { 3 });
+    let mut a = System::new(n, bends);
     // iteration `max_newton` only tests the last iterate
     for it in 0..=s.max_newton {
-        let pgv = pg(&g);
-        let gn = m_norm(rod, &pgv);
+        if it > 0 {
+            pgv = pg(&g);
+        }
+        let gn = if it == 0 { g0 } else { m_norm(rod, &pgv) };
         let not_finite = || format!("the step energy is not finite at Newton iteration {it}");
         if !gn.is_finite() {
             return Err(not_finite());
         }
-        if gn <= s.rel_tol * g0 || gn <= s.abs_tol || gn == 0.0 {
+        if converged(gn) {
             return Ok(Solved {
                 v,
                 gradient: g,
@@ -264,26 +336,16 @@ pub fn solve(
                     }
                 }
             }
-            for r in 0..2 {
-                for c in 0..=r {
-                    a.add(2 * i + r, 2 * i + c, d[r][c]);
-                }
-            }
+            a.add(i, 0, &d);
             for (off, blocks) in [(1, &h.off1), (2, &h.off2)] {
                 if i + off < n && (off == 1 || bends) {
-                    let o = filter(&blocks[i], &cons[i], &cons[i + off]);
-                    for r in 0..2 {
-                        for c in 0..2 {
-                            a.add(2 * i + r, 2 * (i + off) + c, o[r][c]);
-                        }
-                    }
+                    a.add(i, off, &filter(&blocks[i], &cons[i], &cons[i + off]));
                 }
             }
         }
-        if let Err(row) = a.factor() {
+        if let Err(vertex) = a.factor() {
             return Err(format!(
-                "the Newton system is not positive definite at vertex {} (iteration {it})",
-                row / 2
+                "the Newton system is not positive definite at vertex {vertex} (iteration {it})"
             ));
         }
         let mut d: Vec<f64> = pgv.iter().flat_map(|g| [-g.x, -g.y]).collect();
