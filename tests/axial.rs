@@ -320,10 +320,10 @@ const FLIP_TIME: f64 = 0.002;
 /// 1.0003] (tighter than the goal's [0.999, 1.001], which the bounds'
 /// clamp described below, 0.99947, passed) through the fall, the landing,
 /// the slide between the circles and the pile against the walls over its
-/// whole second (checked every 5 ms; measured [0.9999935, 1.0000086] at
-/// 4e-5, [0.9999671, 1.0000115] at 2e-5, [0.9999866, 1.0000086] under
-/// `"auto"`, [0.9999883, 1.0000152] at safety 0.6 and [0.9999865,
-/// 1.0000129] at 0.15), and its total energy never rises from one check
+/// whole second (checked every 5 ms; measured [0.9999430, 1.0000095] at
+/// 4e-5, [0.9999849, 1.0000095] at 2e-5, [0.9999871, 1.0000109] under
+/// `"auto"`, [0.9999790, 1.0000099] at safety 0.6 and [0.9999820,
+/// 1.0000088] at 0.15), and its total energy never rises from one check
 /// to the next by more than 1e-4 of its start (measured: it falls at every
 /// check in all five). Until the particles' velocities took only the
 /// grid's share of the axial step's `dv` (`src/mpm/machinery/share.rs`),
@@ -388,7 +388,7 @@ fn stiff_bundle_under_flip_keeps_its_length_and_its_energy_falls() {
         );
         // the checks span the landing, the slide and the pile, not a free
         // fall that keeps its energy: by 1 s the bundle has lost over 70 %
-        // of it (measured 15.5, 15.0 and 15.7 J left of 75.7 J)
+        // of it (measured 15.4 to 16.0 J left of 75.7 J in the five)
         assert!(last < 0.3 * e0, "dt {dt:?}, safety {safety:?}: {last}");
     }
 }
@@ -426,12 +426,12 @@ fn a_relaxation_time_is_the_ratio_of_its_step() {
 /// is: the explicit run at k = 1e7 at its own stable step (`dt = "auto"`,
 /// about 4e-6 s) keeps it within 1.5 mm over 0.3 s (measured 0.81 mm).
 /// With the axial solve at dt 4e-5, 2e-5 and 1e-5: the end stays within
-/// 5 mm of its start (measured 3.56, 1.85 and 1.16 mm: the wall holds 91 %
+/// 5 mm of its start (measured 3.49, 1.83 and 1.15 mm: the wall holds 91 %
 /// of the end's stencil, and the solve sees the end 11 times as heavy),
 /// the total energy never rises from one 1 ms check to the next by more
 /// than 1e-4 of its start (measured: it falls at every check), and the
 /// largest kinetic energy is the explicit run's within 2 % (measured
-/// -0.12, 0.33 and 0.54 %). With the grid's share of `dv` taking what
+/// -0.10, 0.34 and 0.55 %). With the grid's share of `dv` taking what
 /// reaches the wall's nodes too, the end moved 4.83 mm at 4e-5. Before the solve knew the wall, the springs pulled the
 /// end out of it (by 126 mm at dt 4e-5), its velocity grew where its
 /// position could not follow (FLIP keeps it), and the kinetic energy

@@ -18,8 +18,9 @@
 //! the minimum of `sum_i m_i |dv_i|^2 / 2 + E_k(x* + dt dv)` (the
 //! optimization form of backward Euler, Gast, Schroeder, Stomakhin, Jiang,
 //! Teran 2015), found by the projected Newton of the grid-free integrator
-//! ([`crate::mpm::implicit_vertex::newton`], a banded Cholesky solve per
-//! iteration, block tridiagonal here) with no bending, attractor or
+//! ([`crate::mpm::implicit_vertex::newton`], a block tridiagonal `LDL^T`
+//! solve per iteration without bending,
+//! [`crate::mpm::implicit_vertex::block_tridiagonal`]) with no bending, attractor or
 //! friction term and the pinned vertices held (`dv = 0`). The solve knows
 //! the two boundaries the grid step enforces and it would otherwise undo:
 //! a vertex the springs would carry past the grid's bounds (where the
@@ -57,9 +58,10 @@
 //! cannot hold of `dv` is dropped at the next one. Under FLIP a particle
 //! keeps its own velocity but moves with the grid's, so the positions take
 //! `dv` and the velocities only what the grid holds of it
-//! ([`crate::mpm::machinery::share`]: `m dv` on the nodes, divided by all
-//! the mass there, gathered back by every particle, other yarns' too; a
-//! sticky wall's nodes keep theirs). Given `dv` itself, a vertex kept the
+//! ([`crate::mpm::machinery::share`]: each vertex's `M dv` with its
+//! lumped mass on the nodes, divided by all that mass there, gathered back
+//! by every vertex, other yarns' too, and a quadrature particle the mean
+//! of its two vertices'; a sticky wall's nodes keep theirs). Given `dv` itself, a vertex kept the
 //! part of it that the grid gives other yarns' mass on its nodes and the
 //! vertex-scale part: a yarn's end held by other yarns reached FLIP
 //! velocities of 13 to 22 m/s while it moved at about 1 m/s, and the
@@ -377,14 +379,19 @@ impl YarnSim {
             wall_share: &scratch.wall_share,
             obstacles,
         };
-        let steps: Vec<YarnStep> = (0..yv.len() - 1)
-            .into_par_iter()
-            .map(|y| {
-                let range = yv[y]..yv[y + 1];
-                let p = &self.particles;
-                yarn_step(p, &self.pinned, &within, k, dt, range)
-            })
-            .collect();
+        let step = |y: usize| {
+            let range = yv[y]..yv[y + 1];
+            yarn_step(&self.particles, &self.pinned, &within, k, dt, range)
+        };
+        // the yarns in parallel, or in turn on one thread (rayon's split
+        // and join took 3 % of the stiff bundle's samples there; the same
+        // bits either way, each yarn's solve on its own)
+        let yarns = 0..yv.len() - 1;
+        let steps: Vec<YarnStep> = if rayon::current_num_threads() > 1 {
+            yarns.into_par_iter().map(step).collect()
+        } else {
+            yarns.map(step).collect()
+        };
         let (dv, impulse) = (&mut scratch.dv, &mut scratch.impulse);
         dv.clear();
         impulse.clear();
@@ -427,16 +434,12 @@ impl YarnSim {
                 free[i] = false;
             }
             let mut grids = vec![&self.grid];
-            let (mut vert_field, mut quad_field) = (None, None);
+            let mut vert_field = None;
             if let Some(f) = &self.fields {
                 grids.extend(&f.grids);
-                (vert_field, quad_field) = (Some(&f.vert_field[..]), Some(&f.quad_field[..]));
+                vert_field = Some(&f.vert_field[..]);
             }
-            let fields = FieldGrids {
-                grids,
-                vert_field,
-                quad_field,
-            };
+            let fields = FieldGrids { grids, vert_field };
             let (cells, n) = (self.scene.walls.cells as usize, geom.n);
             let held = |i, j| sticky && sticky_holds(cells, n, i, j);
             let s = &mut scratch;

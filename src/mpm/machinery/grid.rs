@@ -187,8 +187,14 @@ impl GridGeom {
 
     /// Storage indices of window block `b`, row by row (eight runs of eight).
     pub fn block_nodes(&self, b: usize) -> impl Iterator<Item = usize> + '_ {
+        self.block_rows(b).flatten()
+    }
+
+    /// The rows of window block `b`: eight runs of eight storage indices.
+    #[inline(always)]
+    pub fn block_rows(&self, b: usize) -> impl Iterator<Item = std::ops::Range<usize>> + '_ {
         let (bi, bj) = (b / self.nbj, b % self.nbj);
-        (0..BLOCK).flat_map(move |r| {
+        (0..BLOCK).map(move |r| {
             let start = ((bi << BLOCK_SHIFT) + r) * self.stride + (bj << BLOCK_SHIFT);
             start..start + BLOCK
         })
