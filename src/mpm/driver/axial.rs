@@ -167,11 +167,13 @@ struct Bounds<'a> {
 }
 
 /// The backward Euler step of the axial springs of the yarn with vertices
-/// `range` (see the module docs) from the positions `x*` the vertices
+/// `range` (see the module docs), their `lumped` masses
+/// ([`Particles::lumped_masses`]), from the positions `x*` the vertices
 /// have, held by `within` (the grid's bounds, the sticky walls) and
 /// placed out of its obstacles.
 fn yarn_step(
     p: &Particles,
+    lumped: &[f64],
     pinned: &[bool],
     within: &Bounds,
     k: f64,
@@ -179,14 +181,13 @@ fn yarn_step(
     range: std::ops::Range<usize>,
 ) -> YarnStep {
     let (v, q) = (&p.vert, &p.quad);
-    let mut m = v.m[range.clone()].to_vec();
-    let mut segments = Vec::with_capacity(range.len().saturating_sub(1));
-    for i in range.start..range.end - 1 {
-        let s = v.q_right[i] as usize;
-        m[i - range.start] += 0.5 * q.m[s];
-        m[i + 1 - range.start] += 0.5 * q.m[s];
-        segments.push((q.vol[s] * k, q.l0[s]));
-    }
+    let mut m = lumped[range.clone()].to_vec();
+    let segments = (range.start..range.end - 1)
+        .map(|i| {
+            let s = v.q_right[i] as usize;
+            (q.vol[s] * k, q.l0[s])
+        })
+        .collect();
     // a sticky wall absorbs the share `h` of a force on a vertex in its
     // reach: the vertex answers the springs as `m / (1 - h)` would, and
     // not at all where the wall holds its whole stencil
@@ -365,6 +366,7 @@ impl YarnSim {
         // and freed each substep, they cost the allocator's trimming and
         // page faults: about 2 % of the stiff bundle's wall time, measured)
         let mut scratch = std::mem::take(&mut self.axial_scratch);
+        self.particles.lumped_masses(&mut scratch.lumped);
         scratch.wall_share.clear();
         if sticky {
             let cells = self.scene.walls.cells as usize;
@@ -381,7 +383,8 @@ impl YarnSim {
         };
         let step = |y: usize| {
             let range = yv[y]..yv[y + 1];
-            yarn_step(&self.particles, &self.pinned, &within, k, dt, range)
+            let (p, lumped) = (&self.particles, &scratch.lumped[..]);
+            yarn_step(p, lumped, &self.pinned, &within, k, dt, range)
         };
         // the yarns in parallel, or in turn on one thread (rayon's split
         // and join took 3 % of the stiff bundle's samples there; the same
@@ -443,7 +446,8 @@ impl YarnSim {
             let (cells, n) = (self.scene.walls.cells as usize, geom.n);
             let held = |i, j| sticky && sticky_holds(cells, n, i, j);
             let s = &mut scratch;
-            s.share.of(&self.particles, &fields, &s.dv, &free, held);
+            s.share
+                .of(&self.particles, &fields, &s.dv, &s.lumped, &free, held);
         } else {
             scratch.share.own(&self.particles, &scratch.dv);
         }
@@ -492,6 +496,9 @@ pub(super) struct AxialScratch {
     impulse: Vec<Vec2>,
     /// Each vertex's [`sticky_share`] (empty without sticky walls).
     wall_share: Vec<f64>,
+    /// Each vertex's lumped mass ([`Particles::lumped_masses`]), for the
+    /// yarns' solves and the share.
+    lumped: Vec<f64>,
     /// Each particle's share of `dv` (under FLIP what the grid holds of
     /// it, otherwise its own).
     share: Share,

@@ -33,14 +33,11 @@ impl YarnSim {
     /// The yarn's step energy at the current state over `dt`.
     fn rod(&self, dt: f64) -> Rod {
         let p = &self.particles;
-        let mut m = p.vert.m.clone();
-        let mut segments = Vec::with_capacity(p.quad.m.len());
-        for q in 0..p.quad.m.len() {
-            let l = p.quad.left[q] as usize;
-            m[l] += 0.5 * p.quad.m[q];
-            m[l + 1] += 0.5 * p.quad.m[q];
-            segments.push((p.quad.vol[q] * self.energy.k, p.quad.l0[q]));
-        }
+        let mut m = Vec::new();
+        p.lumped_masses(&mut m);
+        let segments = (p.quad.vol.iter().zip(&p.quad.l0))
+            .map(|(&vol, &l0)| (vol * self.energy.k, l0))
+            .collect();
         let passes = self.passes();
         Rod {
             x: p.vert.x.clone(),

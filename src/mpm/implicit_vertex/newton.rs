@@ -275,7 +275,6 @@ pub fn solve(
         |g: &[Vec2]| -> Vec<Vec2> { cons.iter().zip(g).map(|(c, g)| project(c, *g)).collect() };
     let mut pgv = pg(&g);
     let g0 = m_norm(rod, &pgv);
-    let converged = |gn: f64| gn <= s.rel_tol * g0 || gn <= s.abs_tol || gn == 0.0;
     // half-bandwidth: bending couples a vertex to the second one on, stretch
     // to the next only
     let bends = rod.bending > 0.0;
@@ -290,7 +289,7 @@ pub fn solve(
         if !gn.is_finite() {
             return Err(not_finite());
         }
-        if converged(gn) {
+        if gn <= s.rel_tol * g0 || gn <= s.abs_tol || gn == 0.0 {
             return Ok(Solved {
                 v,
                 gradient: g,

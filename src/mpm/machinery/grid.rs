@@ -492,6 +492,13 @@ impl Grid {
             .sum()
     }
 
+    /// The rows (runs of eight storage indices) of the active blocks.
+    pub fn active_rows(&self) -> impl Iterator<Item = std::ops::Range<usize>> + '_ {
+        self.active
+            .iter()
+            .flat_map(|&b| self.geom.block_rows(b as usize))
+    }
+
     /// Collects the union of the chunks' touched blocks into `active`, sorted.
     pub fn collect_active(&mut self) {
         for &b in &self.active {

@@ -191,4 +191,16 @@ impl Particles {
     pub fn is_empty(&self) -> bool {
         self.len() == 0
     }
+
+    /// Each vertex's lumped mass into `out`: its own and half of each
+    /// adjacent quadrature particle's (the mass a vertex solve moves with
+    /// it; the quadrature particle's mass split between its two vertices).
+    pub fn lumped_masses(&self, out: &mut Vec<f64>) {
+        out.clear();
+        out.extend_from_slice(&self.vert.m);
+        for (&l, &m) in self.quad.left.iter().zip(&self.quad.m) {
+            out[l as usize] += 0.5 * m;
+            out[l as usize + 1] += 0.5 * m;
+        }
+    }
 }

@@ -45,9 +45,6 @@ type Nodes = Vec<[f64; 3]>;
 #[derive(Clone, Debug, Default)]
 pub struct Share {
     nodes: Vec<Nodes>,
-    /// Each vertex's lumped mass (its own and half of each adjacent
-    /// quadrature particle's).
-    lumped: Vec<f64>,
     /// Each vertex's share of the change.
     pub vert: Vec<Vec2>,
     /// Each quadrature particle's share of the change.
@@ -66,7 +63,8 @@ pub struct FieldGrids<'a> {
 impl Share {
     /// The grid's share of the velocity change `dv` of the vertices whose
     /// `free` is set, into [`Share::vert`]; the others keep their own
-    /// change and still lend their lumped mass to the nodes. Each
+    /// change and still lend their lumped mass (`lumped`,
+    /// [`Particles::lumped_masses`]) to the nodes. Each
     /// quadrature particle takes the mean of its two vertices' results,
     /// into [`Share::quad`]. One sequential pass in vertex order, so the bits do not
     /// depend on the thread count. A node where `held(i, j)` (a sticky wall's: bands
@@ -77,10 +75,11 @@ impl Share {
         p: &Particles,
         fields: &FieldGrids,
         dv: &[Vec2],
+        lumped: &[f64],
         free: &[bool],
         held: impl Fn(usize, usize) -> bool,
     ) {
-        of(p, fields, dv, free, held, self);
+        of(p, fields, dv, lumped, free, held, self);
     }
 
     /// Each particle keeps its own change: a vertex its `dv`, a
@@ -108,6 +107,7 @@ fn of(
     p: &Particles,
     fields: &FieldGrids,
     dv: &[Vec2],
+    lumped: &[f64],
     free: &[bool],
     held: impl Fn(usize, usize) -> bool,
     out: &mut Share,
@@ -121,15 +121,6 @@ fn of(
             buf.clear();
             buf.resize(g.geom.storage(), [0.0; 3]);
         }
-    }
-    // each vertex's mass with half of each adjacent quadrature particle's,
-    // the mass the axial step moves with it
-    let lumped = &mut out.lumped;
-    lumped.clear();
-    lumped.extend_from_slice(&v.m);
-    for (&l, &m) in q.left.iter().zip(&q.m) {
-        lumped[l as usize] += 0.5 * m;
-        lumped[l as usize + 1] += 0.5 * m;
     }
     let field = |i: usize| fields.vert_field.map_or(0, |f| f[i] as usize);
     for i in 0..v.x.len() {
@@ -147,13 +138,11 @@ fn of(
     // stencils (a division per node and not per particle and node: the
     // gather's nine divisions took a fifth of the share's time, measured)
     for (buf, g) in nodes.iter_mut().zip(&fields.grids) {
-        for &b in &g.active {
-            for row in g.geom.block_rows(b as usize) {
-                for n in &mut buf[row] {
-                    if n[2] > 0.0 {
-                        n[0] /= n[2];
-                        n[1] /= n[2];
-                    }
+        for row in g.active_rows() {
+            for n in &mut buf[row] {
+                if n[2] > 0.0 {
+                    n[0] /= n[2];
+                    n[1] /= n[2];
                 }
             }
         }
@@ -177,10 +166,8 @@ fn of(
     // zero what the splats wrote, for the next call: the blocks the
     // substep's scatter touched with the same stencils
     for (buf, g) in out.nodes.iter_mut().zip(&fields.grids) {
-        for &b in &g.active {
-            for row in g.geom.block_rows(b as usize) {
-                buf[row].fill([0.0; 3]);
-            }
+        for row in g.active_rows() {
+            buf[row].fill([0.0; 3]);
         }
     }
 }
@@ -271,7 +258,9 @@ mod tests {
             vert_field: None,
         };
         let mut s = Share::default();
-        s.of(p, &fields, dv, free, |_, _| false);
+        let mut lumped = Vec::new();
+        p.lumped_masses(&mut lumped);
+        s.of(p, &fields, dv, &lumped, free, |_, _| false);
         // the buffers are left zero for the next call
         assert!(s.nodes[0].iter().all(|n| *n == [0.0; 3]));
         (s.vert, s.quad)
