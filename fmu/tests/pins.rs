@@ -508,10 +508,10 @@ fn a_preset_yarns_pin_force_times_the_spacing_is_one_yarns_weight() {
     assert!(err.abs() < 0.02, "{err}");
 }
 
-/// A scene file with `transfer.flip_time` (a relaxation time, not an FMU
-/// variable) runs with the library's bits, and `transfer.flip_ratio`
-/// reads 1; another ratio beside it is refused, naming
-/// `transfer.flip_time`, and the FMU reports the error.
+/// A scene file with `transfer.flip_time` (a relaxation time; the
+/// parameter of that name: `tests/axial.rs`) runs with the library's bits,
+/// and `transfer.flip_ratio` reads 1; another ratio beside it is refused,
+/// naming `transfer.flip_time`, and the FMU reports the error.
 #[test]
 fn a_scene_with_a_flip_time_runs_and_refuses_another_ratio() {
     let mut scene = small_scene();

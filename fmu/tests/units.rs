@@ -161,7 +161,9 @@ fn scene_field(fmu_name: &str) -> Option<(&'static str, Option<usize>)> {
         "dt" => ("time.dt", None),
         "transfer.scheme" => ("transfer.scheme", None),
         "transfer.flip_ratio" => ("transfer.flip_ratio", None),
+        "transfer.flip_time" => ("transfer.flip_time", None),
         "integrator" => ("time.integrator", None),
+        "time.axial" => ("time.axial", None),
         _ => return None,
     })
 }
@@ -204,7 +206,11 @@ fn fmu_units_and_starts_match_the_scene_file_reference() {
             v.name,
             v.unit
         );
-        let default = default.trim_matches('`');
+        let default = match default.trim_matches('`') {
+            // `transfer.flip_time` unset is the parameter's 0
+            "unset" if field == "transfer.flip_time" => "0",
+            d => d,
+        };
         if default == "required" {
             continue;
         }
@@ -227,8 +233,8 @@ fn fmu_units_and_starts_match_the_scene_file_reference() {
         compared += 1;
     }
     // attractor (4), gravity (2), bending, density, plasticity, scheme,
-    // flip_ratio, integrator
-    assert_eq!(compared, 12);
+    // flip_ratio, flip_time, integrator, axial
+    assert_eq!(compared, 14);
 }
 
 #[test]

@@ -7,7 +7,10 @@ usage: fmu_check.py SMALL.fmu REFERENCE_SCENE.fmu WORKDIR REPLAY_EXE SMALL_SCENE
    circle, switched on at 0.1 s; gravity turning), compared bit for bit
    with the Rust library run of the same inputs (fmu-replay); again with
    the parameter dt = 0 (adaptive substeps) against the scene with
-   dt = "auto", in fewer substeps.
+   dt = "auto", in fewer substeps; and the stiff setting (a fibre 100
+   times stiffer, time.axial = "implicit", transfer.flip_time, dt = 0) set
+   through start values alone, against the scene file that says the same,
+   in fewer substeps than the explicit run of the stiff fibre.
 3. FMU state through fmpy: get + serialize at t1, run on, deserialize +
    set, run on again: identical outputs.
 4. A short simulate_fmu of the default (reference) scene FMU.
@@ -139,6 +142,37 @@ fixed_n, auto_n = result[-1]["substeps"], result_auto[-1]["substeps"]
 print(f"substeps to {STOP} s: fixed dt {fixed_n:.0f}, auto {auto_n:.0f}")
 if not auto_n < fixed_n:
     failures.append(f"auto took {auto_n} substeps, the fixed dt {fixed_n}")
+
+# 2c. the stiff setting through parameters alone: a fibre 100 times
+# stiffer (material.k), its stretch by backward Euler (time.axial), FLIP
+# relaxed over 2 ms (transfer.flip_time), adaptive substeps (dt = 0),
+# against the Rust run of the scene file that says the same; the axial
+# step lifts the fibre wave's bound, so fewer substeps than the explicit
+# run of the same stiff fibre
+stiff_text = re.sub(r"(?m)^k\s*=.*$", "k = 100000.0", auto_text, count=1)
+stiff_text = re.sub(r'(?m)^dt = "auto"$', 'dt = "auto"\naxial = "implicit"', stiff_text, count=1)
+stiff_text += "\n[transfer]\nflip_time = 0.002\n"
+if stiff_text.count("100000.0") != 1 or 'axial = "implicit"' not in stiff_text:
+    failures.append("could not write the stiff small scene")
+stiff_scene = f"{work}/small_stiff.toml"
+with open(stiff_scene, "w") as fh:
+    fh.write(stiff_text)
+stiff = {"material.k": 1e5, "dt": 0.0, "transfer.flip_time": 0.002}
+result_stiff = against_replay(
+    "YarnBundle (small, k x100, time.axial = implicit, flip_time 2 ms, dt = 0)", small_fmu, stiff_scene,
+    in_csv, signals, outputs, H, STOP, f"{work}/rust_stiff.csv",
+    start_values={**stiff, "time.axial": "implicit"},
+)
+explicit_stiff = simulate_fmu(small_fmu, stop_time=STOP, output_interval=H, input=signals,
+                              output=["substeps", "max_stretch"], start_values=stiff)
+axial_n, explicit_n = result_stiff[-1]["substeps"], explicit_stiff[-1]["substeps"]
+stretch = max(result_stiff["max_stretch"])
+print(f"k x100, substeps to {STOP} s: time.axial implicit {axial_n:.0f}, explicit {explicit_n:.0f}; "
+      f"largest stretch {stretch:.6f}")
+if not axial_n < explicit_n:
+    failures.append(f"time.axial = implicit took {axial_n} substeps, explicit {explicit_n}")
+if not stretch < 1.01:
+    failures.append(f"time.axial = implicit stretched a segment to {stretch}")
 
 # 3. FMU state through fmpy's C calls
 vrs = [v.valueReference for v in md.modelVariables if v.causality == "output" and v.type == "Real"]

@@ -4,7 +4,7 @@
 
 use yarnsim::math::Vec2;
 use yarnsim::mpm::YarnSim;
-use yarnsim::scene::{Integrator, TransferScheme, YarnScene};
+use yarnsim::scene::{Axial, Integrator, TransferScheme, YarnScene};
 
 use super::variables::*;
 use super::{effective_scene, Config, Inputs, PinForces, YarnModel, YarnSnapshot};
@@ -41,6 +41,11 @@ impl YarnModel {
             Some(Integrator::Implicit) => 2,
             Some(Integrator::ImplicitVertices) => 3,
             Some(Integrator::MidpointVertices) => 4,
+        });
+        w.u8(match s.config.axial {
+            None => 0,
+            Some(Axial::Explicit) => 1,
+            Some(Axial::Implicit) => 2,
         });
         w.u64(s.forces.substeps);
         w.f64(s.forces.weight);
@@ -95,6 +100,12 @@ impl YarnModel {
             4 => Some(Integrator::MidpointVertices),
             b => return Err(format!("bad integrator byte {b}")),
         };
+        let axial = match r.u8()? {
+            0 => None,
+            1 => Some(Axial::Explicit),
+            2 => Some(Axial::Implicit),
+            b => return Err(format!("bad time.axial byte {b}")),
+        };
         if let Some((i, v)) = reals.iter().enumerate().find_map(|(i, v)| {
             let (_, f) = yarn_real_parameters().nth(i).unwrap();
             v.filter(|v| !(0.0..=f.max).contains(v)).map(|v| (i, v))
@@ -107,6 +118,7 @@ impl YarnModel {
             plasticity: has_p.then_some(p),
             scheme,
             integrator,
+            axial,
         };
         let substeps = r.u64()?;
         let weight = r.f64()?;

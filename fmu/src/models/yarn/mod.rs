@@ -7,7 +7,7 @@ use std::path::Path;
 
 use yarnsim::mpm::driver::state::DynamicState;
 use yarnsim::mpm::{Diagnostics, SimError, YarnSim};
-use yarnsim::scene::{Integrator, TransferScheme, YarnScene};
+use yarnsim::scene::{Axial, Integrator, TransferScheme, YarnScene};
 
 use crate::model_description::*;
 use crate::models::model::{
@@ -36,6 +36,8 @@ pub struct Config {
     pub scheme: Option<TransferScheme>,
     /// `integrator` (`time.integrator`).
     pub integrator: Option<Integrator>,
+    /// `time.axial`.
+    pub axial: Option<Axial>,
 }
 
 impl Default for Config {
@@ -46,6 +48,7 @@ impl Default for Config {
             plasticity: None,
             scheme: None,
             integrator: None,
+            axial: None,
         }
     }
 }
@@ -88,6 +91,9 @@ fn effective_scene(base: &YarnScene, config: &Config) -> YarnScene {
     }
     if let Some(i) = config.integrator {
         s.time.integrator = i;
+    }
+    if let Some(a) = config.axial {
+        s.time.axial = a;
     }
     s
 }
@@ -213,13 +219,18 @@ impl YarnModel {
         let Set { vrs, vals, ctx } = set;
         let mut changed = false;
         for (&vr, v) in vrs.iter().zip(vals) {
-            if vr != VR_SCENE && vr != VR_TRANSFER_SCHEME && vr != VR_INTEGRATOR {
+            if ![VR_SCENE, VR_TRANSFER_SCHEME, VR_INTEGRATOR, VR_AXIAL].contains(&vr) {
                 return refuse(format!("{} is not a String parameter", self.shown(vr)));
             }
             (ctx.check)(name_of(vr))?;
             if vr == VR_INTEGRATOR {
                 let i = refuse_unknown("integrator", v, &INTEGRATORS, "an integrator")?;
                 changed |= replace(&mut self.config.integrator, i);
+                continue;
+            }
+            if vr == VR_AXIAL {
+                let a = refuse_unknown("time.axial", v, &AXIALS, "a fibre-stretch treatment")?;
+                changed |= replace(&mut self.config.axial, a);
                 continue;
             }
             if vr == VR_TRANSFER_SCHEME {
@@ -464,6 +475,10 @@ impl FmuModel for YarnModel {
             VR_INTEGRATOR => Some(choice_name(
                 &INTEGRATORS,
                 self.config.integrator.unwrap_or(self.base.time.integrator),
+            )),
+            VR_AXIAL => Some(choice_name(
+                &AXIALS,
+                self.config.axial.unwrap_or(self.base.time.axial),
             )),
             _ => None,
         }

@@ -6,7 +6,7 @@
 //! the scene the FMU runs: the number of yarns fixes the outputs, the
 //! scene's material, substep and inputs give the start values.
 
-use yarnsim::scene::{Integrator, PinMotionKind, StepSize, TransferScheme, YarnScene};
+use yarnsim::scene::{Axial, Integrator, PinMotionKind, StepSize, TransferScheme, YarnScene};
 
 use crate::model_description::*;
 use Causality::{Input, Parameter};
@@ -15,7 +15,7 @@ use Causality::{Input, Parameter};
 pub const MODEL_IDENTIFIER: &str = "YarnBundle";
 
 /// Bumped whenever the variable layout changes; part of the GUID.
-pub const INTERFACE_VERSION: u32 = 5;
+pub const INTERFACE_VERSION: u32 = 6;
 
 // Value references. They are unique across all types.
 pub const VR_ATTRACTOR_X: u32 = 1;
@@ -34,6 +34,9 @@ pub const VR_DT: u32 = 16;
 pub const VR_PLASTICITY: u32 = 17; // Boolean
 /// `transfer.flip_ratio` (Real parameter in [0, 1]).
 pub const VR_FLIP_RATIO: u32 = 18;
+/// `transfer.flip_time` (Real parameter in s; 0: none, the scene without
+/// a relaxation time).
+pub const VR_FLIP_TIME: u32 = 19;
 pub const VR_KINETIC_ENERGY: u32 = 100;
 pub const VR_ELASTIC_ENERGY: u32 = 101;
 pub const VR_MAX_STRETCH: u32 = 102;
@@ -43,6 +46,9 @@ pub const VR_TRANSFER_SCHEME: u32 = 301;
 /// `integrator` (String parameter, `"explicit"` or `"implicit"`: the
 /// scene's `time.integrator`).
 pub const VR_INTEGRATOR: u32 = 302;
+/// `time.axial` (String parameter, `"explicit"` or `"implicit"`: the
+/// scene's `[time] axial`).
+pub const VR_AXIAL: u32 = 303;
 /// `yarn[i].left.x` has `VR_YARN_BASE + 4 i`, then `left.y`, `right.x`, `right.y`.
 pub const VR_YARN_BASE: u32 = 1000;
 /// Pin `i` (`[[pins]]` order) has `VR_PIN_BASE + 8 i + k`: k = 0..3 the
@@ -88,6 +94,13 @@ pub const INTEGRATORS: [(&str, Integrator); 4] = [
     (Integrator::NAMES[3], Integrator::MidpointVertices),
 ];
 
+/// The treatments of the fibre stretch by their name as the scene and
+/// `time.axial` write it (the scene's spelling, [`Axial::NAMES`]).
+pub const AXIALS: [(&str, Axial); 2] = [
+    (Axial::NAMES[0], Axial::Explicit),
+    (Axial::NAMES[1], Axial::Implicit),
+];
+
 /// The name of `value` in a table of names ([`SCHEMES`], [`INTEGRATORS`]).
 pub fn choice_name<T: PartialEq>(table: &[(&'static str, T)], value: T) -> &'static str {
     let (name, _) = table
@@ -125,11 +138,18 @@ fn set_dt(s: &mut YarnScene, v: f64) {
     }
 }
 
+/// Sets the scene's `transfer.flip_time` from the parameter: 0 is none
+/// (the FLIP particles keep their own velocity, blended by
+/// `transfer.flip_ratio`), a positive value the relaxation time.
+fn set_flip_time(s: &mut YarnScene, v: f64) {
+    s.transfer.flip_time = (v != 0.0).then_some(v);
+}
+
 /// The YarnBundle's variables before the ones every model has
 /// ([`COMMON_VARIABLES`]) and the per-yarn outputs ([`yarn_outputs`]), in
 /// `ModelVariables` order. The Real parameters read and override the scene
 /// through their [`SceneField`].
-pub static YARN_VARIABLES: [VarSpec<YarnScene>; 21] = [
+pub static YARN_VARIABLES: [VarSpec<YarnScene>; 23] = [
     var(Input, "attractor.x", VR_ATTRACTOR_X, Some("m"), Start::Real(|s| s.attractor.position[0]), "Attractor position x"),
     var(Input, "attractor.y", VR_ATTRACTOR_Y, Some("m"), Start::Real(|s| s.attractor.position[1]), "Attractor position y"),
     var(Input, "attractor.strength", VR_ATTRACTOR_STRENGTH, Some("m/s2"), Start::Real(|s| s.attractor.strength), "Attractor acceleration magnitude, 0 to 1e6"),
@@ -146,7 +166,9 @@ pub static YARN_VARIABLES: [VarSpec<YarnScene>; 21] = [
     var(Parameter, "material.plasticity", VR_PLASTICITY, None, Start::Bool(|s| s.material.plasticity), "Mohr-Coulomb return mapping on or off"),
     var(Parameter, "transfer.scheme", VR_TRANSFER_SCHEME, None, Start::Name(|s| choice_name(&SCHEMES, s.transfer.scheme)), "Particle velocity update of grid-to-particle: flip (FLIP/APIC blend by transfer.flip_ratio) or apic"),
     var(Parameter, "transfer.flip_ratio", VR_FLIP_RATIO, None, Start::Scene(SceneField { get: |s| s.transfer.flip_ratio, set: |s, v| s.transfer.flip_ratio = v, positive: false, max: 1.0 }), "FLIP ratio in [0, 1] of the flip scheme (1: pure FLIP; ignored by apic)"),
+    var(Parameter, "transfer.flip_time", VR_FLIP_TIME, Some("s"), Start::Scene(SceneField { get: |s| s.transfer.flip_time.unwrap_or(0.0), set: set_flip_time, positive: false, max: 1e12 }), "Relaxation time of the flip scheme: each substep relaxes a particle's own velocity to the grid's by exp(-dt / flip_time), a damping per simulated second that does not follow the number of substeps; 0: none (then transfer.flip_ratio blends per substep). A positive value needs transfer.flip_ratio = 1"),
     var(Parameter, "integrator", VR_INTEGRATOR, None, Start::Name(|s| choice_name(&INTEGRATORS, s.time.integrator)), "Time integrator (the scene's time.integrator): explicit (symplectic Euler), implicit (backward Euler, Newton on the grid velocities), implicit-vertices (backward Euler on the vertices of a single yarn without the grid) or midpoint-vertices (generalized midpoint there); the last two only for one yarn with gamma = youngs_modulus = 0 and no walls: another scene is refused with fmi2Error at the end of initialization, the log naming the scene field; a Newton solve that fails in a step gives fmi2Discard"),
+    var(Parameter, "time.axial", VR_AXIAL, None, Start::Name(|s| choice_name(&AXIALS, s.time.axial)), "Fibre stretch under the explicit integrator (the scene's [time] axial): explicit (a grid force; its axial wave bounds the substep) or implicit (backward Euler on each yarn's vertices after the grid-to-particle pass, so the axial wave no longer bounds the substep; needs integrator = explicit and transfer.scheme = apic or a transfer.flip_time, else fmi2Error at the end of initialization naming time.axial)"),
     var(Parameter, "scene", VR_SCENE, None, Start::Text(SCENE_FILE), "Scene file: a path relative to the FMU's resources folder, or absolute; it must create as many yarns as the bundled scene and have its pins (same number, same input pins)"),
     output("kinetic_energy", VR_KINETIC_ENERGY, Some("J/m"), "Kinetic energy (per m of depth)"),
     output("elastic_energy", VR_ELASTIC_ENERGY, Some("J/m"), "Elastic energy (per m of depth)"),
@@ -163,7 +185,7 @@ pub fn yarn_real_parameters() -> impl Iterator<Item = (u32, SceneField<YarnScene
 }
 
 /// Number of [`yarn_real_parameters`].
-pub const YARN_REAL_PARAMETERS: usize = 8;
+pub const YARN_REAL_PARAMETERS: usize = 9;
 const _: () = {
     let mut n = 0;
     let mut i = 0;
@@ -397,5 +419,11 @@ mod tests {
             assert_eq!(s.name(), name);
         }
         assert_eq!(parse_choice(&SCHEMES, "pic"), None);
+        assert_eq!(choice_list(&AXIALS), "\"explicit\" or \"implicit\"");
+        for (name, a) in AXIALS {
+            assert_eq!(parse_choice(&AXIALS, name), Some(a));
+            assert_eq!(choice_name(&AXIALS, a), name);
+            assert_eq!(a.name(), name);
+        }
     }
 }
