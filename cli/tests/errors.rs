@@ -125,6 +125,45 @@ fn forced_it_diverges_and_the_divergence_says_why() {
     assert_eq!(stderr(&out), "");
 }
 
+/// Without the return mapping the built-in bundle diverges at its landing
+/// (t = 0.126 s at dt 4e-5) and no smaller step helps: the hint names the
+/// field to change instead of the step.
+#[test]
+#[cfg_attr(debug_assertions, ignore = "release-mode test (cargo test --release)")]
+fn a_divergence_without_plasticity_points_to_the_plasticity() {
+    let out = yarnsim(&["run", "-d", "0.2", "--set", "material.plasticity=false"]);
+    assert_eq!(out.status.code(), Some(1), "{}", stderr(&out));
+    let err = stderr(&out);
+    assert!(
+        err.starts_with("error: simulation diverged at step "),
+        "{err}"
+    );
+    assert!(
+        err.contains("material.plasticity = false keeps every cross-section that has opened")
+            && err
+                .trim_end()
+                .ends_with("set material.plasticity = true (--set material.plasticity=true)"),
+        "{err}"
+    );
+    assert!(!err.contains("a smaller dt"), "{err}");
+    // A fixed step above its bound is the step's fault, plasticity or not.
+    let forced = args(
+        &[
+            "run",
+            "yarn-drape",
+            "-d",
+            "0.01",
+            "--allow-unstable",
+            "--set",
+            "material.plasticity=false",
+        ],
+        &STIFF,
+    );
+    let err = stderr(&yarnsim(&forced));
+    assert!(err.contains("x the stability bound"), "{err}");
+    assert!(!err.contains("keeps every cross-section"), "{err}");
+}
+
 #[test]
 fn a_fixed_dt_a_little_above_the_bound_is_warned_about() {
     // The small scene's density lowered until its bound is dt / 1.3: the
