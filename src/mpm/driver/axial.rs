@@ -432,7 +432,9 @@ impl YarnSim {
         // under FLIP the particles keep what the grid holds of dv (see
         // the module docs); the positions take dv itself
         if flip {
-            let mut free: Vec<bool> = self.pinned.iter().map(|&p| !p).collect();
+            let free = &mut scratch.free;
+            free.clear();
+            free.extend(self.pinned.iter().map(|&p| !p));
             for &(i, _) in &placed {
                 free[i] = false;
             }
@@ -447,7 +449,7 @@ impl YarnSim {
             let held = |i, j| sticky && sticky_holds(cells, n, i, j);
             let s = &mut scratch;
             s.share
-                .of(&self.particles, &fields, &s.dv, &s.lumped, &free, held);
+                .of(&self.particles, &fields, &s.dv, &s.lumped, &s.free, held);
         } else {
             scratch.share.own(&self.particles, &scratch.dv);
         }
@@ -502,4 +504,7 @@ pub(super) struct AxialScratch {
     /// Each particle's share of `dv` (under FLIP what the grid holds of
     /// it, otherwise its own).
     share: Share,
+    /// Under FLIP, the vertices the share moves (not pinned, not placed
+    /// on an obstacle by the solve).
+    free: Vec<bool>,
 }
