@@ -81,3 +81,35 @@ fn the_window_follows_a_moving_bundle() {
     // two yarns span 0.8 m x 0.01 m: about 26 x 3 blocks plus margins
     assert!(peak < 8 << 20, "peak grid memory {peak} B");
 }
+
+/// Under `axial = "implicit"` with FLIP the share's node buffers (one per
+/// velocity field, the size of its grid's window) are counted, and they
+/// follow the window as the grid does: on an 8192^2 grid the bundle still
+/// holds less than on its own 256^2 one, and the buffers add about as many
+/// bytes as three values per window node.
+#[test]
+fn the_axial_share_is_counted_and_follows_the_window() {
+    let mut s = reference();
+    s.walls.mode = WallMode::None;
+    s.material.k = 1e7;
+    s.transfer.flip_time = Some(0.002);
+    let mut axial = s.clone();
+    axial.time.axial = yarnsim::scene::Axial::Implicit;
+    let mut huge = axial.clone();
+    huge.grid.resolution = 8192;
+    huge.grid.size = 32.0;
+    let memory = |scene: &YarnScene| {
+        let mut sim = YarnSim::new(scene).unwrap();
+        sim.steps_n(20).unwrap();
+        (sim.grid_memory_bytes(), sim.active_blocks())
+    };
+    let ((plain, blocks), (with_share, _), (on_huge, _)) =
+        (memory(&s), memory(&axial), memory(&huge));
+    eprintln!("grid memory: {plain} B, with the share {with_share} B, on 8192^2 {on_huge} B");
+    // at least the active blocks' 64 nodes of 24 bytes each
+    assert!(
+        with_share >= plain + blocks * 64 * 24,
+        "{with_share} against {plain}"
+    );
+    assert!(on_huge <= with_share, "{on_huge} against {with_share}");
+}

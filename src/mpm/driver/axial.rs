@@ -488,6 +488,13 @@ impl YarnSim {
     }
 }
 
+impl AxialScratch {
+    /// Bytes of the grid-sized buffers: the share's nodes.
+    pub(super) fn grid_memory_bytes(&self) -> usize {
+        self.share.node_memory_bytes()
+    }
+}
+
 /// The buffers of [`YarnSim::axial_step`], kept from one substep to the
 /// next (not part of the state: each substep overwrites them).
 #[derive(Clone, Debug, Default)]

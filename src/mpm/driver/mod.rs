@@ -295,9 +295,12 @@ impl YarnSim {
         self.attractor
     }
     /// Bytes the grid holds now: its window of nodes and the scatter
-    /// buffers (they follow the particles' bounding box, not the domain).
+    /// buffers, and under `axial = "implicit"` with FLIP the share's node
+    /// buffers (all follow the particles' bounding box, not the domain).
     pub fn grid_memory_bytes(&self) -> usize {
-        self.grid.memory_bytes() + self.fields.as_ref().map_or(0, Fields::memory_bytes)
+        self.grid.memory_bytes()
+            + self.fields.as_ref().map_or(0, Fields::memory_bytes)
+            + self.axial_scratch.grid_memory_bytes()
     }
     /// Whether the yarns move in more than one velocity field
     /// (`crate::mpm::laws::fields`): held and free yarns, or several free

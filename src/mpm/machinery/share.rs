@@ -61,6 +61,15 @@ pub struct FieldGrids<'a> {
 }
 
 impl Share {
+    /// Bytes of the node buffers (one per field, the size of its grid's
+    /// window; empty until the first call).
+    pub fn node_memory_bytes(&self) -> usize {
+        self.nodes
+            .iter()
+            .map(|n| n.capacity() * std::mem::size_of::<[f64; 3]>())
+            .sum()
+    }
+
     /// The grid's share of the velocity change `dv` of the vertices whose
     /// `free` is set, into [`Share::vert`]; the others keep their own
     /// change and still lend their lumped mass (`lumped`,
