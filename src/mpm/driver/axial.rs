@@ -453,6 +453,16 @@ impl YarnSim {
         } else {
             scratch.share.own(&self.particles, &scratch.dv);
         }
+        // the share's momentum that landed on a pinned vertex is the pin's:
+        // its force on the yarn takes it away from the others
+        for (pin, r) in self.pins.iter().zip(self.pin_reactions.iter_mut()) {
+            for &i in &pin.vertices {
+                let w = &scratch.share.withheld;
+                if let Ok(k) = w.binary_search_by_key(&i, |&(j, _)| j) {
+                    *r -= w[k].1 * (scratch.lumped[i] / dt);
+                }
+            }
+        }
         let vert = &mut self.particles.vert;
         let steps = vert.x.iter_mut().zip(&mut vert.v);
         for ((x, v), (d, u)) in steps.zip(scratch.dv.iter().zip(&scratch.share.vert)) {

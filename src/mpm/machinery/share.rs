@@ -18,7 +18,9 @@
 //! change instead (a pinned vertex, one held on an obstacle) still lends
 //! its mass to the nodes: the part of the momentum that lands on it is
 //! the pin's or the obstacle's, as the grid update's constraints take
-//! what reaches the nodes they hold. With no affine part, like PIC, it
+//! what reaches the nodes they hold ([`Share::withheld`]; a pin's reported
+//! force includes it, so that the pin's impulse balances the yarn's
+//! momentum, `tests/axial.rs`). With no affine part, like PIC, it
 //! does not keep the angular momentum of what it drops. The axial step of
 //! `axial = "implicit"` gives its velocity change through it under FLIP,
 //! where a particle keeps its own velocity from one substep to the next
@@ -49,6 +51,11 @@ pub struct Share {
     pub vert: Vec<Vec2>,
     /// Each quadrature particle's share of the change.
     pub quad: Vec<Vec2>,
+    /// Each vertex that kept its own change (not `free`, in vertex order)
+    /// with the share it would have gathered: the momentum `M u` that
+    /// landed on it is what its constraint (a pin, an obstacle) took from
+    /// the others.
+    pub withheld: Vec<(usize, Vec2)>,
 }
 
 /// The vertices' fields: the grid of each field (field 0 the
@@ -95,6 +102,7 @@ impl Share {
     /// quadrature particle the mean of its two vertices' (a substep whose
     /// transfer drops what the grid cannot hold at the next one, APIC).
     pub fn own(&mut self, p: &Particles, dv: &[Vec2]) {
+        self.withheld.clear();
         self.vert.clear();
         self.vert.extend_from_slice(dv);
         self.quad.clear();
@@ -123,6 +131,7 @@ fn of(
 ) {
     let (v, q) = (&p.vert, &p.quad);
     let (nodes, vert_u, quad_u) = (&mut out.nodes, &mut out.vert, &mut out.quad);
+    let withheld = &mut out.withheld;
     nodes.resize(fields.grids.len(), Nodes::new());
     for (buf, g) in nodes.iter_mut().zip(&fields.grids) {
         if buf.len() != g.geom.storage() {
@@ -157,15 +166,14 @@ fn of(
         }
     }
     let nodes = &*nodes;
+    let share = |i: usize| {
+        let f = field(i);
+        gather(&nodes[f], &fields.grids[f].geom, &v.stencil[i], &held)
+    };
     vert_u.clear();
-    vert_u.extend((0..v.x.len()).map(|i| {
-        if free[i] {
-            let f = field(i);
-            gather(&nodes[f], &fields.grids[f].geom, &v.stencil[i], &held)
-        } else {
-            dv[i]
-        }
-    }));
+    vert_u.extend((0..v.x.len()).map(|i| if free[i] { share(i) } else { dv[i] }));
+    withheld.clear();
+    withheld.extend((0..v.x.len()).filter(|&i| !free[i]).map(|i| (i, share(i))));
     // a quadrature particle takes the mean of its two vertices' shares, as
     // it takes the mean of their changes in the step (a vertex that keeps
     // its own change gives it: half the particle's mass is in each
