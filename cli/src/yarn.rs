@@ -14,7 +14,7 @@
 //! exception: there the bound is pessimistic, up to 10x, and
 //! `--allow-unstable` runs such a step.)
 
-use yarnsim::mpm::driver::timestep;
+use yarnsim::mpm::driver::timestep::{self, WITHOUT_PLASTICITY};
 use yarnsim::scene::{Integrator, YarnScene};
 use yarnsim::{SimError, YarnSim};
 
@@ -112,26 +112,27 @@ pub fn check_step(dt: f64, bound: f64, allow: bool) -> Result<Option<String>, Cl
 
 /// A failed substep of `sim` as the CLI reports it: a divergence with the
 /// hint to the stable step, or to the return mapping where the explicit
-/// step was within its bound and the scene runs without it; other errors
-/// as they are.
+/// step was within its bound and the scene runs without it
+/// ([`YarnSim::diverges_without_plasticity`]); other errors as they are.
 pub fn explain(sim: &YarnSim, e: SimError) -> CliError {
     if !matches!(e, SimError::NonFinite { .. }) {
         return CliError::Sim(e);
     }
     let sc = sim.scene();
-    let m = &sc.material;
-    let plasticity_off = !m.plasticity && (m.youngs_modulus > 0.0 || m.gamma > 0.0);
+    if sim.diverges_without_plasticity() {
+        let hint = format!("{WITHOUT_PLASTICITY} (--set material.plasticity=true)");
+        return CliError::Diverged { error: e, hint };
+    }
     let hint = match sc.time.dt.fixed() {
-        Some(dt) if sim.is_implicit() => format!(
-            "the substep dt = {dt} s of integrator = \"{}\" must keep every particle within one \
-             grid cell; {AUTO}, or a smaller dt",
-            sc.time.integrator.name()
-        ),
-        None if plasticity_off => PLASTICITY_OFF.to_string(),
         None => format!(
             "dt = \"auto\" stepped at time.safety = {} of the stability bound; a lower one \
              (--set time.safety=0.4) takes shorter substeps",
             sc.time.safety.unwrap_or(yarnsim::scene::DEFAULT_SAFETY)
+        ),
+        Some(dt) if sim.is_implicit() => format!(
+            "the substep dt = {dt} s of integrator = \"{}\" must keep every particle within one \
+             grid cell; {AUTO}, or a smaller dt",
+            sc.time.integrator.name()
         ),
         Some(dt) => {
             // The bound of the scene at rest: the state that diverged has
@@ -139,34 +140,19 @@ pub fn explain(sim: &YarnSim, e: SimError) -> CliError {
             let bound =
                 timestep::explicit_stable_dt(&sc.material, sc.time.axial, sc.dx(), 0.0, 1.0);
             let ratio = dt / bound;
-            if ratio > 1.0 + 1e-9 {
-                format!(
-                    "the substep dt = {dt} s is {ratio:.1}x the stability bound {bound:.6e} s of \
-                     this yarn scene at rest; {AUTO}, or a smaller dt"
-                )
-            } else if plasticity_off {
-                PLASTICITY_OFF.to_string()
+            let relation = if ratio > 1.0 + 1e-9 {
+                format!("{ratio:.1}x the stability bound {bound:.6e} s of this yarn scene at rest")
             } else {
                 format!(
-                    "the substep dt = {dt} s is within the stability bound {bound:.6e} s of this \
-                     yarn scene at rest, which falls as the yarns speed up; {AUTO}, or a smaller dt"
+                    "within the stability bound {bound:.6e} s of this yarn scene at rest, which \
+                     falls as the yarns speed up"
                 )
-            }
+            };
+            format!("the substep dt = {dt} s is {relation}; {AUTO}, or a smaller dt")
         }
     };
     CliError::Diverged { error: e, hint }
 }
-
-/// The hint of a divergence within the step's bound without the return
-/// mapping. Measured: the built-in bundle with `material.plasticity =
-/// false` diverges at its landing (t = 0.126 to 0.147 s) at dt 4e-5 and
-/// 1e-5 and under `"auto"` at safety 0.8, 0.4 and 0.1
-/// (`docs/performance/bundle-convergence.md`).
-const PLASTICITY_OFF: &str = "material.plasticity = false keeps every cross-section that has \
-     opened (no return mapping of Jiang et al. 2017: r22 > 1 is kept), and yarns that land on \
-     each other or on an obstacle may then diverge whatever the step (the built-in bundle does \
-     at dt 4e-5 and 1e-5 and under dt = \"auto\" at time.safety 0.8, 0.4 and 0.1); set \
-     material.plasticity = true (--set material.plasticity=true)";
 
 impl Stepper for YarnSim {
     fn step(&mut self) -> Result<(), CliError> {

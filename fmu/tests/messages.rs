@@ -352,3 +352,42 @@ fn fmi3_a_rejected_input_needs_a_state_restore_and_then_runs_on_bitwise() {
         assert_eq!(bits(&a), bits(&b), "step {k}");
     }
 }
+
+/// A divergence of the small scene without the return mapping
+/// (`material.plasticity = false`, at its own dt within the bound; it
+/// diverges at t = 0.3064 s) gives fmi2Discard with the log naming the
+/// parameter to change, as the CLI's message does; with plasticity on the
+/// same run passes.
+#[test]
+fn a_divergence_without_plasticity_names_the_parameter() {
+    let scene = small_scene();
+    let f = Fmu::new(&scene);
+    assert_eq!(f.set_bool(VR_PLASTICITY, false), fmi2OK);
+    f.init();
+    let mut t = 0.0;
+    let status = loop {
+        let s = f.do_step(t, H);
+        if s != fmi2OK || t > 1.0 {
+            break s;
+        }
+        t += H;
+    };
+    assert_eq!(status, fmi2Discard, "no divergence by t = {t}");
+    f.assert_discarded_at(t);
+    let e = last_error_in(&f.lines(), fmi2Discard);
+    assert!(
+        e.contains("simulation diverged")
+            && e.contains("material.plasticity = false keeps every cross-section")
+            && e.contains("set material.plasticity = true; the simulation is terminated"),
+        "{e}"
+    );
+    let g = Fmu::initialized(&scene);
+    for k in 0..=(t / H).round() as u32 {
+        assert_eq!(
+            g.do_step(k as f64 * H, H),
+            fmi2OK,
+            "with plasticity, t = {}",
+            k as f64 * H
+        );
+    }
+}

@@ -142,7 +142,40 @@ pub fn implicit_auto_dt(dx: f64, v_max: f64, accel: f64, safety: f64) -> f64 {
     2.0 * h / (v + (v * v + 4.0 * accel.abs() * h).sqrt())
 }
 
+/// Why an explicit run without the return mapping diverged within its
+/// step's bound, as the CLI and the FMU report it ([`YarnSim::diverges_without_plasticity`]).
+/// Measured: the built-in bundle with `material.plasticity = false`
+/// diverges at its landing (t = 0.126 to 0.147 s) at dt 4e-5 and 1e-5 and
+/// under `"auto"` at safety 0.8, 0.4 and 0.1
+/// (`docs/performance/bundle-convergence.md`).
+pub const WITHOUT_PLASTICITY: &str = "material.plasticity = false keeps every cross-section \
+     that has opened (no return mapping of Jiang et al. 2017: r22 > 1 is kept), and yarns that \
+     land on each other or on an obstacle may then diverge whatever the step (the built-in \
+     bundle does at dt 4e-5 and 1e-5 and under dt = \"auto\" at time.safety 0.8, 0.4 and 0.1); \
+     set material.plasticity = true";
+
 impl YarnSim {
+    /// Whether a divergence of this run is the missing return mapping's
+    /// rather than its step's ([`WITHOUT_PLASTICITY`]): the explicit
+    /// integrator on a material with a cross-section or shear stiffness
+    /// and `plasticity = false`, stepping under `dt = "auto"` or at a
+    /// fixed `dt` within the bound of the scene at rest (above it the
+    /// step is the first suspect).
+    pub fn diverges_without_plasticity(&self) -> bool {
+        let scene = self.scene();
+        let m = &scene.material;
+        if self.is_implicit() || m.plasticity || (m.youngs_modulus <= 0.0 && m.gamma <= 0.0) {
+            return false;
+        }
+        match scene.time.dt.fixed() {
+            None => true,
+            Some(dt) => {
+                let bound = explicit_stable_dt(m, scene.time.axial, scene.dx(), 0.0, 1.0);
+                dt <= bound * (1.0 + 1e-9)
+            }
+        }
+    }
+
     /// The largest particle speed now, in m/s (vertices and quadrature
     /// particles). A parallel maximum: the same value for any thread count
     /// (the maximum does not depend on the order of the reduction).

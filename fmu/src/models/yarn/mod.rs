@@ -6,6 +6,7 @@
 use std::path::Path;
 
 use yarnsim::mpm::driver::state::DynamicState;
+use yarnsim::mpm::driver::timestep::WITHOUT_PLASTICITY;
 use yarnsim::mpm::{Diagnostics, SimError, YarnSim};
 use yarnsim::scene::{Axial, Integrator, TransferScheme, YarnScene};
 
@@ -186,9 +187,16 @@ impl YarnModel {
         step: Result<(), SimError>,
         weight: f64,
     ) -> Result<(), StepFailure> {
-        step.map_err(|e| StepFailure {
-            terminal: matches!(e, SimError::NonFinite { .. } | SimError::Refused { .. }),
-            msg: e.to_string(),
+        step.map_err(|e| {
+            let diverged = matches!(e, SimError::NonFinite { .. });
+            StepFailure {
+                terminal: diverged || matches!(e, SimError::Refused { .. }),
+                msg: if diverged && self.sim.diverges_without_plasticity() {
+                    format!("{e}; {WITHOUT_PLASTICITY}")
+                } else {
+                    e.to_string()
+                },
+            }
         })?;
         // The yarn pulls on each pin with the opposite of the pin's force.
         for (s, r) in self.forces.sum.iter_mut().zip(self.sim.pin_reactions()) {
