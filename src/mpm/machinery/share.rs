@@ -21,7 +21,9 @@
 //! what reaches the nodes they hold ([`Share::withheld`]; a pin's reported
 //! force includes it, so that the pin's impulse balances the yarn's
 //! momentum, `tests/axial.rs`). With no affine part, like PIC, it
-//! does not keep the angular momentum of what it drops. The axial step of
+//! does not keep the angular momentum of what it drops (four crossed
+//! yarns thrown at random velocities lose 3.7e-4 of `sum m r v` over 12
+//! ms, `tests/axial_momentum.rs`). The axial step of
 //! `axial = "implicit"` gives its velocity change through it under FLIP,
 //! where a particle keeps its own velocity from one substep to the next
 //! (`crate::mpm::driver`'s `axial.rs`).
