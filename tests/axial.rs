@@ -7,7 +7,7 @@
 
 mod common;
 
-use common::{bundle, pin_end, same_bits_on_one_and_two_threads, straight, Rng, SceneBuilder};
+use common::{pin_end, same_bits_on_one_and_two_threads, straight, SceneBuilder};
 use yarnsim::math::Vec2;
 use yarnsim::scene::{
     builtin::yarn_reference, Axial, Integrator, StepSize, TransferScheme, YarnEnd, YarnScene,
