@@ -15,10 +15,6 @@ use yarnsim_fmu::models::yarn::variables::*;
 const H: f64 = 0.01;
 const STEPS: u32 = 6;
 
-fn bits(v: &[f64]) -> Vec<u64> {
-    v.iter().map(|x| x.to_bits()).collect()
-}
-
 /// The small scene with a stiff fibre (`k` x100: a wave 10 times faster
 /// than the scene's own), where the axial step changes the answer, at a
 /// substep below the explicit bound of that wave (5e-5 s against 6.6e-5
@@ -37,14 +33,7 @@ fn library_run(scene: &YarnScene) -> Vec<f64> {
     let mut sim = YarnSim::new(scene).unwrap();
     let per_step = (H / scene.time.dt.fixed().unwrap()).round() as u64;
     sim.steps_n(STEPS as u64 * per_step).unwrap();
-    let mut out = Vec::new();
-    for y in 0..sim.num_yarns() {
-        let (l, r) = sim.yarn_endpoints(y);
-        out.extend([l.x, l.y, r.x, r.y]);
-    }
-    let d = sim.diagnostics();
-    out.extend([d.kinetic_energy, d.elastic_energy, d.max_stretch]);
-    out
+    library_outputs(&sim)
 }
 
 /// An FMU of `scene` with `time.axial`, `transfer.scheme` and

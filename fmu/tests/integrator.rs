@@ -53,10 +53,6 @@ fn init_status(f: &Fmu) -> fmi2Status {
     }
 }
 
-fn bits(v: &[f64]) -> Vec<u64> {
-    v.iter().map(|x| x.to_bits()).collect()
-}
-
 /// Steps the library's `sim` over one communication step of 0.01 s (10
 /// substeps of the chain's dt 1e-3) and asserts that the FMU's yarn-end
 /// outputs are its bits.

@@ -28,6 +28,24 @@ pub fn cdylib_path() -> PathBuf {
         .unwrap_or_else(|| panic!("{name} was not built next to {}", deps.display()))
 }
 
+/// The library's values of the FMU's outputs in [`Fmu::outputs`] order:
+/// every yarn's ends, then kinetic energy, elastic energy, largest stretch.
+pub fn library_outputs(sim: &yarnsim::YarnSim) -> Vec<f64> {
+    let mut out = Vec::new();
+    for y in 0..sim.num_yarns() {
+        let (l, r) = sim.yarn_endpoints(y);
+        out.extend([l.x, l.y, r.x, r.y]);
+    }
+    let d = sim.diagnostics();
+    out.extend([d.kinetic_energy, d.elastic_energy, d.max_stretch]);
+    out
+}
+
+/// Bit patterns, for exact comparisons of runs.
+pub fn bits(v: &[f64]) -> Vec<u64> {
+    v.iter().map(|x| x.to_bits()).collect()
+}
+
 pub fn small_scene() -> YarnScene {
     YarnScene::from_toml_str(SMALL_SCENE).unwrap()
 }
