@@ -20,7 +20,7 @@
 //! the pin's or the obstacle's, as the grid update's constraints take
 //! what reaches the nodes they hold ([`Share::withheld`]; a pin's reported
 //! force includes it, so that the pin's impulse balances the yarn's
-//! momentum, `tests/axial.rs`). With no affine part, like PIC, it
+//! momentum, `tests/axial_momentum.rs`). With no affine part, like PIC, it
 //! does not keep the angular momentum of what it drops (four crossed
 //! yarns thrown at random velocities lose 3.7e-4 of `sum m r v` over 12
 //! ms, `tests/axial_momentum.rs`). The axial step of
@@ -256,6 +256,11 @@ mod tests {
     }
 
     fn run(p: &Particles, g: GridGeom, dv: &[Vec2], free: &[bool]) -> (Vec<Vec2>, Vec<Vec2>) {
+        let s = run_share(p, g, dv, free);
+        (s.vert, s.quad)
+    }
+
+    fn run_share(p: &Particles, g: GridGeom, dv: &[Vec2], free: &[bool]) -> Share {
         // a window over the whole domain, with the blocks the particles'
         // stencils touch marked active, as the scatter marks them
         let mut grid = Grid::new(g);
@@ -282,7 +287,7 @@ mod tests {
         s.of(p, &fields, dv, &lumped, free, |_, _| false);
         // the buffers are left zero for the next call
         assert!(s.nodes[0].iter().all(|n| *n == [0.0; 3]));
-        (s.vert, s.quad)
+        s
     }
 
     /// Momentum kept (to round-off, 1e-12 of `sum m |dv|`) for a change
@@ -373,6 +378,17 @@ mod tests {
             "{lost:?} against {:?}",
             v0[5] * lumped5
         );
+        // and `withheld` gives it: the held vertex with what the grid
+        // would give it (the pin's force adds its momentum)
+        let w = run_share(&p, g, &dv, &free).withheld;
+        assert_eq!(w.len(), 1);
+        assert_eq!(w[0].0, 5);
+        assert!(
+            (w[0].1 - v0[5]).norm() <= 1e-12 * v0[5].norm(),
+            "{w:?} against {:?}",
+            v0[5]
+        );
+        assert!(run_share(&p, g, &dv0, &vec![true; n]).withheld.is_empty());
         assert!(lost.norm() > 1e-3 * (d * lumped5).norm(), "{lost:?}");
     }
 }
