@@ -163,13 +163,7 @@ fn bad_axial_and_flip_time_values_are_refused_naming_the_variable() {
     // under pure FLIP without a relaxation time, and a relaxation time
     // beside a FLIP ratio other than 1.
     let refused_at_init = |f: &Fmu, field: &str, words: &str| {
-        assert_eq!(f.setup(0.0, None), fmi2OK);
-        // SAFETY: `f.c` came from `fmi2Instantiate` and lives until its `Fmu` drops.
-        let status = unsafe {
-            assert_eq!(fmi2EnterInitializationMode(f.c), fmi2OK);
-            fmi2ExitInitializationMode(f.c)
-        };
-        assert_eq!(status, fmi2Error, "{field}");
+        assert_eq!(f.init_status(), fmi2Error, "{field}");
         f.assert_error_contains(field);
         f.assert_error_contains(words);
     };

@@ -43,16 +43,6 @@ fn chain() -> YarnScene {
     YarnScene::from_toml_str(&chain_text()).unwrap()
 }
 
-/// Enter and exit initialization mode (start 0); the exit's status.
-fn init_status(f: &Fmu) -> fmi2Status {
-    assert_eq!(f.setup(0.0, None), fmi2OK);
-    // SAFETY: `f.c` came from `fmi2Instantiate` and lives until its `Fmu` drops.
-    unsafe {
-        assert_eq!(fmi2EnterInitializationMode(f.c), fmi2OK);
-        fmi2ExitInitializationMode(f.c)
-    }
-}
-
 /// Steps the library's `sim` over one communication step of 0.01 s (10
 /// substeps of the chain's dt 1e-3) and asserts that the FMU's yarn-end
 /// outputs are its bits.
@@ -143,19 +133,19 @@ fn integrator_parameter_takes_the_two_names_and_is_fixed_after_initialization() 
 
     let g = Fmu::new(&mixed_scene());
     assert_eq!(g.set_string(VR_INTEGRATOR, "implicit"), fmi2OK);
-    assert_eq!(init_status(&g), fmi2OK, "{:?}", g.lines());
+    assert_eq!(g.init_status(), fmi2OK, "{:?}", g.lines());
     assert_eq!(g.do_step(0.0, 0.01), fmi2OK, "{:?}", g.lines());
     let small = Fmu::new(&small_scene());
     assert_eq!(small.set_string(VR_INTEGRATOR, "implicit"), fmi2OK);
-    assert_eq!(init_status(&small), fmi2OK, "{:?}", small.lines());
+    assert_eq!(small.init_status(), fmi2OK, "{:?}", small.lines());
     let b = Fmu::new(&chain());
     assert_eq!(b.set_string(VR_INTEGRATOR, "implicit"), fmi2OK);
     assert_eq!(b.set_real(&[VR_BENDING], &[1e-4]), fmi2OK);
-    assert_eq!(init_status(&b), fmi2OK, "{:?}", b.lines());
+    assert_eq!(b.init_status(), fmi2OK, "{:?}", b.lines());
 
     let ok = Fmu::new(&chain());
     assert_eq!(ok.set_string(VR_INTEGRATOR, "implicit"), fmi2OK);
-    assert_eq!(init_status(&ok), fmi2OK, "{:?}", ok.lines());
+    assert_eq!(ok.init_status(), fmi2OK, "{:?}", ok.lines());
     assert_eq!(ok.get_string(VR_INTEGRATOR), "implicit");
     assert_eq!(ok.set_string(VR_INTEGRATOR, "explicit"), fmi2Error);
     ok.assert_error_contains("integrator is a fixed parameter");
@@ -183,12 +173,12 @@ fn gridless_integrators_give_the_library_bits_and_refuse_out_of_scope_scenes() {
         }
         let two = Fmu::new(&mixed_scene());
         assert_eq!(two.set_string(VR_INTEGRATOR, name), fmi2OK);
-        assert_eq!(init_status(&two), fmi2Error, "{:?}", two.lines());
+        assert_eq!(two.init_status(), fmi2Error, "{:?}", two.lines());
         let log = format!("{:?}", two.lines());
         assert!(log.contains("yarns") && log.contains(name), "{log}");
         let small = Fmu::new(&small_scene());
         assert_eq!(small.set_string(VR_INTEGRATOR, name), fmi2OK);
-        assert_eq!(init_status(&small), fmi2Error, "{:?}", small.lines());
+        assert_eq!(small.init_status(), fmi2Error, "{:?}", small.lines());
         let log = format!("{:?}", small.lines());
         assert!(
             log.contains("material.gamma") || log.contains("yarns"),

@@ -37,16 +37,6 @@ fn set_scene(f: &Fmu, path: &str) -> fmi2Status {
     unsafe { fmi2SetString(f.c, &VR_SCENE, 1, &p) }
 }
 
-fn exit_init(f: &Fmu) -> fmi2Status {
-    assert_eq!(f.setup(0.0, None), fmi2OK);
-    // SAFETY: `f.c` came from `fmi2Instantiate` and lives until its `Fmu` drops; every pointer
-    // argument is a local that outlives the call.
-    assert_eq!(unsafe { fmi2EnterInitializationMode(f.c) }, fmi2OK);
-    // SAFETY: `f.c` came from `fmi2Instantiate` and lives until its `Fmu` drops; every pointer
-    // argument is a local that outlives the call.
-    unsafe { fmi2ExitInitializationMode(f.c) }
-}
-
 /// dt = 1e-9 s with h = 1 s asks for 1e9 substeps: refused at once with
 /// fmi2Error and a log line naming the count, before any substep runs.
 #[test]
@@ -55,7 +45,7 @@ fn a_step_beyond_the_substep_budget_is_refused_before_it_runs() {
     let f = Fmu::new(&scene);
     assert_eq!(f.set_real(&[VR_DT], &[1e-9]), fmi2OK);
     // 1e-9 s is far inside the stability bound: no warning.
-    assert_eq!(exit_init(&f), fmi2OK, "{:?}", f.lines());
+    assert_eq!(f.init_status(), fmi2OK, "{:?}", f.lines());
     assert_eq!(get_int(&f, VR_MAX_SUBSTEPS), DEFAULT_MAX_SUBSTEPS as c_int);
     let t0 = Instant::now();
     assert_eq!(f.do_step(0.0, 1.0), fmi2Error);
@@ -94,7 +84,7 @@ fn a_step_beyond_the_substep_budget_is_refused_before_it_runs() {
         m.set_real(&[yarnsim_fmu::models::massspring::VR_DT], &[1e-9]),
         fmi2OK
     );
-    assert_eq!(exit_init(&m), fmi2OK, "{:?}", m.lines());
+    assert_eq!(m.init_status(), fmi2OK, "{:?}", m.lines());
     assert_eq!(m.do_step(0.0, 1.0), fmi2Error);
     m.assert_error_contains("needs 1000000000 substeps");
 }
@@ -110,12 +100,12 @@ fn a_substep_beyond_the_stability_bound_gives_a_warning() {
     let dt = scene.time.dt.fixed().unwrap();
     assert!(dt < bound, "{dt} vs {bound}");
     let f = Fmu::new(&scene);
-    assert_eq!(exit_init(&f), fmi2OK);
+    assert_eq!(f.init_status(), fmi2OK);
     assert!(!f.lines().iter().any(|l| l.0 == fmi2Warning));
 
     let f = Fmu::new(&scene);
     assert_eq!(f.set_real(&[VR_DT], &[2.0 * bound]), fmi2OK);
-    assert_eq!(exit_init(&f), fmi2Warning);
+    assert_eq!(f.init_status(), fmi2Warning);
     let line = warning_line(&f);
     assert!(line.contains("stability bound"), "{}", line);
     assert!(line.contains(&format!("{bound:.6e}")), "{} {bound}", line);
@@ -140,20 +130,20 @@ fn a_substep_beyond_the_stability_bound_gives_a_warning() {
     // argument is a local that outlives the call.
     assert_eq!(unsafe { fmi2SetString(m.c, &VR_INTEGRATOR, 1, &p) }, fmi2OK);
     // Its default step (cfl_number times the bound) is inside.
-    assert_eq!(exit_init(&m), fmi2OK, "{:?}", m.lines());
+    assert_eq!(m.init_status(), fmi2OK, "{:?}", m.lines());
     let m = Fmu::mass_spring(&layout);
     // SAFETY: `m.c` came from `fmi2Instantiate` and lives until its `Fmu` drops; every pointer
     // argument is a local that outlives the call.
     assert_eq!(unsafe { fmi2SetString(m.c, &VR_INTEGRATOR, 1, &p) }, fmi2OK);
     assert_eq!(m.set_real(&[MS_DT], &[1.5 * ms_bound]), fmi2OK);
-    assert_eq!(exit_init(&m), fmi2Warning);
+    assert_eq!(m.init_status(), fmi2Warning);
     assert!(m
         .lines()
         .iter()
         .any(|l| l.0 == fmi2Warning && l.2.contains("stability bound")));
     let m = Fmu::mass_spring(&layout);
     assert_eq!(m.set_real(&[MS_DT], &[0.5]), fmi2OK);
-    assert_eq!(exit_init(&m), fmi2OK);
+    assert_eq!(m.init_status(), fmi2OK);
 }
 
 fn threaded_run(threads: c_int, scene: &yarnsim::scene::YarnScene) -> Vec<u64> {

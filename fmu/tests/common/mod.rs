@@ -326,17 +326,24 @@ impl Fmu {
         }
     }
 
-    /// Setup at 0, enter and exit initialization, which may warn (a scene
-    /// warning, `YarnScene::warnings`); returns the exit status.
-    pub fn init_warned(&self) -> fmi2Status {
+    /// Setup at 0 without stop time, enter initialization (fmi2OK) and
+    /// exit it; returns the exit's status (an error the scene's checks
+    /// raise there, a warning, or fmi2OK).
+    pub fn init_status(&self) -> fmi2Status {
         assert_eq!(self.setup(0.0, None), fmi2OK);
         // SAFETY: `self.c` came from `fmi2Instantiate` and lives until its `Fmu` drops.
         unsafe {
             assert_eq!(fmi2EnterInitializationMode(self.c), fmi2OK);
-            let status = fmi2ExitInitializationMode(self.c);
-            assert!(status <= fmi2Warning, "{status}: {:?}", self.lines());
-            status
+            fmi2ExitInitializationMode(self.c)
         }
+    }
+
+    /// [`Self::init_status`], which may warn (a scene warning,
+    /// `YarnScene::warnings`) but not fail; returns the exit status.
+    pub fn init_warned(&self) -> fmi2Status {
+        let status = self.init_status();
+        assert!(status <= fmi2Warning, "{status}: {:?}", self.lines());
+        status
     }
 
     pub fn set_real(&self, vr: &[u32], v: &[f64]) -> fmi2Status {
