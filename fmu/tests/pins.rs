@@ -488,7 +488,7 @@ fn a_preset_yarns_pin_force_times_the_spacing_is_one_yarns_weight() {
 }
 
 /// A scene file with `transfer.flip_time` (a relaxation time; the
-/// parameter of that name: `tests/axial.rs`) runs with the library's bits,
+/// parameter of that name: `fmu/tests/axial.rs`) runs with the library's bits,
 /// and `transfer.flip_ratio` reads 1; another ratio beside it is refused,
 /// naming `transfer.flip_time`, and the FMU reports the error.
 #[test]
