@@ -352,6 +352,50 @@ pub fn capstan_vertices(r: f64, l1: f64, l2: f64, res: u32) -> u32 {
     (length / (0.5 * dx)).round() as u32 + 1
 }
 
+/// The capstan of [`capstan_toml`] (R 0.1, L1 0.1, L2 0.3 m, the grid and
+/// step of `c`) as one yarn of `[material] preset = preset` on its
+/// vertices (the preset's cross-section energies off: a gridless
+/// integrator has none), every length and the domain times `scale`. A
+/// real yarn's bending is not negligible on the 0.1 m drum (the
+/// heavy-rope threshold neglects it: the nylon monofilament's EI / R is
+/// twice the hanging strand's moment); ten times longer it is 1/500 of
+/// it, while the threshold, which depends on the ratios of the lengths
+/// only, stays. Returns the scene and the hanging lengths `(l1, l2)` in
+/// m. The scene's integrator is the explicit default: set a gridless one.
+pub fn capstan_preset_scene(
+    preset: &str,
+    scale: f64,
+    mu: f64,
+    c: &Capstan,
+) -> (YarnScene, f64, f64) {
+    let (r, l1, l2) = (0.1, 0.1, 0.3);
+    let mut text = capstan_toml(r, l1, l2, mu, c);
+    let start = text.find("[material]").expect("[material] table");
+    let end = start
+        + text[start..]
+            .find("[walls]")
+            .expect("[walls] after [material]");
+    text.replace_range(
+        start..end,
+        &format!("[material]\npreset = {preset:?}\ngamma = 0.0\nyoungs_modulus = 0.0\n"),
+    );
+    let mut s = YarnScene::from_toml_str(&text).expect("the capstan with a preset");
+    s.grid.size *= scale;
+    s.attractor.position = s.attractor.position.map(|x| x * scale);
+    for o in &mut s.obstacles {
+        o.center = o.center.map(|x| x * scale);
+        o.radius *= scale;
+    }
+    for p in s
+        .yarns
+        .iter_mut()
+        .flat_map(|y| y.points.iter_mut().flatten())
+    {
+        *p = p.map(|x| x * scale);
+    }
+    (s, l1 * scale, l2 * scale)
+}
+
 /// A yarn over a half circle of radius `r` centred at (0.5, 0.75), hanging
 /// `l1` on the left and `l2` on the right, on a circle with friction `mu`,
 /// as scene TOML: k = 1000, no walls, the rest from `c`.

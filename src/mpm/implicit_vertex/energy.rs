@@ -4,6 +4,7 @@
 //!
 //! ```text
 //! E(v) = sum_i m_i |v_i - v*_i|^2 / 2 + Psi(x + dt v)
+//! (the segment vectors of y = x + dt v formed as (x_{s+1} - x_s) + dt (v_{s+1} - v_s): Rod::edges)
 //! Psi(y) = sum_s a_s / 2 (|y_{s+1} - y_s| / l0_s - 1)^2
 //!        + sum_j B / 2 (kappa_j - kappa0_j)^2 inv_len_j
 //!        + sum_i m_i phi(|y_i - p|)
@@ -74,9 +75,26 @@ impl Rod {
         self.x.len()
     }
 
-    /// End-of-step positions `x + dt v`.
+    /// End-of-step positions `x + dt v` (the attractor's term only: the
+    /// yarn's own terms read [`Rod::edges`]).
     pub fn positions(&self, v: &[Vec2]) -> Vec<Vec2> {
         self.x.iter().zip(v).map(|(x, v)| x + v * self.dt).collect()
+    }
+
+    /// End-of-step segment vectors `(x_{s+1} - x_s) + dt (v_{s+1} - v_s)`:
+    /// formed from the start's segment vectors, not as differences of the
+    /// end positions `x + dt v`. Both are the same vectors, but rounding
+    /// `x + dt v` costs each trial of the line search an error of the
+    /// vertices' distance from the origin times the machine epsilon, which
+    /// on a stiff yarn metres from the origin (a real nylon monofilament
+    /// over a 1 m drum, 7 m up) outweighed the Newton step's predicted
+    /// decrease: the line search found none. Here the start's segment
+    /// vectors are the same in every trial and the rest is rounded at the
+    /// segment's length.
+    pub fn edges(&self, v: &[Vec2]) -> Vec<Vec2> {
+        (0..self.len().saturating_sub(1))
+            .map(|s| (self.x[s + 1] - self.x[s]) + (v[s + 1] - v[s]) * self.dt)
+            .collect()
     }
 
     /// Whether vertex `j` carries a bending term.
@@ -84,21 +102,22 @@ impl Rod {
         self.bending > 0.0 && j > 0 && j + 1 < self.len() && self.bend[j].inv_len != 0.0
     }
 
-    /// `Psi` at positions `y`.
-    pub fn potential(&self, y: &[Vec2]) -> f64 {
+    /// `Psi` at the end of the step with velocities `v`.
+    pub fn potential(&self, v: &[Vec2]) -> f64 {
+        let d = self.edges(v);
         let mut e = 0.0;
         for (s, &(a, l0)) in self.segments.iter().enumerate() {
-            e += axial::energy(a, l0, y[s + 1] - y[s]);
+            e += axial::energy(a, l0, d[s]);
         }
         for j in 0..self.len() {
             if self.bends(j) {
                 let b = &self.bend[j];
-                let dk = curvature(y[j] - y[j - 1], y[j + 1] - y[j]) - b.kappa0;
+                let dk = curvature(d[j - 1], d[j]) - b.kappa0;
                 e += 0.5 * self.bending * dk * dk * b.inv_len;
             }
         }
         if let Some((p, s)) = self.attractor {
-            for (y, m) in y.iter().zip(&self.m) {
+            for (y, m) in self.positions(v).iter().zip(&self.m) {
                 e += m * attractor::potential((y - p).norm(), s);
             }
         }
@@ -113,21 +132,22 @@ impl Rod {
             .zip(&self.m)
             .map(|((v, vs), m)| 0.5 * m * (v - vs).norm_squared())
             .sum();
-        kinetic + self.potential(&self.positions(v))
+        kinetic + self.potential(v)
     }
 
-    /// `dPsi/dy` at positions `y`.
-    pub fn potential_gradient(&self, y: &[Vec2]) -> Vec<Vec2> {
+    /// `dPsi/dy` at the end of the step with velocities `v`.
+    pub fn potential_gradient(&self, v: &[Vec2]) -> Vec<Vec2> {
+        let d = self.edges(v);
         let mut g = vec![Vec2::zeros(); self.len()];
         for (s, &(a, l0)) in self.segments.iter().enumerate() {
-            let f = axial::gradient(a, l0, y[s + 1] - y[s]);
+            let f = axial::gradient(a, l0, d[s]);
             g[s] -= f;
             g[s + 1] += f;
         }
         for j in 0..self.len() {
             if self.bends(j) {
                 let b = &self.bend[j];
-                let (e1, e2) = (y[j] - y[j - 1], y[j + 1] - y[j]);
+                let (e1, e2) = (d[j - 1], d[j]);
                 let [g1x, g1y, g2x, g2y] = bend_gradient_edges(
                     [e1.x, e1.y, e2.x, e2.y],
                     self.bending,
@@ -141,7 +161,7 @@ impl Rod {
             }
         }
         if let Some((p, s)) = self.attractor {
-            for ((g, y), m) in g.iter_mut().zip(y).zip(&self.m) {
+            for ((g, y), m) in g.iter_mut().zip(&self.positions(v)).zip(&self.m) {
                 let r = y - p;
                 let d = r.norm();
                 if d > 0.0 {
@@ -154,7 +174,7 @@ impl Rod {
 
     /// `dE/dv` without the friction term.
     pub fn gradient(&self, v: &[Vec2]) -> Vec<Vec2> {
-        let gp = self.potential_gradient(&self.positions(v));
+        let gp = self.potential_gradient(v);
         v.iter()
             .zip(&self.vstar)
             .zip(&self.m)
@@ -169,7 +189,7 @@ impl Rod {
     /// bending block by [`project_bend`]).
     pub fn hessian(&self, v: &[Vec2]) -> Hessian {
         let n = self.len();
-        let y = self.positions(v);
+        let d = self.edges(v);
         let z = [[0.0; 2]; 2];
         let mut h = Hessian {
             diag: vec![z; n],
@@ -178,7 +198,7 @@ impl Rod {
         };
         let dt2 = self.dt * self.dt;
         for (s, &(a, l0)) in self.segments.iter().enumerate() {
-            if let Some(k) = axial::hessian(a, l0, y[s + 1] - y[s]) {
+            if let Some(k) = axial::hessian(a, l0, d[s]) {
                 add(&mut h.diag[s], &k, dt2);
                 add(&mut h.diag[s + 1], &k, dt2);
                 add(&mut h.off1[s], &k, -dt2);
@@ -189,7 +209,7 @@ impl Rod {
                 continue;
             }
             let b = &self.bend[j];
-            let (e1, e2) = (y[j] - y[j - 1], y[j + 1] - y[j]);
+            let (e1, e2) = (d[j - 1], d[j]);
             let e = [e1.x, e1.y, e2.x, e2.y];
             let bs = self.bending;
             let mut he = jacobian(e, |e| bend_gradient_edges(e, bs, b.kappa0, b.inv_len));
@@ -221,7 +241,7 @@ impl Rod {
             add(&mut h.off2[j - 1], &h12, -dt2);
         }
         if let Some((p, s)) = self.attractor {
-            for (i, (y, m)) in y.iter().zip(&self.m).enumerate() {
+            for (i, (y, m)) in self.positions(v).iter().zip(&self.m).enumerate() {
                 let r = y - p;
                 let d = r.norm();
                 if d <= 0.0 {
