@@ -5,9 +5,10 @@
 //!
 //! ```text
 //! cargo run --release -p yarnsim-evidence --example peers_chain -- chain VERTICES GRID DT [INTEGRATOR [K]]
-//! cargo run --release -p yarnsim-evidence --example peers_chain -- chain-preset PRESET VERTICES GRID DT
+//! cargo run --release -p yarnsim-evidence --example peers_chain -- chain-preset PRESET VERTICES GRID DT [INTEGRATOR]
 //! cargo run --release -p yarnsim-evidence --example peers_chain -- cantilever VERTICES [INTEGRATOR [DT]]
 //! cargo run --release -p yarnsim-evidence --example peers_chain -- capstan R L1 L2 MU [INTEGRATOR [DT]]
+//! cargo run --release -p yarnsim-evidence --example peers_chain -- capstan-preset PRESET SCALE MU INTEGRATOR [DT]
 //! cargo run --release -p yarnsim-evidence --example peers_chain -- bundle DURATION [INTEGRATOR [DT [OPTION...]]]
 //! ```
 //!
@@ -26,6 +27,11 @@
 //! * `chain-preset`: the same chain as one yarn of `[material] preset =
 //!   PRESET` (its EA, EI, mass and cross-section), APIC, `[time] axial =
 //!   "implicit"`; `period` is to be compared with the hanging beam's.
+//!   With `INTEGRATOR` `implicit-vertices` or `midpoint-vertices` the
+//!   yarn steps on its vertices without the grid (`GRID` then only sizes
+//!   the domain): the preset's EA, EI and mass, its cross-section
+//!   energies off (`gamma = youngs_modulus = 0`: they live on the grid
+//!   and act only where yarns touch, which one hanging yarn does not).
 //! * `cantilever`: the Euler-Bernoulli cantilever of the oracle test
 //!   (L = 0.5 m, B = 1, rho = 1, 64^2, dt 5e-5, two vertices pinned), the tip
 //!   deflection averaged over two measured periods of the first mode;
@@ -34,6 +40,15 @@
 //!   g = 2) loaded for 0.2 s, then up to 1 s more: slid if a free end moved
 //!   vertically by more than 0.5 % of its hanging length; `DT` replaces
 //!   the substep.
+//! * `capstan-preset`: the capstan above (R 0.1, L1 0.1, L2 0.3 m) as one
+//!   yarn of `PRESET`, its lengths (and the domain) times `SCALE` and its
+//!   load and hold times `sqrt(SCALE)` (the same motion in units of the
+//!   hanging lengths; the slip threshold does not depend on the scale),
+//!   on the yarn's vertices without the grid (`INTEGRATOR`
+//!   `implicit-vertices` or `midpoint-vertices`; the preset's
+//!   cross-section energies off, as in `chain-preset`). A real yarn's
+//!   bending is not negligible on the 0.1 m drum (the heavy-rope oracle
+//!   neglects it); `SCALE` makes it so.
 //! * `bundle`: the built-in `yarn-reference` scene for `DURATION` s; prints
 //!   every yarn's vertex positions for the driver's common metrics and the
 //!   wall time of two windows (`windows`: `[start, end, wall]` for the fall
@@ -43,7 +58,9 @@
 //!   yarn's vertices every 0.1 s (not timed). `OPTION`s: `preset=NAME`
 //!   (the `[material]` table replaced by `preset = NAME`, return mapping
 //!   on), `apic`, `per-yarn` (`[contact] fields`), `axial-implicit`
-//!   (`[time] axial = "implicit"`).
+//!   (`[time] axial = "implicit"`), and any scene field as `KEY=VALUE`,
+//!   as `yarnsim run --set` takes it (for example
+//!   `transfer.flip_time=0.002` or `time.safety=0.3`).
 //!
 //! Threads: set `RAYON_NUM_THREADS=1` for one thread. The whole run steps
 //! on one rayon worker (`yarnsim::pool::on_pool`), as a program's own
@@ -53,12 +70,14 @@
 
 use std::time::Instant;
 
+use yarnsim::scene::overrides::{apply_to_text, parse_all};
 use yarnsim::scene::{
-    builtin_toml, Axial, FieldPartition, Integrator, StepSize, TransferScheme, YarnScene,
+    builtin_toml, Axial, FieldPartition, Integrator, Scene, StepSize, TransferScheme, YarnScene,
 };
 use yarnsim::testing::{
-    cantilever_setup, cantilever_toml, capstan_toml, capstan_vertices, hanging_chain_period,
-    hanging_chain_toml, two_periods_about_mean, ZeroCrossings, CAPSTAN_PURE_STRING,
+    cantilever_setup, cantilever_toml, capstan_preset_scene, capstan_toml, capstan_vertices,
+    hanging_chain_period, hanging_chain_toml, two_periods_about_mean, ZeroCrossings,
+    CAPSTAN_PURE_STRING,
 };
 use yarnsim::YarnSim;
 
@@ -137,11 +156,18 @@ fn chain(vertices: u32, grid: u32, dt: &str, integ: Integrator, k: Option<f64>) 
 /// return mapping), APIC and `[time] axial = "implicit"`. The `error` is
 /// against the string's oracle; the driver compares `period` with the
 /// hanging beam's (the bending shortens it).
-fn chain_preset(preset: &str, vertices: u32, grid: u32, dt: &str) -> String {
+fn chain_preset(preset: &str, vertices: u32, grid: u32, dt: &str, integ: Integrator) -> String {
     let text = hanging_chain_toml(vertices, grid, dt);
     let material = "k = 2000.0\ngamma = 0.0\nyoungs_modulus = 0.0\nfriction = 0.0\nbending = 0.0\n";
     assert!(text.contains(material), "the chain's [material] lines");
-    let mut s = scene(&text.replace(material, &format!("preset = {}\n", json_str(preset))));
+    let mut lines = format!("preset = {}\n", json_str(preset));
+    if integ.is_gridless() {
+        lines.push_str("gamma = 0.0\nyoungs_modulus = 0.0\n");
+    }
+    let mut s = scene(&text.replace(material, &lines));
+    if integ.is_gridless() {
+        return chain_run(s, integ);
+    }
     s.transfer.scheme = TransferScheme::Apic;
     s.time.axial = Axial::Implicit;
     chain_run(s, Integrator::Explicit)
@@ -221,9 +247,40 @@ fn capstan(r: f64, l1: f64, l2: f64, mu: f64, integ: Integrator, dt: Option<f64>
     }
     let vertices = capstan_vertices(r, l1, l2, c.res);
     let s = scene(&capstan_toml(r, l1, l2, mu, &c));
+    capstan_run(s, integ, (l1, l2), (0.2, 1.0), vertices)
+}
+
+/// The capstan of `capstan` (R 0.1, L1 0.1, L2 0.3 m) as one yarn of
+/// `preset` on its vertices, every length times `scale`, the load and
+/// hold times `sqrt(scale)`.
+fn capstan_preset(preset: &str, scale: f64, mu: f64, integ: Integrator, dt: Option<f64>) -> String {
+    if !integ.is_gridless() {
+        eprintln!("capstan-preset: INTEGRATOR must be implicit-vertices or midpoint-vertices");
+        std::process::exit(2)
+    }
+    let mut c = CAPSTAN_PURE_STRING;
+    if let Some(dt) = dt {
+        c.dt = dt;
+    }
+    let vertices = capstan_vertices(0.1, 0.1, 0.3, c.res);
+    let (s, l1, l2) = capstan_preset_scene(preset, scale, mu, &c);
+    let t = scale.sqrt();
+    capstan_run(s, integ, (l1, l2), (0.2 * t, 1.0 * t), vertices)
+}
+
+/// One capstan run: loaded for `load` s, then held `hold` s; slid if a
+/// free end moved vertically by more than 0.5 % of its hanging length
+/// (`l1` on the left, `l2` on the right).
+fn capstan_run(
+    s: YarnScene,
+    integ: Integrator,
+    (l1, l2): (f64, f64),
+    (load, hold): (f64, f64),
+    vertices: u32,
+) -> String {
     let mut sim = sim_with(s, integ);
     let t0 = Instant::now();
-    let mut ok = match sim.advance(0.2) {
+    let mut ok = match sim.advance(load) {
         Ok(_) => true,
         Err(e) => {
             eprintln!("{e}");
@@ -231,7 +288,7 @@ fn capstan(r: f64, l1: f64, l2: f64, mu: f64, integ: Integrator, dt: Option<f64>
         }
     };
     let (a0, b0) = sim.yarn_endpoints(0);
-    let steps = (1.0 / sim.dt()).round() as u64;
+    let steps = (hold / sim.dt()).round() as u64;
     let (mut worst, mut slid) = (0.0f64, false);
     for k in 0..steps {
         if !ok {
@@ -301,22 +358,38 @@ fn bundle_scene(options: &[String]) -> YarnScene {
             );
         }
     }
-    let mut s = scene(&text);
+    let sets: Vec<String> = options.iter().filter(|o| is_set(o)).cloned().collect();
+    let mut s = match parse_all(&sets).and_then(|o| apply_to_text(&text, &o)) {
+        Ok(Scene::Yarn(s)) => s,
+        Ok(_) => unreachable!("yarn-reference is a yarn scene"),
+        Err(e) => {
+            eprintln!("scene: {e}");
+            std::process::exit(3)
+        }
+    };
     for o in options {
         match o.as_str() {
             "apic" => s.transfer.scheme = TransferScheme::Apic,
             "per-yarn" => s.contact.fields = FieldPartition::PerYarn,
             "axial-implicit" => s.time.axial = Axial::Implicit,
-            x if x.starts_with("preset=") => {}
+            x if x.starts_with("preset=") || is_set(x) => {}
             x => {
                 eprintln!(
-                    "OPTION must be preset=NAME, apic, per-yarn or axial-implicit, got {x:?}"
+                    "OPTION must be preset=NAME, apic, per-yarn, axial-implicit or a scene \
+                     field KEY=VALUE, got {x:?}"
                 );
                 std::process::exit(2)
             }
         }
     }
     s
+}
+
+/// A bundle `OPTION` that sets a scene field: `KEY=VALUE` other than
+/// `preset=NAME` (`time.safety=0.3`, `gravity=[0.0, -9.8]`), as `yarnsim
+/// run --set` takes it.
+fn is_set(option: &str) -> bool {
+    option.contains('=') && !option.starts_with("preset=")
 }
 
 /// Seconds between the bundle's recorded frames (every yarn's vertices).
@@ -412,6 +485,7 @@ fn main() {
             arg(&args, 2, "VERTICES"),
             arg(&args, 3, "GRID"),
             &arg::<String>(&args, 4, "DT"),
+            integrator(&args, 5),
         ),
         Some("cantilever") => cantilever(
             arg(&args, 1, "VERTICES"),
@@ -425,6 +499,13 @@ fn main() {
             arg(&args, 4, "MU"),
             integrator(&args, 5),
             opt(&args, 6, "DT"),
+        ),
+        Some("capstan-preset") => capstan_preset(
+            &arg::<String>(&args, 1, "PRESET"),
+            arg(&args, 2, "SCALE"),
+            arg(&args, 3, "MU"),
+            integrator(&args, 4),
+            opt(&args, 5, "DT"),
         ),
         Some("bundle") => bundle(
             arg(&args, 1, "DURATION"),

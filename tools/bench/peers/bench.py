@@ -24,11 +24,12 @@ a scene the implicit integrator refuses is a row with ok=False and the
 refusal in `note`. `--quick` (under a minute) runs the coarsest chain and
 cantilever of each tool (and the implicit chain at 25 vertices, dt 1e-2), once, and writes `peers_quick.csv` / `.svg` into `--out` (default
 for quick: the system temp directory) instead of `peers.csv` / `.svg`.
-`--only nylon,bundle-preset,bundle-converged` runs only the real-yarn
-cases (the nylon monofilament's hanging chain in every tool, the bundle
-with a preset in yarnsim and MuJoCo, the bundle at yarnsim's converged
-setting against MuJoCo at two steps; README, "Real yarns") and replaces
-their rows in the existing CSV.
+`--only nylon,bundle-preset,bundle-converged,bundle-ladder` runs only
+the real-yarn cases (the nylon monofilament's hanging chain and capstan
+in every tool, the bundle with a preset in yarnsim and MuJoCo, the bundle
+at yarnsim's converged setting against MuJoCo at two steps, the bundle
+with a preset at a ladder of steps in each tool; README, "Real yarns")
+and replaces their rows in the existing CSV.
 """
 
 import argparse
@@ -151,13 +152,16 @@ def interleave(cs, rounds):
     return results
 
 
-def capstan(tool, slides, setting, integrator, rows):
+def capstan(tool, slides, setting, integrator, rows, case="capstan", c=None, rope_radius=None):
     """Bisection of the slip threshold between 0.7 and 1.4 mu* with
-    `slides(mu) -> (slid, wall, sim)`; one row."""
-    c = O.CAPSTAN
-    # the rope's centreline radius: MuJoCo's rope radius is 1 mm,
-    # PyElastica's 2 mm; yarnsim's yarn has no radius
-    r_eff = c["radius"] + {"mujoco": 1e-3, "pyelastica": 2e-3}.get(tool, 0.0)
+    `slides(mu) -> (slid, wall, sim)`; one row. `c`: the capstan
+    (`O.CAPSTAN` or `O.capstan_scaled`); `rope_radius` (m): how far the
+    rope's centreline lies from the drum (default: MuJoCo's 1 mm,
+    PyElastica's 2 mm; yarnsim's yarn has no radius)."""
+    c = c or O.CAPSTAN
+    if rope_radius is None:
+        rope_radius = {"mujoco": 1e-3, "pyelastica": 2e-3}.get(tool, 0.0)
+    r_eff = c["radius"] + rope_radius
     mu_star = O.capstan_threshold(r_eff, c["l1"], c["l2"])
     wall = sim = 0.0
     ok = True
@@ -182,14 +186,14 @@ def capstan(tool, slides, setting, integrator, rows):
                     hi = mid
     except yarnsim_rope.Refused as e:
         print(f"  capstan {tool:10s} {integrator} {setting}: refused: {e}", flush=True)
-        rows.append(refused_row(tool, integrator, "capstan", setting, str(e)))
+        rows.append(refused_row(tool, integrator, case, setting, str(e)))
         return
     mu = 0.5 * (lo + hi)
     err = (mu - mu_star) / mu_star
     print(f"  capstan {tool:10s} {setting}: mu* {mu_star:.4f}, threshold in [{lo:.4f}, {hi:.4f}], "
           f"error {err:+.2%} (bracket [{(lo - mu_star) / mu_star:+.1%}, "
           f"{(hi - mu_star) / mu_star:+.1%}]), {wall:.2f} s wall for {sim:.2f} s", flush=True)
-    rows.append(dict(tool=tool, integrator=integrator, case="capstan", setting=setting,
+    rows.append(dict(tool=tool, integrator=integrator, case=case, setting=setting,
                      error=err if ok else float("nan"), wall_s_per_sim_s=wall / sim,
                      wall_s=wall, sim_s=sim, rounds=1, ok=ok,
                      note=f"mu* {mu_star:.4f}, bracket [{(lo - mu_star) / mu_star:+.1%}, "
@@ -344,6 +348,14 @@ def nylon(rows, rounds):
                   f"{v} vertices, {g}^2, APIC, axial implicit, dt auto",
                   lambda v=v, g=g: yarnsim_rope.chain_preset(NYLON, v, g, '"auto"',
                                                              mat["oracle"])))
+    # one yarn needs no grid: its vertices under the midpoint rule (the
+    # preset's EA, EI and mass; `peers_chain chain-preset ... INTEGRATOR`),
+    # at the settings that reach MuJoCo's three errors
+    for v, dt in [(40, 1e-2), (100, 5e-3), (100, 2e-3)]:
+        c.append(("yarnsim", "vertices-midpoint", "chain-nylon",
+                  f"{v} vertices, no grid, dt {dt:g}",
+                  lambda v=v, dt=dt: yarnsim_rope.chain_preset(NYLON, v, 16, dt, mat["oracle"],
+                                                               "midpoint-vertices")))
     res = interleave(c, rounds)
     for i, (tool, integ, case, setting, _) in enumerate(c):
         rs = res[i]
@@ -355,6 +367,38 @@ def nylon(rows, rounds):
         rows.append(dict(tool=tool, integrator=integ, case=case, setting=setting,
                          error=rs[0]["error"], wall_s_per_sim_s=wall / sim, wall_s=wall,
                          sim_s=sim, rounds=len(rs), ok=all(r["ok"] for r in rs), note=note))
+
+
+# The nylon capstan's lengths against `O.CAPSTAN`: on the 0.1 m drum the
+# monofilament's bending moment EI / R (9.9e-6 N m) is twice the hanging
+# strand's w l2 R (4.8e-6 N m), which the heavy-rope oracle neglects; ten
+# times longer it is 1/500 of it
+NYLON_CAPSTAN_SCALE = 10.0
+
+
+def nylon_capstan(rows):
+    """The heavy-rope capstan (`O.capstan_scaled(NYLON_CAPSTAN_SCALE)`) as
+    one yarn of the nylon monofilament in every tool, one bisection each
+    (`capstan`). yarnsim on the yarn's vertices (`capstan-preset`);
+    MuJoCo with the preset's mass and EI at 150 and 300 elements (50 put
+    the 14 cm chords 2.5 mm inside the 1 m drum, more than the rope's 1 mm
+    radius: it slid at 1.4 mu*); PyElastica at a 5 cm radius (the
+    rotational mode of a thinner rope needs a smaller step: 2 cm ran at dt
+    1e-5 but not at 4e-5; the bend matrix is EI whatever the radius)."""
+    c = O.capstan_scaled(NYLON_CAPSTAN_SCALE)
+    mat = O.preset_chain(NYLON)
+    for integ, name in [("implicit-vertices", "vertices-implicit"),
+                        ("midpoint-vertices", "vertices-midpoint")]:
+        capstan("yarnsim", lambda mu, integ=integ: yarnsim_rope.capstan_preset_slides(
+            NYLON, NYLON_CAPSTAN_SCALE, mu, integ, 1e-2), "184 vertices, no grid, dt 1e-2",
+            name, rows, "capstan-nylon", c)
+    for n in (150, 300):
+        capstan("mujoco", lambda mu, n=n: mujoco_rope.capstan_slides(n, 1e-3, mu, c=c,
+                                                                      material=mat),
+                f"{n} elements, dt 1e-3, r 1 mm", "discrete", rows, "capstan-nylon", c)
+    capstan("pyelastica", lambda mu: elastica_rope.capstan_slides(
+        70, mu, dt=4e-5, radius=0.05, c=c, material=mat), "70 elements, dt 4e-5, r 5 cm",
+        "position-verlet", rows, "capstan-nylon", c, rope_radius=0.05)
 
 
 def bundle_preset(rows, duration, rounds, presets):
@@ -417,6 +461,110 @@ def bundle_converged(rows, duration):
     rows += [row_y, row_1, row_2]
 
 
+# The ladders of `bundle-ladder`: yarnsim's converged setting of the stiff
+# bundle (FLIP with `flip_time` 2 ms, the axial solve, `dt = "auto"`) at
+# the default safety factor 0.8, then 0.6 (the stiff bundle's converged
+# setting, docs/performance/cost.md) and its halvings (the mean step
+# follows the factor); MuJoCo's planar armature set-up at dt 1e-3 and its
+# halvings.
+LADDER_YARNSIM = (0.8, 0.6, 0.3, 0.15)
+LADDER_MUJOCO = (1e-3, 5e-4, 2.5e-4, 1.25e-4, 6.25e-5)
+# a run is converged at T when its centre of mass stays within T (m) of
+# every finer run of its ladder and of itself with gravity changed by
+# PERTURB over the whole second (frames every 0.1 s)
+LADDER_TOLS = (0.01, 0.02, 0.03, 0.05)
+# the relative change of gravity of the perturbed runs: how far a 1e-9
+# change moves the bundle (no step brings two runs closer than that)
+PERTURB = 1e-9
+
+
+def _com_apart(a, b):
+    d = bundle_metrics.frame_distances(a["frames"], b["frames"])
+    return d["com_max"] if d else float("nan")
+
+
+def bundle_ladder(rows, duration, name, finest_mujoco=None):
+    """The bundle with one real yarn of preset `name` per rope at a ladder
+    of steps in each tool (`LADDER_YARNSIM`, `LADDER_MUJOCO`, and
+    `finest_mujoco` (s) below them if given), one run each, the tools in
+    turn, then every run but the finest with gravity changed by
+    `PERTURB`. Each row's note gives how far its centre of mass lies from
+    the finer runs of its ladder and from its perturbed twin (at most,
+    over the second): its self-convergence and its sensitivity, the error
+    estimate of a scene without an oracle.
+    The tools are compared at each tolerance of `LADDER_TOLS` through
+    their cheapest run converged at it; where a tool has none the
+    comparison is a bound, against its finest run."""
+    g = O.BUNDLE["g"]
+    mat = O.preset_bundle(name)
+    base = (f"preset={name}", "axial-implicit", "time.dt=auto", "transfer.flip_time=0.002")
+
+    def ys(safety, extra=()):
+        return yarnsim_rope.bundle(duration, "explicit", "auto",
+                                   options=(*base, f"time.safety={safety}", *extra))
+
+    def mj(dt, material=mat):
+        return mujoco_rope.bundle(duration, dt=dt, material=material)
+
+    ladders = {"yarnsim": list(LADDER_YARNSIM),
+               "mujoco": list(LADDER_MUJOCO) + ([finest_mujoco] if finest_mujoco else [])}
+    run = {"yarnsim": ys, "mujoco": mj}
+    runs = {"yarnsim": [], "mujoco": []}
+    for i in range(max(len(x) for x in ladders.values())):
+        for tool in ("yarnsim", "mujoco"):
+            if i < len(ladders[tool]):
+                res = run[tool](ladders[tool][i])
+                runs[tool].append(res)
+                print(f"  bundle-ladder {tool:8s} {ladders[tool][i]:g}: {res['wall_s']:.2f} s "
+                      f"wall for {res['sim_s']:.3f} s", flush=True)
+    # every run but the finest again with gravity changed by PERTURB (not
+    # timed): how far a change far below any step's error moves it
+    perturbed = {
+        "yarnsim": [ys(x, (f"gravity=[0.0, {-g * (1 + PERTURB)!r}]",))
+                    for x in ladders["yarnsim"][:-1]],
+        "mujoco": [mj(x, dict(mat, g=g * (1 + PERTURB))) for x in ladders["mujoco"][:-1]],
+    }
+    ladder_rows = {"yarnsim": [], "mujoco": []}
+    for tool in ("yarnsim", "mujoco"):
+        rs, ladder = runs[tool], ladders[tool]
+        for i, res in enumerate(rs):
+            apart = [_com_apart(res, finer) for finer in rs[i + 1:]]
+            moved = _com_apart(res, perturbed[tool][i]) if apart else float("nan")
+            # its accuracy: the farthest finer run, or the perturbed one
+            err = max(apart + [moved]) if apart else float("nan")
+            if tool == "yarnsim":
+                integ = "mpm-axial-implicit"
+                setting = (f"{name}, 256^2, FLIP flip_time 2 ms, axial implicit, dt auto, "
+                           f"safety {ladder[i]:g}")
+            else:
+                integ = "discrete"
+                setting = f"{name}, CG, dt {ladder[i]:g}, r 1.9 mm, planar (y armature)"
+            extra = ("; centre of mass from the finer runs of the ladder at most "
+                     + ", ".join(f"{100 * d:.2f}" for d in apart) + " cm; with gravity "
+                     f"changed by {PERTURB:g} it moves {100 * moved:.2f} cm at most"
+                     if apart else "; the finest run of the ladder")
+            _, row = _bundle_row("bundle-ladder", tool, integ, setting, [res], extra)
+            rows.append(row)
+            ladder_rows[tool].append((row, err))
+    for tol in LADDER_TOLS:
+        best = {t: next(((r, e) for r, e in ladder_rows[t] if e <= tol), None)
+                for t in ladder_rows}
+        ours = best["yarnsim"]
+        if ours is None:
+            print(f"  bundle-ladder at {100 * tol:g} cm: no yarnsim run converged", flush=True)
+            continue
+        theirs, bound = best["mujoco"], ""
+        if theirs is None:
+            theirs, bound = ladder_rows["mujoco"][-1], " or more (MuJoCo: none converged; its finest)"
+        print(f"  bundle-ladder at {100 * tol:g} cm: yarnsim {ours[0]['setting']} "
+              f"{ours[0]['wall_s_per_sim_s']:.3g} s/s; MuJoCo {theirs[0]['setting']} "
+              f"{theirs[0]['wall_s_per_sim_s']:.3g} s/s; MuJoCo / yarnsim "
+              f"{theirs[0]['wall_s_per_sim_s'] / ours[0]['wall_s_per_sim_s']:.3g}{bound}",
+              flush=True)
+    print(f"  bundle-ladder: the two finest runs' centres of mass at most "
+          f"{100 * _com_apart(runs['yarnsim'][-1], runs['mujoco'][-1]):.2f} cm apart", flush=True)
+
+
 def merge_rows(path, rows):
     """The rows of `path` whose case is not among `rows`' cases, then
     `rows` (a partial run replaces its own cases only)."""
@@ -461,8 +609,11 @@ def main():
                     help="simulated seconds of the grid implicit bundle run (~500 s/s)")
     ap.add_argument("--replot", metavar="CSV", help="only redraw the SVG next to CSV")
     ap.add_argument("--only", metavar="GROUPS",
-                    help="comma-separated: bundle-preset, bundle-converged, nylon; runs only "
+                    help="comma-separated: bundle-preset, bundle-converged, bundle-ladder, nylon; "
+                         "runs only "
                          "those and replaces their cases' rows in the existing CSV")
+    ap.add_argument("--finest-mujoco", type=float, default=None, metavar="DT",
+                    help="bundle-ladder: one more MuJoCo step below the ladder's (s)")
     ap.add_argument("--presets", default="polyester-167dtex,nylon66-mono-0.30mm",
                     help="the presets of bundle-preset (comma-separated)")
     a = ap.parse_args()
@@ -482,17 +633,21 @@ def main():
     t_start = time.time()
     if a.only:
         groups = a.only.split(",")
-        unknown = set(groups) - {"bundle-preset", "bundle-converged", "nylon"}
+        unknown = set(groups) - {"bundle-preset", "bundle-converged", "bundle-ladder", "nylon"}
         if unknown:
             ap.error(f"--only: unknown group(s) {', '.join(sorted(unknown))}")
         rows = []
         try:
             if "nylon" in groups:
                 nylon(rows, rounds)
+                nylon_capstan(rows)
             if "bundle-preset" in groups:
                 bundle_preset(rows, a.bundle_duration, rounds, a.presets.split(","))
             if "bundle-converged" in groups:
                 bundle_converged(rows, a.bundle_duration)
+            if "bundle-ladder" in groups:
+                for name in a.presets.split(","):
+                    bundle_ladder(rows, a.bundle_duration, name, a.finest_mujoco)
         finally:
             # the rows of the groups that ran, also when a later one fails
             write(out, stem, merge_rows(os.path.join(out, stem + ".csv"), rows), t_start)

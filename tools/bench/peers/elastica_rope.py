@@ -128,7 +128,7 @@ def cantilever(elements):
 
 
 def capstan_slides(elements, mu, dt=5e-5, radius=2e-3, k_contact=1e4, nu=10.0, c_v=50.0,
-                   load_damping=20.0, load=None, hold=None):
+                   load_damping=20.0, load=None, hold=None, c=None, material=None):
     """The heavy rope over a fixed rigid cylinder (axis y) with
     `RodCylinderContact` (spring k, dashpot nu, Coulomb friction mu
     regularised by the slip-velocity coefficient c_v), EA = 1000 as yarnsim's
@@ -136,13 +136,20 @@ def capstan_slides(elements, mu, dt=5e-5, radius=2e-3, k_contact=1e4, nu=10.0, c
     R + r); its velocity is damped (rate `load_damping` 1/s) during the
     0.2 s load, then it holds 1 s undamped: slid if a free end moved
     vertically by more than 0.5 % of its hanging length. Returns (slid,
-    wall seconds, simulated seconds)."""
+    wall seconds, simulated seconds). `c` replaces `O.CAPSTAN`
+    (`O.capstan_scaled`); `material` (`k` EA in N, `rho` kg/m, `bending`
+    EI in N m^2: `O.preset_chain`) the rope (the contact's spring and
+    dashpot then scale with its line density, so that the contact's
+    frequency and damping ratio stay those of the 1 kg/m rope)."""
     from elastica import Contact, Cylinder, RodCylinderContact
 
     class Sim(BaseSystemCollection, Constraints, Forcing, Contact):
         pass
 
-    c = O.CAPSTAN
+    c = c or O.CAPSTAN
+    rho, ea, bend = ((material["rho"], material["k"], material["bending"]) if material
+                     else (1.0, 1000.0, 1e-6))
+    k_contact, nu = k_contact * rho, nu * rho
     R, l1, l2, g = c["radius"], c["l1"], c["l2"], c["g"]
     Rc = R + radius
     pts, total = O.capstan_centreline(elements, Rc, c)
@@ -151,10 +158,10 @@ def capstan_slides(elements, mu, dt=5e-5, radius=2e-3, k_contact=1e4, nu=10.0, c
     sim = Sim()
     rod = CosseratRod.straight_rod(
         elements, pos[:, 0], np.array([0.0, 0.0, 1.0]), np.array([0.0, 1.0, 0.0]), total,
-        radius, 1.0 / area, youngs_modulus=1000.0 / area, position=pos,
+        radius, rho / area, youngs_modulus=ea / area, position=pos,
         directors=_directors(pos))
-    rod.bend_matrix[0, 0, :] = 1e-6
-    rod.bend_matrix[1, 1, :] = 1e-6
+    rod.bend_matrix[0, 0, :] = bend
+    rod.bend_matrix[1, 1, :] = bend
     rod.rest_lengths[:] = np.linalg.norm(np.diff(pos, axis=1), axis=0)
     cyl = Cylinder(np.array([0.0, -0.05, 0.0]), np.array([0.0, 1.0, 0.0]),
                    np.array([1.0, 0.0, 0.0]), 0.1, R, 1e3)

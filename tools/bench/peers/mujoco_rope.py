@@ -118,12 +118,17 @@ def cantilever(elements, dt, duration=3.0, rate=20.0):
                 sim_s=steps * dt)
 
 
-def capstan_slides(elements, dt, mu, radius=1e-3):
+def capstan_slides(elements, dt, mu, radius=1e-3, c=None, material=None):
     """Heavy rope over a half cylinder (axis y) with friction mu on both the
     rope and the cylinder (MuJoCo takes the larger). Loads for 0.2 s, then
     holds 1 s: slid if a free end moved vertically by more than 0.5 % of its
-    hanging length. Returns (slid, wall seconds, simulated seconds)."""
-    c = O.CAPSTAN
+    hanging length. Returns (slid, wall seconds, simulated seconds). `c`
+    replaces `O.CAPSTAN` (`O.capstan_scaled`); `material` (`rho` in kg/m,
+    `bending` EI in N m^2: `O.preset_chain`) the bending-free rope of 1
+    kg/m."""
+    c = c or O.CAPSTAN
+    rho = material["rho"] if material else 1.0
+    young = 4.0 * material["bending"] / (math.pi * radius ** 4) if material else 0
     R, l1, l2 = c["radius"], c["l1"], c["l2"]
     Rc = R + radius  # the centreline lies on the cylinder surface
     pts, total = O.capstan_centreline(elements, Rc, c)
@@ -133,11 +138,11 @@ def capstan_slides(elements, dt, mu, radius=1e-3):
         f'<mujoco><option gravity="0 0 {-c["g"]}" integrator="discrete" timestep="{dt}" '
         f'cone="elliptic" impratio="100"/><worldbody>'
         f'<geom type="cylinder" size="{R} 0.05" euler="90 0 0" friction="{fr}" solref="2e-3 1"/>'
-        f"{_rope_xml('rope', pts, radius, 1.0 * total, 0, 1e-3, [], contact=contact)}"
+        f"{_rope_xml('rope', pts, radius, rho * total, young, 1e-3, [], contact=contact)}"
         f"</worldbody></mujoco>"
     )
     m = mujoco.MjModel.from_xml_string(xml)
-    adr, num = _set_masses(m, "rope", total / elements, 1.0)
+    adr, num = _set_masses(m, "rope", total / elements, rho)
     _refresh(m)
     d = mujoco.MjData(m)
     t0 = time.perf_counter()

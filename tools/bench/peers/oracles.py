@@ -126,6 +126,20 @@ def capstan_tension(mu, r, w, l1, n=2000):
     return t
 
 
+def capstan_scaled(scale):
+    """`CAPSTAN` with its lengths times `scale` and its load and hold times
+    `sqrt(scale)`: the same motion in units of the hanging lengths (Froude
+    scaling), the same mu* (`capstan_threshold` depends on the ratios of
+    the lengths only), while a yarn's bending moment EI / R against the
+    hanging tension's moment shrinks as 1 / scale^3."""
+    c = dict(CAPSTAN)
+    for k in ("radius", "l1", "l2"):
+        c[k] *= scale
+    for k in ("load", "hold"):
+        c[k] *= math.sqrt(scale)
+    return c
+
+
 def capstan_threshold(r, l1, l2):
     """mu* at which the heavy rope just holds (bisection on T(pi R) = w l2)."""
     lo, hi = 0.0, 5.0

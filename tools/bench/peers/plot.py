@@ -11,9 +11,10 @@ INTEGRATOR_COLORS = {("yarnsim", "mpm-implicit"): "#9467bd",
                      ("yarnsim", "vertices-midpoint"): "#e377c2",
                      ("yarnsim", "mpm-axial-implicit"): "#17becf"}
 # the single-yarn cases (the bundles have no oracle: not drawn)
-DASH = {"chain": "", "cantilever": "6,3", "capstan": "2,2", "chain-nylon": "10,3,2,3"}
+DASH = {"chain": "", "cantilever": "6,3", "capstan": "2,2", "chain-nylon": "10,3,2,3",
+        "capstan-nylon": "10,3,2,3"}
 MARK = {"chain": "circle", "cantilever": "square", "capstan": "diamond",
-        "chain-nylon": "circle"}
+        "chain-nylon": "circle", "capstan-nylon": "diamond"}
 
 
 def _ticks(lo, hi):

@@ -15,5 +15,7 @@ if ! "$venv/bin/python" -c "$want" 2>/dev/null; then
     "$venv/bin/pip" install --quiet mujoco==4.0.0 pyelastica==1.0.0 numpy
     "$venv/bin/python" -c "$want"
 fi
-(cd "$here/../../.." && cargo build --workspace --release --example peers_chain)
+# the CLI gives the presets (`yarnsim materials`, oracles.preset); the
+# example is yarnsim's side of every case
+(cd "$here/../../.." && cargo build --workspace --release --example peers_chain --bin yarnsim)
 echo "peers ready: $venv/bin/python $here/bench.py"

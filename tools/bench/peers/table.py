@@ -5,11 +5,13 @@
     python3 tools/bench/peers/table.py --at-peer-error [CSV]                 # the goals' comparison
 
 `--at-peer-error`: for every peer row of a single-yarn case (chain,
-cantilever, capstan), the cheapest row of yarnsim's implicit integrators
+cantilever, capstan, and the nylon monofilament's `chain-nylon` and
+`capstan-nylon`), the cheapest row of yarnsim's implicit integrators
 (the goal is theirs: every integrator but `mpm-explicit`) of the same case
 whose |error| is at or below the peer's (the capstan: the threshold
-bracket's midpoint; `chain-nylon`: yarnsim's only rows, the grid with the
-axial solve), and the ratio of their wall times per simulated second;
+bracket's midpoint; `chain-nylon`: the grid with the axial solve and the
+yarn's vertices without the grid), and the ratio of their wall times per
+simulated second;
 for the bundles (no oracle; `bundle`, `bundle-preset` per preset,
 `bundle-converged`), every yarnsim row against every MuJoCo row over
 the same simulated time.
@@ -57,7 +59,7 @@ def at_peer_error(path):
     print("| case | peer at its error (wall s per simulated s) | yarnsim cheapest at or below "
           "that error | yarnsim / peer |")
     print("|---|---|---|---|")
-    for case in ("chain", "cantilever", "capstan", "chain-nylon"):
+    for case in ("chain", "cantilever", "capstan", "chain-nylon", "capstan-nylon"):
         ours = [r for r in rows if r["tool"] == "yarnsim" and r["case"] == case
                 and r["integrator"] != "mpm-explicit" and math.isfinite(r["error"])]
         for p in (r for r in rows if r["tool"] != "yarnsim" and r["case"] == case):

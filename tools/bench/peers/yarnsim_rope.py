@@ -50,10 +50,12 @@ def chain(vertices, grid, dt, integrator="explicit", k=None):
     return _refused(_run("chain", vertices, grid, dt, *_opt(integrator, k)))
 
 
-def chain_preset(preset, vertices, grid, dt, oracle):
+def chain_preset(preset, vertices, grid, dt, oracle, integrator=None):
     """The hanging chain as one yarn of `preset` (APIC, `[time] axial =
-    "implicit"`): `error` against the period `oracle` (s)."""
-    res = _refused(_run("chain-preset", preset, vertices, grid, dt))
+    "implicit"`; or, with `integrator` "implicit-vertices" or
+    "midpoint-vertices", on its vertices without the grid): `error`
+    against the period `oracle` (s)."""
+    res = _refused(_run("chain-preset", preset, vertices, grid, dt, *_opt(integrator)))
     if "period" in res:
         res["error"] = (res["period"] - oracle) / oracle
     return res
@@ -94,3 +96,13 @@ def bundle(duration, integrator="explicit", dt=None, threads=1, options=()):
         res["yarns"] = [np.array(y) for y in res["yarns"]]
         res["frames"] = [[t, [np.array(y) for y in ys]] for t, ys in res.get("frames", [])]
     return res
+
+
+def capstan_preset_slides(preset, scale, mu, integrator, dt=None):
+    """(slid, wall_s, sim_s) of the capstan as one yarn of `preset`, its
+    lengths times `scale` (`oracles.capstan_scaled`), on the yarn's
+    vertices (`integrator` "implicit-vertices" or "midpoint-vertices")."""
+    res = _refused(_run("capstan-preset", preset, scale, mu, *_opt(integrator, dt)))
+    if "refused" in res:
+        raise Refused(res["refused"])
+    return res.get("slid", False) or not res["ok"], res["wall_s"], res["sim_s"]
