@@ -116,11 +116,15 @@ const DECREASE_TOL: f64 = 1e-8;
 /// line search, on an energy that cancels to round-off near the rest
 /// length, nothing left to measure. The line search may likewise stop once
 /// the gradient has fallen by 1e-3 (`floor_tol`, 1e-6 in the grid-free
-/// integrator): the spring energy `a / 2 (|e| / l0 - 1)^2` is computed to
+/// integrator): the spring energy `a / 2 (|e| / l0 - 1)^2` was computed to
 /// a relative precision of about `eps |x| / |e| / (|e| / l0 - 1)`, 1e-8 at
 /// the strains of a stiff fibre (1e-6 at k = 1e7 on the reference bundle),
 /// and for the same reason Newton stops where its step would lower the
-/// energy by less than 1e-8 of it ([`DECREASE_TOL`]).
+/// energy by less than 1e-8 of it ([`DECREASE_TOL`]). Since the step's
+/// energy forms its segment vectors from the start's ([`Rod::edges`]),
+/// a trial's energy is rounded at `|e|`, not at `|x|`: these floors are
+/// now bounds above the round-off, kept as they were measured (the stiff
+/// bundle's Newton counts and cost).
 fn round_off(rod: &Rod) -> f64 {
     let stiff = rod
         .segments

@@ -351,7 +351,7 @@ def nylon(rows, rounds):
     # one yarn needs no grid: its vertices under the midpoint rule (the
     # preset's EA, EI and mass; `peers_chain chain-preset ... INTEGRATOR`),
     # at the settings that reach MuJoCo's three errors
-    for v, dt in [(40, 1e-2), (100, 5e-3), (100, 2e-3)]:
+    for v, dt in [(40, 1e-2), (100, 5e-3), (100, 2e-3), (150, 2e-3)]:
         c.append(("yarnsim", "vertices-midpoint", "chain-nylon",
                   f"{v} vertices, no grid, dt {dt:g}",
                   lambda v=v, dt=dt: yarnsim_rope.chain_preset(NYLON, v, 16, dt, mat["oracle"],
