@@ -102,6 +102,23 @@ fn cantilever_tip_matches_euler_bernoulli() {
     }
 }
 
+/// Whether a capstan yarn hanging `l1` and `l2` slides: after `load` s,
+/// a free end moves by more than 0.5 % of its hanging length before `load
+/// + hold` s (dt 1e-2).
+fn slides(s: YarnScene, integ: Integrator, (l1, l2): (f64, f64), load: f64, hold: f64) -> bool {
+    let mut sim = YarnSim::new(&with(s, integ, 1e-2)).unwrap();
+    sim.advance(load).unwrap();
+    let (a0, b0) = sim.yarn_endpoints(0);
+    while sim.time() < load + hold - 1e-9 {
+        sim.step().unwrap_or_else(|e| panic!("{integ:?}: {e}"));
+        let (a, b) = sim.yarn_endpoints(0);
+        if ((a.y - a0.y).abs() / l1).max((b.y - b0.y).abs() / l2) > 5e-3 {
+            return true;
+        }
+    }
+    false
+}
+
 /// Whether the capstan yarn (r 0.1, hanging 0.1 and 0.3) slides at
 /// friction `f mu*` within 1 s after 0.2 s of loading.
 fn capstan_slides(integ: Integrator, f: f64) -> bool {
@@ -109,17 +126,7 @@ fn capstan_slides(integ: Integrator, f: f64) -> bool {
     // mu*: the heavy rope's threshold (its weight on the arc included)
     let mu = f * capstan_threshold(r, l1, l2);
     let s = YarnScene::from_toml_str(&capstan_toml(r, l1, l2, mu, &CAPSTAN_PURE_STRING)).unwrap();
-    let mut sim = YarnSim::new(&with(s, integ, 1e-2)).unwrap();
-    sim.advance(0.2).unwrap();
-    let (a0, b0) = sim.yarn_endpoints(0);
-    for _ in 0..100 {
-        sim.step().unwrap();
-        let (a, b) = sim.yarn_endpoints(0);
-        if ((a.y - a0.y).abs() / l1).max((b.y - b0.y).abs() / l2) > 5e-3 {
-            return true;
-        }
-    }
-    false
+    slides(s, integ, (l1, l2), 0.2, 1.0)
 }
 
 /// The heavy-rope capstan: the yarn slides at 0.9 mu* and holds at 1.1
@@ -143,18 +150,7 @@ fn nylon_capstan_slides(integ: Integrator, f: f64) -> bool {
     let scale: f64 = 10.0;
     let mu = f * capstan_threshold(0.1, 0.1, 0.3);
     let (s, l1, l2) = capstan_preset_scene("nylon66-mono-0.30mm", scale, mu, &CAPSTAN_PURE_STRING);
-    let mut sim = YarnSim::new(&with(s, integ, 1e-2)).unwrap();
-    sim.advance(0.2 * scale.sqrt()).unwrap();
-    let (a0, b0) = sim.yarn_endpoints(0);
-    while sim.time() < 1.2 * scale.sqrt() {
-        sim.step()
-            .unwrap_or_else(|e| panic!("{integ:?} at {f} mu*: {e}"));
-        let (a, b) = sim.yarn_endpoints(0);
-        if ((a.y - a0.y).abs() / l1).max((b.y - b0.y).abs() / l2) > 5e-3 {
-            return true;
-        }
-    }
-    false
+    slides(s, integ, (l1, l2), 0.2 * scale.sqrt(), scale.sqrt())
 }
 
 /// The capstan oracle with a real yarn metres from the origin: slides at
