@@ -352,6 +352,17 @@ pub fn capstan_vertices(r: f64, l1: f64, l2: f64, res: u32) -> u32 {
     (length / (0.5 * dx)).round() as u32 + 1
 }
 
+/// Scene TOML `text` with its `[material]` table, up to the next table,
+/// replaced by one of the lines `material` (each ending in a newline), as
+/// a scene gives a preset instead of the model's parameters.
+pub fn with_material_table(text: &str, material: &str) -> String {
+    let start = text.find("[material]").expect("a [material] table");
+    let end = text[start..]
+        .find("\n[")
+        .map_or(text.len(), |e| start + e + 1);
+    format!("{}[material]\n{material}{}", &text[..start], &text[end..])
+}
+
 /// The capstan of [`capstan_toml`] (R 0.1, L1 0.1, L2 0.3 m, the grid and
 /// step of `c`) as one yarn of `[material] preset = preset` on its
 /// vertices (the preset's cross-section energies off: a gridless
@@ -369,15 +380,9 @@ pub fn capstan_preset_scene(
     c: &Capstan,
 ) -> (YarnScene, f64, f64) {
     let (r, l1, l2) = (0.1, 0.1, 0.3);
-    let mut text = capstan_toml(r, l1, l2, mu, c);
-    let start = text.find("[material]").expect("[material] table");
-    let end = start
-        + text[start..]
-            .find("[walls]")
-            .expect("[walls] after [material]");
-    text.replace_range(
-        start..end,
-        &format!("[material]\npreset = {preset:?}\ngamma = 0.0\nyoungs_modulus = 0.0\n"),
+    let text = with_material_table(
+        &capstan_toml(r, l1, l2, mu, c),
+        &format!("preset = {preset:?}\ngamma = 0.0\nyoungs_modulus = 0.0\n"),
     );
     let mut s = YarnScene::from_toml_str(&text).expect("the capstan with a preset");
     s.grid.size *= scale;

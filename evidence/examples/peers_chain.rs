@@ -75,8 +75,8 @@ use yarnsim::scene::{
     builtin_toml, Axial, FieldPartition, Integrator, Scene, StepSize, TransferScheme, YarnScene,
 };
 use yarnsim::testing::{
-    cantilever_setup, cantilever_toml, capstan_preset_scene, capstan_toml, capstan_vertices,
-    hanging_chain_period, hanging_chain_toml, two_periods_about_mean, ZeroCrossings,
+    cantilever_setup, cantilever_toml, capstan_preset_scene, capstan_toml, hanging_chain_period,
+    hanging_chain_toml, two_periods_about_mean, with_material_table, ZeroCrossings,
     CAPSTAN_PURE_STRING,
 };
 use yarnsim::YarnSim;
@@ -245,9 +245,8 @@ fn capstan(r: f64, l1: f64, l2: f64, mu: f64, integ: Integrator, dt: Option<f64>
     if let Some(dt) = dt {
         c.dt = dt;
     }
-    let vertices = capstan_vertices(r, l1, l2, c.res);
     let s = scene(&capstan_toml(r, l1, l2, mu, &c));
-    capstan_run(s, integ, (l1, l2), (0.2, 1.0), vertices)
+    capstan_run(s, integ, (l1, l2), (0.2, 1.0))
 }
 
 /// The capstan of `capstan` (R 0.1, L1 0.1, L2 0.3 m) as one yarn of
@@ -262,10 +261,9 @@ fn capstan_preset(preset: &str, scale: f64, mu: f64, integ: Integrator, dt: Opti
     if let Some(dt) = dt {
         c.dt = dt;
     }
-    let vertices = capstan_vertices(0.1, 0.1, 0.3, c.res);
     let (s, l1, l2) = capstan_preset_scene(preset, scale, mu, &c);
     let t = scale.sqrt();
-    capstan_run(s, integ, (l1, l2), (0.2 * t, 1.0 * t), vertices)
+    capstan_run(s, integ, (l1, l2), (0.2 * t, 1.0 * t))
 }
 
 /// One capstan run: loaded for `load` s, then held `hold` s; slid if a
@@ -276,8 +274,8 @@ fn capstan_run(
     integ: Integrator,
     (l1, l2): (f64, f64),
     (load, hold): (f64, f64),
-    vertices: u32,
 ) -> String {
+    let vertices = s.yarns[0].vertices;
     let mut sim = sim_with(s, integ);
     let t0 = Instant::now();
     let mut ok = match sim.advance(load) {
@@ -350,11 +348,9 @@ fn bundle_scene(options: &[String]) -> YarnScene {
         .to_string();
     for o in options {
         if let Some(name) = o.strip_prefix("preset=") {
-            let start = text.find("[material]").expect("[material] table");
-            let end = start + text[start..].find("\n\n").expect("end of [material]");
-            text.replace_range(
-                start..end,
-                &format!("[material]\npreset = {}\nplasticity = true", json_str(name)),
+            text = with_material_table(
+                &text,
+                &format!("preset = {}\nplasticity = true\n", json_str(name)),
             );
         }
     }
