@@ -74,13 +74,17 @@ class Refused(Exception):
     """The scene validation refused the run (the message is its text)."""
 
 
-def capstan_slides(r, l1, l2, mu, integrator="explicit", dt=None):
-    """(slid, wall_s, sim_s) of one capstan run; raises `Refused` when the
-    scene is refused."""
-    res = capstan(r, l1, l2, mu, integrator, dt)
+def _slides(res):
+    """(slid, wall_s, sim_s) of one capstan run's JSON (a run that failed
+    counts as slid); raises `Refused` when the scene is refused."""
     if "refused" in res:
         raise Refused(res["refused"])
     return res.get("slid", False) or not res["ok"], res["wall_s"], res["sim_s"]
+
+
+def capstan_slides(r, l1, l2, mu, integrator="explicit", dt=None):
+    """(slid, wall_s, sim_s) of one capstan run (`_slides`)."""
+    return _slides(capstan(r, l1, l2, mu, integrator, dt))
 
 
 def bundle(duration, integrator="explicit", dt=None, threads=1, options=()):
@@ -101,8 +105,5 @@ def bundle(duration, integrator="explicit", dt=None, threads=1, options=()):
 def capstan_preset_slides(preset, scale, mu, integrator, dt=None):
     """(slid, wall_s, sim_s) of the capstan as one yarn of `preset`, its
     lengths times `scale` (`oracles.capstan_scaled`), on the yarn's
-    vertices (`integrator` "implicit-vertices" or "midpoint-vertices")."""
-    res = _refused(_run("capstan-preset", preset, scale, mu, *_opt(integrator, dt)))
-    if "refused" in res:
-        raise Refused(res["refused"])
-    return res.get("slid", False) or not res["ok"], res["wall_s"], res["sim_s"]
+    vertices (`integrator` "implicit-vertices" or "midpoint-vertices"; `_slides`)."""
+    return _slides(_refused(_run("capstan-preset", preset, scale, mu, *_opt(integrator, dt))))
