@@ -624,7 +624,7 @@ def main():
                                                                         "performance"))
     stem = "peers_quick" if a.quick else "peers"
     rounds = 1 if a.quick else a.rounds
-    if not os.path.exists(yarnsim_rope.BIN):
+    if not all(os.path.exists(b) for b in (yarnsim_rope.BIN, yarnsim_rope.CLI)):
         yarnsim_rope.build()
     # warm-up: Numba compiles PyElastica's kernels on the first run (cached)
     elastica_rope.chain(4, dt=1e-4, duration=0.01)

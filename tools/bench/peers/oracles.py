@@ -3,7 +3,6 @@
 Euler-Bernoulli cantilever and the heavy-rope capstan threshold."""
 
 import math
-import os
 
 J01 = 2.404825557695773  # first zero of J0
 
@@ -163,9 +162,9 @@ def preset(name):
     friction on yarn and on solids, as `yarnsim materials` lists them (the
     one table: `src/scene/yarn/presets.rs`)."""
     import subprocess
-    root = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", "..", ".."))
-    out = subprocess.run([os.path.join(root, "target", "release", "yarnsim"), "materials"],
-                         check=True, capture_output=True, text=True).stdout
+
+    from yarnsim_rope import CLI
+    out = subprocess.run([CLI, "materials"], check=True, capture_output=True, text=True).stdout
     for line in out.splitlines():
         f = line.split()
         if f and f[0] == name:

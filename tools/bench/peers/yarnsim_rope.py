@@ -11,11 +11,14 @@ import subprocess
 
 ROOT = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", "..", ".."))
 BIN = os.path.join(ROOT, "target", "release", "examples", "peers_chain")
+# the CLI, whose `yarnsim materials` gives the presets (`oracles.preset`)
+CLI = os.path.join(ROOT, "target", "release", "yarnsim")
 
 
 def build():
-    subprocess.run(["cargo", "build", "--workspace", "--release", "--example", "peers_chain"], cwd=ROOT,
-                   check=True)
+    """The example and the CLI, as `setup.sh` builds them."""
+    subprocess.run(["cargo", "build", "--workspace", "--release", "--example", "peers_chain",
+                    "--bin", "yarnsim"], cwd=ROOT, check=True)
 
 
 def _run(*args, threads=1):
